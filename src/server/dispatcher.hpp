@@ -1,0 +1,50 @@
+// The pure request handler: one FINS request frame in, at most one response frame out.
+// No sockets and no clock of its own (the caller passes `now`), so it is unit-tested
+// directly and fuzzed. Sessions (udp_server, tcp_server) only read, call, write.
+//
+// Path of a request: decode header -> address check (is it for this node/unit?) ->
+// command table lookup (unknown -> 0401) -> execution conditions of W342 5-1-2 ->
+// the command's handler (src/server/handlers/<group>.cpp) -> response frame.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+
+#include "fins/byte_io.hpp"
+#include "fins/frame.hpp"
+
+namespace fins::plc {
+class Plc;
+}
+
+namespace fins::server {
+
+enum class Link : std::uint8_t { udp, tcp, local };
+
+// What the session knows about where a request came from.
+struct RequestContext {
+    Link link = Link::udp;
+    std::chrono::system_clock::time_point now{};
+};
+
+class Dispatcher {
+public:
+    // `self` is this node's address on the network (network, node, unit 00).
+    Dispatcher(plc::Plc& plc, NodeAddress self) noexcept;
+
+    // Handles one request frame. Writes the response frame into `out` (which must hold
+    // max_frame_size bytes) and returns its length, or 0 when nothing is to be sent:
+    // the ICF no-response bit was set, the frame is itself a response, or it is too
+    // short to carry a header and command code (there is no SID to answer).
+    std::size_t handle(Bytes request, MutableBytes out, const RequestContext& context);
+
+    [[nodiscard]] const NodeAddress& self() const noexcept { return self_; }
+    plc::Plc& plc() noexcept { return plc_; }
+
+private:
+    plc::Plc& plc_;
+    NodeAddress self_;
+};
+
+}  // namespace fins::server
