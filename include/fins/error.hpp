@@ -124,7 +124,8 @@ enum class AddressError : int {
 const std::error_category& address_category() noexcept;
 std::error_code make_error_code(AddressError e) noexcept;
 
-// "0x1103 address range error" style text for logs and the CLI.
+// "1103 address range error" for end codes, ec.message() for everything else: text
+// for logs and the CLI.
 std::string describe(std::error_code ec);
 
 }  // namespace fins

@@ -87,10 +87,10 @@ struct ResponseView {
 void write_header(ByteWriter& w, const Header& h) noexcept;
 Header read_header(ByteReader& r) noexcept;
 
-// Whole-frame codecs. decode_request fails with ClientError::malformed_response style
-// errors only for frames too short to carry a header and command code
-// (EndCode::command_too_short) or longer than 2,012 bytes (EndCode::command_too_long), or
-// whose ICF marks a response (EndCode::header_error).
+// Whole-frame codecs. decode_request (server side) fails, with FINS end codes, only for
+// frames too short to carry a header and command code (EndCode::command_too_short),
+// longer than 2,012 bytes (EndCode::command_too_long), or whose ICF marks a response
+// (EndCode::header_error).
 Result<RequestView> decode_request(Bytes frame) noexcept;
 // Fails with ClientError::malformed_response when shorter than header + command + end code,
 // when ICF lacks the response bit, or when bit 15 is set without the relay word.
@@ -106,7 +106,7 @@ Result<std::size_t> encode_request(const Header& h, CommandCode c, Bytes paramet
 // when the request addressed it as "local" (node 00).
 Header response_header(const Header& request, const NodeAddress& responder) noexcept;
 
-// Writes the response frame prefix (header, command, end code) and returns the writer
+// Writes the response frame prefix (header, command, end code), leaving the writer
 // positioned at the start of the response data.
 void write_response_prefix(ByteWriter& w, const Header& response_header, CommandCode c,
                            std::uint16_t end_code) noexcept;

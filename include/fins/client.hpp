@@ -1,0 +1,227 @@
+// fins::Client: a FINS client over UDP or TCP (frames sections 2-3), modelled on the
+// NX SendCmd instruction (W596 section 3, SendCmd p. 3-16): per-request timeout, 0-15
+// retries of the same frame, an optional no-response mode, many requests in flight
+// (an NX CPU runs at most 32 Send/Rcv/SendCmd at once; this client allows 256, one per
+// service ID, and the PLC's own limits still apply).
+//
+// Threading: a Client owns one asio::io_context and runs it only inside its own calls
+// (send*, run, the helpers, connect). It is NOT thread-safe: use it from one thread.
+// Completion callbacks of async_send*() run on that thread, inside send*()/run()/a
+// helper; a callback may call async_send*() again, but must not call the synchronous
+// methods (send, send_raw, send_no_response, run, the helpers: they run the io_context,
+// which asio forbids from inside one of its handlers) and must not destroy the Client.
+//
+// Requests: up to 256 in flight (service IDs allocated round-robin); one more fails
+// with ClientError::too_many_in_flight rather than waiting in a queue. Each
+// attempt waits `timeout`; after `retries` retransmissions the request fails with
+// ClientError::timeout. A response is matched by SID, command code and addresses;
+// stale or duplicate answers are dropped and counted in stats().
+//
+// Errors (all std::error_code): EndCode for a non-zero end code in send<C>() and the
+// helpers (end-code flag bits 0x0040/0x0080 alone still count as success; send_raw()
+// returns every end code to the caller instead), ClientError for local failures, TcpError
+// for FINS/TCP envelope and handshake errors, and system errors from resolve/connect.
+//
+// Connection loss: every request in flight fails with ClientError::connection_closed
+// (TcpError after a command-3 notification). Nothing is re-sent automatically, since the
+// PLC may have executed it. The next request reconnects (TCP: with a fresh handshake,
+// which may allocate a different client node) and is sent once the link is up.
+//
+// Address defaults (node 0 in ClientOptions means "derive"):
+//   destination: TCP -> the server node from the handshake; UDP -> the last octet of
+//                the host's IPv4 address (1 for loopback, last byte for other IPv6).
+//   source:      TCP -> the node the server allocated (or the one requested);
+//                UDP -> the last octet of the local address; if that equals the
+//                destination node (loopback), 254 instead, so the two ends differ.
+#pragma once
+
+#include <array>
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "fins/address.hpp"
+#include "fins/byte_io.hpp"
+#include "fins/commands/memory_area.hpp"
+#include "fins/error.hpp"
+#include "fins/frame.hpp"
+
+namespace fins {
+
+struct ClientOptions {
+    std::string host = "127.0.0.1";
+    std::uint16_t port = 9600;
+    enum class Protocol { udp, tcp } protocol = Protocol::udp;
+    NodeAddress destination;  // node 0: derive (see above)
+    NodeAddress source;       // node 0: derive (see above); TCP: sent in the handshake
+    // Per attempt; also bounds connecting and the TCP handshake. W596 p. 3-16: 0 means 2.0 s.
+    std::chrono::milliseconds timeout{2000};
+    unsigned retries = 0;  // W596 p. 3-16 Option.Retry: 0-15
+    std::uint8_t gateway_count = default_gateway_count;
+};
+
+// A response exactly as received (W596 SendCmd p. 3-16 RespDat): the end code is not
+// interpreted.
+struct RawResponse {
+    Header header;
+    CommandCode command;
+    ResponseCode code;
+    std::optional<RelayErrorSource> relay;  // when code.relay_error()
+    std::vector<std::uint8_t> data;         // bytes after the end code (and relay word)
+};
+
+struct ClientStats {
+    std::uint64_t sent = 0;               // request frames sent (first attempts)
+    std::uint64_t retransmitted = 0;      // frames re-sent after a timeout
+    std::uint64_t completed = 0;          // responses matched to a request
+    std::uint64_t timed_out = 0;          // requests failed with ClientError::timeout
+    std::uint64_t failed = 0;             // requests failed by connection loss or close
+    std::uint64_t stale_discarded = 0;    // answers to no request in flight / wrong command
+    std::uint64_t invalid_discarded = 0;  // undecodable frames, wrong addresses
+    std::uint64_t reconnects = 0;         // successful opens after the first
+};
+
+class Client {
+  public:
+    // Resolves, connects (TCP: handshake) and derives the node addresses. Fails with
+    // ClientError::invalid_argument (retries > 15), a resolve/connect error, a TcpError
+    // from the handshake, or ClientError::timeout.
+    static Result<std::unique_ptr<Client>> connect(ClientOptions options);
+    // Closes the connection; requests still in flight are dropped without callbacks.
+    ~Client();
+    Client(const Client&) = delete;
+    Client& operator=(const Client&) = delete;
+
+    // ---- typed commands (any type with code, Response, encode, decode_response) ----
+    template <class C>
+    Result<typename C::Response> send(const C& command);
+    // The command is encoded before async_send() returns; a copy is kept to decode the
+    // response (it must not need the views it holds, e.g. MemoryAreaWrite::data).
+    template <class C>
+    void async_send(const C& command, std::function<void(Result<typename C::Response>)> done);
+    template <class C>
+    Result<void> send_no_response(const C& command);
+
+    // ---- raw access, like SendCmd: parameters = the bytes after MRC SRC ----
+    Result<RawResponse> send_raw(CommandCode code, Bytes parameters);
+    void async_send_raw(CommandCode code, Bytes parameters,
+                        std::function<void(Result<RawResponse>)> done);
+    // ICF bit 0 (frames 1.2): nothing is awaited; returns once the frame has been handed
+    // to the kernel (or after `timeout` if it could not be). Reconnects first if needed.
+    Result<void> send_no_response(CommandCode code, Bytes parameters);
+
+    // Runs until no request is in flight.
+    void run();
+
+    // ---- I/O memory helpers (01 01 .. 01 05, W342 5-3-2 .. 5-3-6) ----
+    // Reads above 999 words / writes above 997 words (W342 5-2-2 "Number of Elements",
+    // Ethernet) are split into several requests kept in flight together and joined; if
+    // any part fails the whole call fails with that part's error (writes may then be
+    // partly done). Bits use the same limits per element.
+    Result<std::vector<std::uint16_t>> read_words(const Address& start, std::size_t count);
+    Result<void> write_words(const Address& start, std::span<const std::uint16_t> words);
+    // Bit addresses (D100.3, CIO10.15) step bit by bit; T/C/TK flags step word by word.
+    Result<std::vector<bool>> read_bits(const Address& start, std::size_t count);
+    Result<void> write_bits(const Address& start, const std::vector<bool>& bits);
+    Result<void> fill(const Address& start, std::size_t count, std::uint16_t value);
+    Result<void> transfer(const Address& from, const Address& to, std::size_t count);
+    // 01 04, up to 167 addresses per request (W342 5-3-5), more are split. Each value is
+    // the element's 1, 2 or 4 bytes, big-endian.
+    Result<std::vector<std::uint32_t>> read_multiple(std::span<const Address> addresses);
+
+    // Typed values in Omron word order (fins/values.hpp: least significant word first).
+    Result<std::int16_t> read_int16(const Address& a);
+    Result<std::uint16_t> read_uint16(const Address& a);
+    Result<std::int32_t> read_int32(const Address& a);
+    Result<std::uint32_t> read_uint32(const Address& a);
+    Result<float> read_float(const Address& a);
+    Result<double> read_double(const Address& a);
+    Result<void> write_int16(const Address& a, std::int16_t v);
+    Result<void> write_uint16(const Address& a, std::uint16_t v);
+    Result<void> write_int32(const Address& a, std::int32_t v);
+    Result<void> write_uint32(const Address& a, std::uint32_t v);
+    Result<void> write_float(const Address& a, float v);
+    Result<void> write_double(const Address& a, double v);
+    Result<std::uint16_t> read_bcd16(const Address& a);  // 0-9999, one word
+    Result<std::uint32_t> read_bcd32(const Address& a);  // 0-99999999, two words
+    Result<void> write_bcd16(const Address& a, std::uint16_t v);
+    Result<void> write_bcd32(const Address& a, std::uint32_t v);
+    // `word_count` words, two ASCII characters per word, first in the high byte; stops at
+    // the first 00 byte.
+    Result<std::string> read_string(const Address& a, std::size_t word_count);
+    // Writes ceil(size/2) words, or exactly `word_count` (padded with 00) when non-zero.
+    Result<void> write_string(const Address& a, std::string_view s, std::size_t word_count = 0);
+
+    // ---- state ----
+    [[nodiscard]] ClientStats stats() const noexcept;
+    [[nodiscard]] std::size_t in_flight() const noexcept;
+    [[nodiscard]] bool is_connected() const noexcept;
+    [[nodiscard]] const ClientOptions& options() const noexcept;
+    // The addresses put in request headers (after derivation).
+    [[nodiscard]] NodeAddress destination() const noexcept;
+    [[nodiscard]] NodeAddress source() const noexcept;
+    // Closes the connection; requests in flight fail with ClientError::canceled. The next
+    // request reconnects.
+    void close();
+
+    struct Impl;
+
+  private:
+    using ViewCompletion = std::function<void(Result<ResponseView>)>;
+
+    explicit Client(std::unique_ptr<Impl> impl);
+    // Submits a request; failures (too many in flight, not connected ...) reach `done`
+    // from the io_context, never from inside submit().
+    void submit(CommandCode code, Bytes parameters, ViewCompletion done);
+    void fail_later(ViewCompletion done, std::error_code ec);
+    Result<void> submit_no_response(CommandCode code, Bytes parameters);
+    // Runs the io_context until `done()` is true; every request ends by its deadline.
+    void run_until(const std::function<bool()>& done);
+
+    std::unique_ptr<Impl> impl_;
+};
+
+// ---- template definitions ----
+
+template <class C>
+void Client::async_send(const C& command, std::function<void(Result<typename C::Response>)> done) {
+    std::array<std::uint8_t, max_parameter_size> buffer{};
+    ByteWriter w(buffer);
+    command.encode(w);
+    auto finish = [command, done = std::move(done)](Result<ResponseView> r) {
+        if (!r) return done(Unexpected(r.error()));
+        if (!r->code.ok()) return done(Unexpected(make_error_code(r->code.end_code())));
+        done(command.decode_response(r->data));
+    };
+    if (w.overflowed())
+        return fail_later(std::move(finish), make_error_code(ClientError::request_too_long));
+    submit(C::code, w.written(), std::move(finish));
+}
+
+template <class C>
+Result<typename C::Response> Client::send(const C& command) {
+    std::optional<Result<typename C::Response>> out;
+    async_send(command, [&out](Result<typename C::Response> r) { out.emplace(std::move(r)); });
+    run_until([&out] { return out.has_value(); });
+    if (!out) return Unexpected(make_error_code(ClientError::canceled));
+    return std::move(*out);
+}
+
+template <class C>
+Result<void> Client::send_no_response(const C& command) {
+    std::array<std::uint8_t, max_parameter_size> buffer{};
+    ByteWriter w(buffer);
+    command.encode(w);
+    if (w.overflowed()) return Unexpected(make_error_code(ClientError::request_too_long));
+    return submit_no_response(C::code, w.written());
+}
+
+}  // namespace fins
