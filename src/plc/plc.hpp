@@ -1,0 +1,68 @@
+// The virtual CPU Unit: a Profile, its I/O memory, the operating mode and the state
+// the execution conditions of W342 5-1-2 look at. No sockets, no frames, no clock.
+//
+// Power-on mode is RUN: a CS/CJ CPU Unit whose PLC Setup keeps the default startup
+// mode and has no Programming Console attached starts in RUN mode (CJ2: "RUN mode"
+// is the default startup mode). With no user program that changes nothing but the
+// execution conditions (e.g. 03 07 PROGRAM AREA WRITE answers 2206 until STOP).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+
+#include "fins/frame.hpp"
+#include "plc/io_memory.hpp"
+#include "plc/profile.hpp"
+
+namespace fins::plc {
+
+enum class OperatingMode : std::uint8_t { program, monitor, run };
+
+class Plc {
+  public:
+    explicit Plc(Profile profile = cj2h());
+
+    [[nodiscard]] const Profile& profile() const noexcept { return memory_.profile(); }
+    IoMemory& memory() noexcept { return memory_; }
+    [[nodiscard]] const IoMemory& memory() const noexcept { return memory_; }
+
+    [[nodiscard]] OperatingMode mode() const noexcept { return mode_; }
+    void set_mode(OperatingMode mode) noexcept { mode_ = mode; }
+
+    // The node holding the access right (0C 01/02), if any (W342 5-3-1 "Access Right").
+    [[nodiscard]] const std::optional<NodeAddress>& access_right_holder() const noexcept {
+        return access_right_holder_;
+    }
+    void set_access_right_holder(std::optional<NodeAddress> holder) noexcept {
+        access_right_holder_ = holder;
+    }
+    // True when a device other than `requester` holds the access right.
+    [[nodiscard]] bool access_right_held_by_other(const NodeAddress& requester) const noexcept {
+        return access_right_holder_.has_value() && !(*access_right_holder_ == requester);
+    }
+
+    // PLC Setup "Write Protection from FINS Commands Sent to CPU Units via Networks"
+    // (W342 5-1-2 note 5).
+    [[nodiscard]] bool network_write_protection() const noexcept {
+        return network_write_protection_;
+    }
+    void set_network_write_protection(bool on) noexcept { network_write_protection_ = on; }
+
+    // UM read protection set from a Peripheral Device.
+    [[nodiscard]] bool um_read_protection() const noexcept { return um_read_protection_; }
+    void set_um_read_protection(bool on) noexcept { um_read_protection_ = on; }
+
+    // DIP switch pin 1 ON: UM write-protected.
+    [[nodiscard]] bool dip_write_protection() const noexcept { return dip_write_protection_; }
+    void set_dip_write_protection(bool on) noexcept { dip_write_protection_ = on; }
+
+  private:
+    IoMemory memory_;
+    OperatingMode mode_ = OperatingMode::run;
+    std::optional<NodeAddress> access_right_holder_;
+    bool network_write_protection_ = false;
+    bool um_read_protection_ = false;
+    bool dip_write_protection_ = false;
+};
+
+}  // namespace fins::plc

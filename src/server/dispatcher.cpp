@@ -1,0 +1,82 @@
+// Dispatcher::handle: header checks, command lookup, execution conditions, handler,
+// response frame (see dispatcher.hpp for the contract).
+#include "server/dispatcher.hpp"
+
+#include <algorithm>
+
+#include "fins/command_table.hpp"
+#include "plc/plc.hpp"
+#include "server/handlers/handlers.hpp"
+
+namespace fins::server {
+
+namespace {
+
+constexpr std::size_t response_prefix_size = header_size + command_code_size + end_code_size;
+
+// Is the frame for this CPU Unit? DNA 00 or ours; DA1 00 (local), ours or FF
+// (broadcast, answered like our own node); DA2 00 (the CPU Unit).
+// A wrong network or node answers 0201, any other unit 0202.
+EndCode check_destination(const NodeAddress& destination, const NodeAddress& self) noexcept {
+    if (destination.network != local_network && destination.network != self.network)
+        return EndCode::destination_node_not_in_network;
+    if (destination.node != 0x00 && destination.node != self.node &&
+        destination.node != broadcast_node)
+        return EndCode::destination_node_not_in_network;
+    if (destination.unit != cpu_unit) return EndCode::unit_missing;
+    return EndCode::normal_completion;
+}
+
+}  // namespace
+
+Dispatcher::Dispatcher(plc::Plc& plc, NodeAddress self) noexcept : plc_(plc), self_(self) {}
+
+std::size_t Dispatcher::handle(Bytes request, MutableBytes out, const RequestContext& context) {
+    // Without a header and command code there is no SID to answer.
+    if (request.size() < header_size + command_code_size) return 0;
+    ByteReader reader(request);
+    const Header header = read_header(reader);
+    const CommandCode command{reader.u8(), reader.u8()};
+    if (header.is_response()) return 0;
+    const bool reply = header.response_required() && out.size() >= response_prefix_size;
+
+    Header response = response_header(header, self_);
+    if (header.destination.node == broadcast_node) response.source.node = self_.node;
+
+    const auto answer = [&](EndCode code) -> std::size_t {
+        if (!reply) return 0;
+        ByteWriter w(out);
+        write_response_prefix(w, response, command, static_cast<std::uint16_t>(code));
+        return w.overflowed() ? 0 : w.size();
+    };
+
+    if (const auto code = check_destination(header.destination, self_);
+        code != EndCode::normal_completion)
+        return answer(code);
+
+    const auto decoded = decode_request(request);  // 1001 above 2,012 bytes
+    if (!decoded) return answer(handlers::to_end_code(decoded.error()));
+
+    const CommandInfo* info = find_command(command);
+    const handlers::HandlerEntry* entry = handlers::find_handler(command);
+    if (info == nullptr || entry == nullptr) return answer(EndCode::undefined_command);
+
+    if (const auto code = handlers::check_execution_conditions(info->conditions, plc_,
+                                                               header.source, context.link);
+        code != EndCode::normal_completion)
+        return answer(code);
+
+    // The handler writes its data directly after the prefix, at most 1,998 bytes.
+    const auto data_offset = std::min(out.size(), response_prefix_size);
+    ByteWriter data(
+        out.subspan(data_offset, std::min(out.size() - data_offset, max_response_data_size)));
+    handlers::HandlerContext handler_context{plc_, header, context};
+    auto code = entry->function(handler_context, decoded->parameters, data);
+    if (code == EndCode::normal_completion && data.overflowed()) code = EndCode::response_too_long;
+    if (code != EndCode::normal_completion) return answer(code);
+
+    const auto prefix = answer(EndCode::normal_completion);
+    return prefix == 0 ? 0 : prefix + data.size();
+}
+
+}  // namespace fins::server

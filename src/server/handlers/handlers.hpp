@@ -1,0 +1,63 @@
+// Private to the server: the command handlers and their registry.
+//
+// A handler receives the decoded command and the PLC, writes its response data (the
+// bytes after the end code) through a ByteWriter over the response buffer, and returns
+// the end code. On any end code other than 0000 the dispatcher discards the data and
+// answers the end code alone. Handlers never see the frame header checks or the
+// execution conditions: the dispatcher has done those (W342 5-1-2) before calling.
+//
+// One file per command group of W342 section 5: memory_area.cpp = 01 xx, ...
+#pragma once
+
+#include <span>
+#include <system_error>
+
+#include "fins/byte_io.hpp"
+#include "fins/command_table.hpp"
+#include "fins/commands/memory_area.hpp"
+#include "fins/error.hpp"
+#include "fins/frame.hpp"
+#include "server/dispatcher.hpp"
+
+namespace fins::plc {
+class Plc;
+}
+
+namespace fins::server::handlers {
+
+struct HandlerContext {
+    plc::Plc& plc;
+    const Header& header;  // the request's header (source address for access rights ...)
+    const RequestContext& request;
+};
+
+using HandlerFunction = EndCode (*)(HandlerContext& context, Bytes parameters, ByteWriter& out);
+
+struct HandlerEntry {
+    CommandCode code;
+    HandlerFunction function;
+};
+
+// Every command this server implements; each also has a row in fins::command_table().
+std::span<const HandlerEntry> handler_table() noexcept;
+const HandlerEntry* find_handler(CommandCode code) noexcept;
+
+// The execution conditions of W342 5-1-2, checked in this order: operating mode
+// (RUN 2206, MONITOR 2205, PROGRAM 2203), network write protection (2102, only for
+// requests that came over a network link), access right held by another node (3001),
+// UM read protection (2002), DIP switch UM write protection (2101).
+EndCode check_execution_conditions(const ExecutionConditions& conditions, const plc::Plc& plc,
+                                   const NodeAddress& source, Link link) noexcept;
+
+// FINS end codes pass through; any other error (not expected from a decoder) is 1004.
+EndCode to_end_code(const std::error_code& error) noexcept;
+
+// 01 xx I/O memory area access (memory_area.cpp, W342 5-3-2 .. 5-3-6).
+EndCode execute(HandlerContext& context, const MemoryAreaRead& command, ByteWriter& out) noexcept;
+EndCode execute(HandlerContext& context, const MemoryAreaWrite& command, ByteWriter& out) noexcept;
+EndCode execute(HandlerContext& context, const MemoryAreaFill& command, ByteWriter& out) noexcept;
+EndCode execute(HandlerContext& context, const MultipleMemoryAreaRead& command,
+                ByteWriter& out) noexcept;
+EndCode execute(HandlerContext& context, const MemoryAreaTransfer& command, ByteWriter& out);
+
+}  // namespace fins::server::handlers
