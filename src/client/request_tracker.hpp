@@ -1,0 +1,157 @@
+// The client's sans-I/O core: service IDs, request frames, response matching,
+// timeouts and retransmission. No sockets and no clock: the I/O layer passes `now`
+// into every call, hands received frames to on_frame(), arms one timer for
+// next_deadline() and calls on_timer() when it fires.
+//
+// Contract (W596 section 3, Send/Rcv/SendCmd pp. 3-6..3-16, "Option": isNonResp,
+// TimeOut, Retry 0-15):
+// - Service IDs (SID) are allocated round-robin over 00-FF: the next SID after the
+//   last one handed out that is not in flight, so a freed SID is reused as late as
+//   possible and a late answer to it is unlikely to meet a new request. Up to 256
+//   requests are in flight at once; the 257th fails with ClientError::too_many_in_flight.
+// - The request frame is built once, at submit(), into a fixed per-slot buffer; no
+//   allocation per request besides the caller's Completion.
+// - A response matches when its SID is in flight, its command code equals the
+//   request's, and its addresses are the request's swapped (frames 1.5). A request field
+//   sent as 00 (network 00 "local network", node 00 "local node") matches any value,
+//   because a responder may report its real network or node there.
+//   SID not in flight or a different command code: a stale or duplicate answer (for
+//   example the second answer to a retransmitted frame); discarded, counted in
+//   stats().stale_discarded. Undecodable frames, frames without the response bit and
+//   address mismatches are discarded and counted in stats().invalid_discarded; the
+//   request stays in flight.
+// - On timeout the identical frame (same SID) is sent again, up to `retries` times; after
+//   the last attempt the request fails with ClientError::timeout. A request's clock
+//   starts at submit(), whether or not the link is up.
+// - No-response mode (ICF bit 0, frames 1.2) is submit_no_response(): the frame is handed
+//   to the sink and nothing is kept in flight.
+// - Link state: while the link is down, submitted requests are held (built but not sent;
+//   a timeout while held consumes an attempt without sending anything). link_up() puts
+//   the current addresses into the held frames and sends them. link_down() fails every
+//   request, sent or held, with the given error: nothing is re-sent after a reconnect,
+//   because a request may already have been executed by the PLC.
+// - Completions are never called from inside submit(). They are called after the slot is
+//   freed, so a completion may submit again; a completion must not destroy the tracker.
+#pragma once
+
+#include <array>
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <system_error>
+#include <vector>
+
+#include "fins/byte_io.hpp"
+#include "fins/error.hpp"
+#include "fins/frame.hpp"
+
+namespace fins {
+
+using SteadyTime = std::chrono::steady_clock::time_point;
+
+// W596 SendCmd p. 3-16: Option.Retry 0 to 15.
+inline constexpr unsigned max_retries = 15;
+// W596 SendCmd p. 3-16: Option.TimeOut 0 means 2.0 s, which is also the default.
+inline constexpr std::chrono::milliseconds default_timeout{2000};
+// One per service ID.
+inline constexpr std::size_t max_in_flight = 256;
+
+struct RequestTiming {
+    std::chrono::milliseconds timeout = default_timeout;  // per attempt; <= 0 means 2.0 s
+    unsigned retries = 0;                                 // extra attempts, 0-15
+};
+
+struct TrackerStats {
+    std::uint64_t sent = 0;               // frames handed to the sink for the first time
+    std::uint64_t retransmitted = 0;      // frames sent again after a timeout
+    std::uint64_t completed = 0;          // responses matched to a request
+    std::uint64_t timed_out = 0;          // requests failed with ClientError::timeout
+    std::uint64_t failed = 0;             // requests failed by link_down() / cancel_all()
+    std::uint64_t stale_discarded = 0;    // SID not in flight, or wrong command code
+    std::uint64_t invalid_discarded = 0;  // undecodable, not a response, wrong addresses
+};
+
+// Where frames go. send_frame() must copy the bytes (the slot buffer is reused) and
+// must not call back into the tracker; failures are reported later via link_down().
+class FrameSink {
+  public:
+    virtual void send_frame(Bytes frame) = 0;
+
+  protected:
+    ~FrameSink() = default;
+};
+
+class RequestTracker {
+  public:
+    // Called once per submitted request: the decoded response (views valid only during
+    // the call; the end code is not interpreted) or the failure.
+    using Completion = std::function<void(Result<ResponseView>)>;
+
+    enum class Disposition { matched, stale, invalid };
+
+    explicit RequestTracker(FrameSink& sink, std::uint8_t gateway_count = default_gateway_count);
+    RequestTracker(const RequestTracker&) = delete;
+    RequestTracker& operator=(const RequestTracker&) = delete;
+
+    // Sets the header addresses and sends every held request.
+    void link_up(const NodeAddress& destination, const NodeAddress& source, SteadyTime now);
+    // Fails every request (sent or held) with `reason`; later submits are held.
+    void link_down(std::error_code reason);
+    [[nodiscard]] bool is_link_up() const noexcept { return link_up_; }
+
+    // Builds the frame, sends it (or holds it while the link is down) and returns the
+    // service ID. Fails with too_many_in_flight, request_too_long or invalid_argument
+    // (retries > 15); `done` is then left untouched (not moved from) and never called.
+    Result<std::uint8_t> submit(CommandCode command, Bytes parameters, const RequestTiming& timing,
+                                Completion&& done, SteadyTime now);
+    // ICF bit 0 set: sends and forgets. Fails with not_connected while the link is down.
+    Result<std::uint8_t> submit_no_response(CommandCode command, Bytes parameters);
+
+    Disposition on_frame(Bytes frame, SteadyTime now);
+    // Retransmits or fails every request whose deadline is <= now.
+    void on_timer(SteadyTime now);
+    [[nodiscard]] std::optional<SteadyTime> next_deadline() const noexcept;
+
+    // Fails every request with `reason`; the link state is unchanged.
+    void cancel_all(std::error_code reason);
+
+    [[nodiscard]] std::size_t in_flight() const noexcept { return in_flight_; }
+    [[nodiscard]] const TrackerStats& stats() const noexcept { return stats_; }
+    [[nodiscard]] const NodeAddress& destination() const noexcept { return destination_; }
+    [[nodiscard]] const NodeAddress& source() const noexcept { return source_; }
+    void set_gateway_count(std::uint8_t count) noexcept { gateway_count_ = count; }
+
+  private:
+    struct Slot {
+        bool busy = false;
+        bool sent = false;  // false while held for the link
+        CommandCode command;
+        Header header;
+        unsigned attempts_left = 0;
+        std::chrono::milliseconds timeout{};
+        SteadyTime deadline{};
+        std::size_t size = 0;
+        std::array<std::uint8_t, max_frame_size> frame{};
+        Completion done;
+    };
+
+    std::optional<std::uint8_t> allocate_service_id() noexcept;
+    Header make_header(std::uint8_t service_id, bool response_required) const noexcept;
+    void transmit(Slot& slot);
+    bool addresses_match(const Header& request, const Header& response) const noexcept;
+    void fail_all(std::error_code reason);
+
+    FrameSink& sink_;
+    std::vector<Slot> slots_;  // indexed by service ID
+    std::uint8_t next_service_id_ = 0;
+    std::size_t in_flight_ = 0;
+    bool link_up_ = false;
+    std::uint8_t gateway_count_;
+    NodeAddress destination_;
+    NodeAddress source_;
+    TrackerStats stats_;
+};
+
+}  // namespace fins

@@ -1,0 +1,243 @@
+#include "transport/tcp_transport.hpp"
+
+#include <cstring>
+#include <string>
+#include <utility>
+
+#include <asio/connect.hpp>
+#include <asio/write.hpp>
+
+namespace fins::transport {
+
+using asio::ip::tcp;
+
+namespace {
+
+std::error_code tcp_error_code(std::uint32_t raw) {
+    return make_error_code(static_cast<TcpError>(static_cast<int>(raw & 0x7FFFFFFF)));
+}
+
+}  // namespace
+
+TcpTransport::TcpTransport(asio::io_context& io, TransportOptions options)
+    : options_(std::move(options)), resolver_(io), socket_(io), open_timer_(io) {}
+
+TcpTransport::~TcpTransport() {
+    close();
+}
+
+void TcpTransport::async_open(OpenHandler done) {
+    close();
+    state_ = State::opening;
+    open_done_ = std::move(done);
+    auto gen = generation_;
+    std::weak_ptr<int> life = life_;
+    open_timer_.expires_after(options_.open_timeout);
+    open_timer_.async_wait([this, life, gen](std::error_code ec) {
+        if (life.expired() || gen != generation_ || ec || state_ != State::opening) return;
+        finish_open(Unexpected(make_error_code(ClientError::timeout)));
+    });
+    resolver_.async_resolve(
+        options_.host, std::to_string(options_.port), tcp::resolver::numeric_service,
+        [this, life, gen](std::error_code ec, tcp::resolver::results_type results) {
+            if (life.expired() || gen != generation_) return;
+            if (ec) return finish_open(Unexpected(ec));
+            asio::async_connect(socket_, results,
+                                [this, life, gen](std::error_code ec2, const tcp::endpoint&) {
+                                    if (life.expired() || gen != generation_) return;
+                                    if (ec2) return finish_open(Unexpected(ec2));
+                                    on_connected();
+                                });
+        });
+}
+
+void TcpTransport::on_connected() {
+    std::error_code ec;
+    socket_.set_option(tcp::no_delay(true), ec);
+    if (!ec) socket_.non_blocking(true, ec);
+    if (ec) return finish_open(Unexpected(ec));
+    ByteWriter w(hello_);
+    write_node_address_request(w, options_.requested_node);
+    auto gen = generation_;
+    std::weak_ptr<int> life = life_;
+    asio::async_write(socket_, asio::buffer(hello_.data(), w.size()),
+                      [this, life, gen](std::error_code ec2, std::size_t) {
+                          if (life.expired() || gen != generation_) return;
+                          if (ec2) return finish_open(Unexpected(ec2));
+                          read_handshake();
+                      });
+}
+
+void TcpTransport::read_handshake() {
+    auto gen = generation_;
+    std::weak_ptr<int> life = life_;
+    socket_.async_read_some(
+        asio::buffer(rx_.data() + rx_size_, rx_.size() - rx_size_),
+        [this, life, gen](std::error_code ec, std::size_t n) {
+            if (life.expired() || gen != generation_) return;
+            // The server closes right after an error answer; EOF before it is a failure.
+            if (ec) return finish_open(Unexpected(make_error_code(ClientError::handshake_failed)));
+            rx_size_ += n;
+            auto parsed = parse_tcp_frame(Bytes{rx_.data(), rx_size_});
+            if (parsed.status == TcpParse::Status::need_more) return read_handshake();
+            if (parsed.status == TcpParse::Status::error)
+                return finish_open(Unexpected(make_error_code(parsed.error)));
+            const auto& packet = parsed.packet;
+            if (packet.error != 0 &&
+                (packet.command == static_cast<std::uint32_t>(TcpCommand::node_address_response) ||
+                 packet.command == static_cast<std::uint32_t>(TcpCommand::frame_error)))
+                return finish_open(Unexpected(tcp_error_code(packet.error)));
+            if (packet.command != static_cast<std::uint32_t>(TcpCommand::node_address_response))
+                return finish_open(Unexpected(make_error_code(ClientError::handshake_failed)));
+            auto nodes = decode_node_address_response(packet.data);
+            if (!nodes)
+                return finish_open(Unexpected(make_error_code(ClientError::handshake_failed)));
+            consume(parsed.consumed);
+            finish_open(LinkInfo{nodes->client_node, nodes->server_node});
+        });
+}
+
+void TcpTransport::finish_open(Result<LinkInfo> result) {
+    open_timer_.cancel();
+    auto done = std::move(open_done_);
+    open_done_ = nullptr;
+    if (!result) {
+        close();
+        if (done) done(std::move(result));
+        return;
+    }
+    state_ = State::open;
+    auto gen = generation_;
+    std::weak_ptr<int> life = life_;
+    if (done) done(std::move(result));
+    if (life.expired() || gen != generation_) return;
+    // Frames the server sent right behind its handshake answer are already buffered.
+    if (process_frames()) read_frames();
+}
+
+void TcpTransport::read_frames() {
+    auto gen = generation_;
+    std::weak_ptr<int> life = life_;
+    socket_.async_read_some(asio::buffer(rx_.data() + rx_size_, rx_.size() - rx_size_),
+                            [this, life, gen](std::error_code ec, std::size_t n) {
+                                if (life.expired() || gen != generation_) return;
+                                if (ec)
+                                    return fail(make_error_code(ClientError::connection_closed));
+                                rx_size_ += n;
+                                if (process_frames()) read_frames();
+                            });
+}
+
+bool TcpTransport::process_frames() {
+    std::weak_ptr<int> life = life_;
+    auto gen = generation_;
+    // Each pass consumes at least one whole packet or stops, so this ends.
+    while (rx_size_ > 0) {
+        auto parsed = parse_tcp_frame(Bytes{rx_.data(), rx_size_});
+        if (parsed.status == TcpParse::Status::need_more) return true;
+        if (parsed.status == TcpParse::Status::error) {
+            send_error_and_fail(parsed.error);
+            return false;
+        }
+        switch (static_cast<TcpCommand>(parsed.packet.command)) {
+            case TcpCommand::frame:
+                if (on_frame_) on_frame_(parsed.packet.data);
+                if (life.expired() || gen != generation_) return false;
+                break;
+            case TcpCommand::connection_confirmation:
+                break;
+            case TcpCommand::frame_error:
+                fail(tcp_error_code(parsed.packet.error));
+                return false;
+            default:
+                send_error_and_fail(TcpError::command_not_supported);
+                return false;
+        }
+        consume(parsed.consumed);
+    }
+    return true;
+}
+
+void TcpTransport::consume(std::size_t n) noexcept {
+    if (n >= rx_size_) {
+        rx_size_ = 0;
+        return;
+    }
+    std::memmove(rx_.data(), rx_.data() + n, rx_size_ - n);
+    rx_size_ -= n;
+}
+
+void TcpTransport::send_error_and_fail(TcpError error) {
+    std::array<std::uint8_t, tcp_header_size> packet{};
+    ByteWriter w(packet);
+    write_tcp_error(w, TcpCommand::frame_error, error);
+    // Best effort, non-blocking: the connection is closed right after anyway.
+    std::error_code ignored;
+    socket_.send(asio::buffer(packet.data(), w.size()), 0, ignored);
+    fail(make_error_code(error));
+}
+
+void TcpTransport::send(Bytes frame) {
+    if (state_ != State::open) return;
+    std::array<std::uint8_t, tcp_header_size> header{};
+    ByteWriter w(header);
+    write_tcp_header(w, TcpCommand::frame, frame.size());
+    write_raw(Bytes{header.data(), w.size()}, frame);
+}
+
+void TcpTransport::write_raw(Bytes first, Bytes second) {
+    if (writing_) {
+        queue_.push(first, second);
+        return;
+    }
+    // Nothing queued: hand the packet to the kernel now; queue only what did not fit.
+    std::array<asio::const_buffer, 2> buffers{asio::buffer(first.data(), first.size()),
+                                              asio::buffer(second.data(), second.size())};
+    std::error_code ec;
+    auto written = socket_.send(buffers, 0, ec);
+    if (!ec && written == first.size() + second.size()) return;
+    // would_block, or a real error that the queued write reports asynchronously (never
+    // from inside send(): the caller may be the request tracker).
+    queue_.push(first, second);
+    front_written_ = ec ? 0 : written;
+    write_next();
+}
+
+void TcpTransport::write_next() {
+    if (writing_ || queue_.empty()) return;
+    writing_ = true;
+    auto gen = generation_;
+    std::weak_ptr<int> life = life_;
+    const auto& buffer = queue_.front();
+    asio::async_write(socket_,
+                      asio::buffer(buffer.data() + front_written_, buffer.size() - front_written_),
+                      [this, life, gen](std::error_code ec, std::size_t) {
+                          if (life.expired() || gen != generation_) return;
+                          writing_ = false;
+                          front_written_ = 0;
+                          if (ec) return fail(make_error_code(ClientError::connection_closed));
+                          queue_.pop();
+                          write_next();
+                      });
+}
+
+void TcpTransport::fail(std::error_code reason) {
+    close();
+    if (on_close_) on_close_(reason);
+}
+
+void TcpTransport::close() {
+    ++generation_;
+    std::error_code ignored;
+    resolver_.cancel();
+    open_timer_.cancel();
+    socket_.close(ignored);
+    queue_.clear();
+    writing_ = false;
+    front_written_ = 0;
+    rx_size_ = 0;
+    open_done_ = nullptr;
+    state_ = State::closed;
+}
+
+}  // namespace fins::transport

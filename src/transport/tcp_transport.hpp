@@ -1,0 +1,74 @@
+// FINS/TCP client transport (W421 7-4, frames section 3).
+//
+// Open: resolve host:port, connect (first address that answers), TCP_NODELAY, send
+// NODE ADDRESS DATA SEND (command 0) with TransportOptions::requested_node (0 = ask the
+// server to allocate), read the 24-byte command-1 answer and learn the client node and
+// the server node (LinkInfo). A command 1 with a non-zero error code, or a command 3,
+// fails the open with that TcpError (e.g. 0x21 node_already_connected); anything else
+// fails it with ClientError::handshake_failed. The whole open is bounded by
+// TransportOptions::open_timeout.
+//
+// Open: every packet is parsed with parse_tcp_frame(), which copes with packets split
+// across reads or glued together. Command 2 delivers its FINS frame; command 6
+// (connection confirmation) is ignored as frames 3.4 says; command 3 closes the
+// transport with its TcpError; an envelope error, or command 0/1/unknown, is answered
+// with command 3 (frames 3.4 items 4-5) and closes with that TcpError. The peer
+// closing or resetting closes with ClientError::connection_closed.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+
+#include <asio/io_context.hpp>
+#include <asio/ip/tcp.hpp>
+#include <asio/steady_timer.hpp>
+
+#include "fins/tcp.hpp"
+#include "transport/transport.hpp"
+#include "transport/write_queue.hpp"
+
+namespace fins::transport {
+
+class TcpTransport final : public Transport {
+  public:
+    TcpTransport(asio::io_context& io, TransportOptions options);
+    ~TcpTransport() override;
+
+    void async_open(OpenHandler done) override;
+    void send(Bytes frame) override;
+    void close() override;
+    [[nodiscard]] State state() const noexcept override { return state_; }
+    [[nodiscard]] bool write_pending() const noexcept override { return !queue_.empty(); }
+
+  private:
+    void on_connected();
+    void read_handshake();
+    void finish_open(Result<LinkInfo> result);
+    void read_frames();
+    // Parses what is buffered; false once the transport was closed meanwhile.
+    bool process_frames();
+    void send_error_and_fail(TcpError error);
+    void write_raw(Bytes first, Bytes second);
+    void write_next();
+    void fail(std::error_code reason);
+    void consume(std::size_t n) noexcept;
+
+    TransportOptions options_;
+    asio::ip::tcp::resolver resolver_;
+    asio::ip::tcp::socket socket_;
+    asio::steady_timer open_timer_;
+    State state_ = State::closed;
+    std::uint64_t generation_ = 0;  // bumped on close: handlers of older sockets ignore
+    std::shared_ptr<int> life_ = std::make_shared<int>(0);
+    OpenHandler open_done_;
+    WriteQueue queue_;
+    bool writing_ = false;
+    std::size_t front_written_ = 0;  // bytes of queue_.front() already written
+    std::array<std::uint8_t, 20> hello_{};
+    // Room for two maximal packets: whatever is left after parsing fits with room to read.
+    std::array<std::uint8_t, 2 * tcp_max_packet> rx_{};
+    std::size_t rx_size_ = 0;
+};
+
+}  // namespace fins::transport
