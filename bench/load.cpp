@@ -1,0 +1,285 @@
+// fins_load: drives finsd with 1-word MEMORY AREA READs over FINS/UDP and FINS/TCP with
+// 1 and 32 requests in flight, and measures a raw loopback echo of the same frame sizes
+// in the same run, so the ratio tells what finsd costs over the kernel's own loopback.
+//
+// Both servers run in this process on one thread each (finsd is single-threaded too);
+// the generator uses blocking sockets on the main thread. Output: one line per case,
+// or JSON with --json. Timing lives here, never in pass/fail tests.
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <fmt/core.h>
+#include <spdlog/spdlog.h>
+#include <CLI/CLI.hpp>
+#include <asio/io_context.hpp>
+
+#include "fins/commands/memory_area.hpp"
+#include "fins/frame.hpp"
+#include "fins/tcp.hpp"
+#include "plc/plc.hpp"
+#include "plc/profile.hpp"
+#include "server/server.hpp"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct Frames {
+    std::vector<std::uint8_t> request;  // what the generator sends (with envelope on TCP)
+    std::size_t response_size = 0;      // what comes back
+};
+
+// The 1-word read of D0 as a FINS frame, plus the size of finsd's answer.
+std::vector<std::uint8_t> read_frame(std::uint8_t sid) {
+    std::array<std::uint8_t, 32> params{};
+    fins::ByteWriter pw{params};
+    fins::MemoryAreaRead{{0x82, 0, 0}, 1}.encode(pw);
+    fins::Header h;
+    h.destination = {0, 1, 0};
+    h.source = {0, 200, 0};
+    h.service_id = sid;
+    std::vector<std::uint8_t> out(fins::max_frame_size);
+    auto n = fins::encode_request(h, fins::MemoryAreaRead::code, pw.written(), out);
+    out.resize(n.value_or(0));
+    return out;
+}
+
+void set_nodelay(int fd) {
+    int one = 1;
+    setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+}
+
+bool read_exact(int fd, std::uint8_t* p, std::size_t n) {
+    while (n > 0) {
+        const ssize_t r = ::recv(fd, p, n, 0);
+        if (r <= 0) return false;
+        p += r;
+        n -= static_cast<std::size_t>(r);
+    }
+    return true;
+}
+
+// Raw echo servers: answer each request with a canned reply of the size finsd sends.
+class EchoServer {
+  public:
+    EchoServer(bool tcp, std::size_t request_size, std::size_t response_size)
+        : tcp_(tcp), request_size_(request_size), response_(response_size, 0xC0) {
+        fd_ = ::socket(AF_INET, tcp ? SOCK_STREAM : SOCK_DGRAM, 0);
+        int one = 1;
+        setsockopt(fd_, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+        sockaddr_in a{};
+        a.sin_family = AF_INET;
+        a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+        ::bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a);
+        socklen_t len = sizeof a;
+        ::getsockname(fd_, reinterpret_cast<sockaddr*>(&a), &len);
+        port_ = ntohs(a.sin_port);
+        if (tcp) ::listen(fd_, 4);
+        thread_ = std::thread([this] { tcp_ ? serve_tcp() : serve_udp(); });
+    }
+    ~EchoServer() {
+        stop_ = true;
+        ::shutdown(fd_, SHUT_RDWR);
+        if (conn_ >= 0) ::shutdown(conn_, SHUT_RDWR);
+        ::close(fd_);
+        thread_.join();
+        if (conn_ >= 0) ::close(conn_);
+    }
+    [[nodiscard]] std::uint16_t port() const { return port_; }
+
+  private:
+    void serve_udp() {
+        std::array<std::uint8_t, 4096> buf{};
+        while (!stop_) {
+            sockaddr_storage peer{};
+            socklen_t len = sizeof peer;
+            const ssize_t r = ::recvfrom(fd_, buf.data(), buf.size(), 0,
+                                         reinterpret_cast<sockaddr*>(&peer), &len);
+            if (r <= 0) return;
+            ::sendto(fd_, response_.data(), response_.size(), 0, reinterpret_cast<sockaddr*>(&peer),
+                     len);
+        }
+    }
+    void serve_tcp() {
+        conn_ = ::accept(fd_, nullptr, nullptr);
+        if (conn_ < 0) return;
+        set_nodelay(conn_);
+        std::array<std::uint8_t, 4096> buf{};
+        while (!stop_ && read_exact(conn_, buf.data(), request_size_))
+            if (::send(conn_, response_.data(), response_.size(), MSG_NOSIGNAL) <= 0) return;
+    }
+
+    bool tcp_;
+    std::size_t request_size_;
+    std::vector<std::uint8_t> response_;
+    int fd_ = -1;
+    int conn_ = -1;
+    std::uint16_t port_ = 0;
+    std::atomic<bool> stop_{false};
+    std::thread thread_;
+};
+
+struct Stats {
+    double rate = 0;
+    double p50_us = 0;
+    double p99_us = 0;
+    std::size_t count = 0;
+};
+
+int connect_to(bool tcp, std::uint16_t port) {
+    const int fd = ::socket(AF_INET, tcp ? SOCK_STREAM : SOCK_DGRAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    a.sin_port = htons(port);
+    if (::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
+        ::close(fd);
+        return -1;
+    }
+    if (tcp) set_nodelay(fd);
+    // A lost datagram must end the case, not hang it.
+    timeval tv{1, 0};
+    setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+    return fd;
+}
+
+// Keeps `depth` requests outstanding for `seconds`; a request's latency is measured
+// from its send to the arrival of the next response (responses come back in order).
+Stats drive(int fd, bool tcp, const Frames& f, unsigned depth, double seconds) {
+    std::vector<Clock::time_point> sent;
+    sent.reserve(1 << 20);
+    std::vector<double> latencies;
+    latencies.reserve(1 << 20);
+    std::vector<std::uint8_t> in(f.response_size + 64);
+    const auto start = Clock::now();
+    const auto end =
+        start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+    std::size_t next_reply = 0;
+    auto send_one = [&] {
+        sent.push_back(Clock::now());
+        return ::send(fd, f.request.data(), f.request.size(), MSG_NOSIGNAL) > 0;
+    };
+    for (unsigned i = 0; i < depth; ++i)
+        if (!send_one()) return {};
+    bool sending = true;
+    while (next_reply < sent.size()) {
+        const bool ok = tcp ? read_exact(fd, in.data(), f.response_size)
+                            : ::recv(fd, in.data(), in.size(), 0) > 0;
+        if (!ok) break;
+        const auto now = Clock::now();
+        latencies.push_back(
+            std::chrono::duration<double, std::micro>(now - sent[next_reply]).count());
+        ++next_reply;
+        if (sending && now < end) {
+            if (!send_one()) break;
+        } else {
+            sending = false;
+        }
+    }
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    Stats s;
+    s.count = latencies.size();
+    if (latencies.empty()) return s;
+    std::sort(latencies.begin(), latencies.end());
+    s.rate = static_cast<double>(latencies.size()) / elapsed;
+    s.p50_us = latencies[latencies.size() / 2];
+    s.p99_us = latencies[std::min(latencies.size() - 1, latencies.size() * 99 / 100)];
+    return s;
+}
+
+// FINS/TCP handshake by hand: ask for node allocation, read the 24-byte answer.
+bool tcp_handshake(int fd) {
+    std::array<std::uint8_t, 24> buf{};
+    fins::ByteWriter w{buf};
+    fins::write_node_address_request(w, 0);
+    if (::send(fd, buf.data(), w.size(), MSG_NOSIGNAL) <= 0) return false;
+    return read_exact(fd, buf.data(), 24);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"fins_load: finsd request rate vs a raw loopback echo"};
+    double seconds = 2.0;
+    bool json = false;
+    app.add_option("--seconds", seconds, "Duration of each case")->capture_default_str();
+    app.add_flag("--json", json, "Print JSON lines");
+    CLI11_PARSE(app, argc, argv);
+    spdlog::set_level(spdlog::level::warn);
+
+    fins::plc::Plc plc{fins::plc::cj2h()};
+    asio::io_context io{1};
+    fins::server::ServerOptions options;
+    options.port = 0;
+    auto server = fins::server::Server::start(io, plc, options);
+    if (!server) {
+        std::fprintf(stderr, "fins_load: cannot start finsd: %s\n",
+                     server.error().message().c_str());
+        return 1;
+    }
+    std::thread server_thread([&] { io.run(); });
+
+    const auto frame = read_frame(1);
+    const std::size_t fins_response = fins::header_size + 2 + 2 + 2;  // header, cmd, end, 1 word
+    for (const bool tcp : {false, true}) {
+        Frames f;
+        f.request = frame;
+        f.response_size = fins_response;
+        if (tcp) {
+            std::array<std::uint8_t, 16> env{};
+            fins::ByteWriter w{env};
+            fins::write_tcp_header(w, fins::TcpCommand::frame, frame.size());
+            f.request.insert(f.request.begin(), env.begin(), env.end());
+            f.response_size += fins::tcp_header_size;
+        }
+        for (const unsigned depth : {1u, 32u}) {
+            const int fd = connect_to(tcp, (*server)->tcp_port());
+            if (fd < 0 || (tcp && !tcp_handshake(fd))) {
+                std::fprintf(stderr, "fins_load: cannot reach finsd\n");
+                return 1;
+            }
+            const Stats finsd = drive(fd, tcp, f, depth, seconds);
+            ::close(fd);
+
+            EchoServer echo(tcp, f.request.size(), f.response_size);
+            const int efd = connect_to(tcp, echo.port());
+            const Stats raw = drive(efd, tcp, f, depth, seconds);
+            ::close(efd);
+
+            const double ratio = raw.rate > 0 ? finsd.rate / raw.rate : 0;
+            const char* proto = tcp ? "tcp" : "udp";
+            if (json) {
+                fmt::print(
+                    "{{\"transport\":\"{}\",\"in_flight\":{},\"finsd_rps\":{:.0f},"
+                    "\"finsd_p50_us\":{:.1f},\"finsd_p99_us\":{:.1f},\"echo_rps\":{:.0f},"
+                    "\"echo_p50_us\":{:.1f},\"echo_p99_us\":{:.1f},\"ratio\":{:.2f}}}\n",
+                    proto, depth, finsd.rate, finsd.p50_us, finsd.p99_us, raw.rate, raw.p50_us,
+                    raw.p99_us, ratio);
+            } else {
+                fmt::print(
+                    "{} in-flight {:>2}: finsd {:>8.0f} req/s p50 {:>6.1f} us p99 {:>6.1f} us | "
+                    "echo {:>8.0f} req/s p50 {:>6.1f} us p99 {:>6.1f} us | ratio {:.2f}\n",
+                    proto, depth, finsd.rate, finsd.p50_us, finsd.p99_us, raw.rate, raw.p50_us,
+                    raw.p99_us, ratio);
+            }
+            std::fflush(stdout);
+        }
+    }
+    (*server)->stop();
+    io.stop();
+    server_thread.join();
+    return 0;
+}

@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# Configures and builds one tree. Usage: scripts/build.sh [release|asan|fuzz]
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+kind=${1:-release}
+jobs=${FINS_JOBS:-$(nproc)}
+case "$kind" in
+  release) dir=build; args=(-DCMAKE_BUILD_TYPE=Release -DFINS_WERROR=ON) ;;
+  asan) dir=build-asan; args=(-DCMAKE_BUILD_TYPE=Debug -DFINS_SANITIZE=ON -DFINS_BENCH=OFF -DFINS_WERROR=ON) ;;
+  fuzz) dir=build-fuzz; args=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DFINS_FUZZ=ON -DFINS_TESTS=OFF -DCMAKE_CXX_COMPILER=clang++-14) ;;
+  *) echo "usage: $0 [release|asan|fuzz]" >&2; exit 2 ;;
+esac
+cmake -S "$root" -B "$root/$dir" -G Ninja "${args[@]}" >/dev/null
+if [[ "$kind" == fuzz ]]; then
+  ninja -C "$root/$dir" -j "$jobs" fuzz_frame fuzz_tcp fuzz_address fuzz_dispatch
+else
+  ninja -C "$root/$dir" -j "$jobs"
+fi

@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# The whole test suite, as CI runs it: installs what is missing, then
+#   1. Release build with warnings as errors, all tests (unit, loopback integration,
+#      CLI, tshark conformance);
+#   2. ASan+UBSan debug build, all tests again;
+#   3. libFuzzer targets over every decoder, briefly each.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+cd "$root"
+fuzz_seconds=${FINS_FUZZ_SECONDS:-20}
+"$root/scripts/deps.sh"
+
+summary=()
+run_ctest() {
+  local dir=$1 label=$2 log
+  log=$(mktemp)
+  if ctest --test-dir "$dir" -j 2 --output-on-failure --timeout 300 | tee "$log"; then :; else
+    summary+=("$label: FAILED"); tail -n 3 "$log"; rm -f "$log"; return 1
+  fi
+  summary+=("$label: $(grep -E 'tests passed' "$log" | tail -n 1)")
+  rm -f "$log"
+}
+
+echo "== release build"
+"$root/scripts/build.sh" release
+echo "== release tests"
+run_ctest build release
+
+echo "== ASan+UBSan build"
+"$root/scripts/build.sh" asan
+echo "== ASan+UBSan tests"
+ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+  run_ctest build-asan asan
+
+echo "== fuzz (${fuzz_seconds}s per target)"
+"$root/scripts/build.sh" fuzz
+fuzz_ok=0
+for target in fuzz_frame fuzz_tcp fuzz_address fuzz_dispatch; do
+  corpus=$(mktemp -d)
+  seeds="$root/fuzz/corpus/$target"
+  [[ -d "$seeds" ]] && cp -r "$seeds/." "$corpus/"
+  if "$root/build-fuzz/bin/$target" -max_total_time="$fuzz_seconds" -print_final_stats=0 \
+      "$corpus" >"$corpus.log" 2>&1; then
+    fuzz_ok=$((fuzz_ok + 1))
+    echo "$target: $(grep -Eo '#[0-9]+ +DONE.*' "$corpus.log" | tail -n 1)"
+  else
+    echo "$target FAILED"; tail -n 40 "$corpus.log"; exit 1
+  fi
+  rm -rf "$corpus" "$corpus.log"
+done
+summary+=("fuzz: $fuzz_ok targets ran clean")
+
+echo "== summary"
+printf '%s\n' "${summary[@]}"
+total=$(ctest --test-dir build -N | grep -Eo 'Total Tests: [0-9]+' | grep -Eo '[0-9]+')
+asan_total=$(ctest --test-dir build-asan -N | grep -Eo 'Total Tests: [0-9]+' | grep -Eo '[0-9]+')
+echo "$((total + asan_total + fuzz_ok)) passed, 0 failed"

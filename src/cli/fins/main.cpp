@@ -1,0 +1,99 @@
+// fins: read, write and probe an Omron PLC (or finsd) over FINS/UDP or FINS/TCP.
+//
+// Exit codes: 0 success; 2 usage error (bad option, address or value); 3 transport
+// failure (cannot connect, timeout, connection lost, malformed answer); 4 the PLC
+// answered with a non-zero end code (printed as hex and name).
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <fmt/core.h>
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "cli/fins/commands.hpp"
+
+int main(int argc, char** argv) {
+    using namespace fins::cli;
+    CLI::App app{"fins: talk FINS to an Omron CS/CJ/CP/NX PLC or to finsd"};
+    app.require_subcommand(1);
+    // Global options may also follow the verb: `fins read D100 --json`.
+    app.fallthrough(true);
+    GlobalOptions g;
+    app.add_option("--host", g.host, "PLC host name or IP address")->capture_default_str();
+    app.add_option("--port", g.port, "FINS port")->capture_default_str();
+    app.add_flag("--tcp", g.tcp, "Use FINS/TCP instead of FINS/UDP");
+    app.add_option("--timeout", g.timeout_seconds, "Seconds to wait for each attempt")
+        ->capture_default_str()
+        ->check(CLI::Range(0.001, 3600.0));
+    app.add_option("--retries", g.retries, "Retransmissions after a timeout (0-15, W596)")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 15));
+    app.add_option("--dest", g.dest, "Destination NET.NODE.UNIT (default: derived)");
+    app.add_option("--source", g.source, "Source NET.NODE.UNIT (default: derived)");
+    app.add_flag("--json", g.json, "Print JSON");
+
+    std::string as = "uint16";
+    auto add_as = [&as](CLI::App* c) {
+        c->add_option("--as", as,
+                      "Value format: int16 uint16 int32 uint32 float double bcd string bits hex")
+            ->capture_default_str();
+    };
+
+    ReadArgs read;
+    auto* c_read = app.add_subcommand("read", "Read consecutive values (01 01)");
+    c_read->add_option("address", read.address, "Start address, e.g. D100, CIO10.13, E3_0, T5")
+        ->required();
+    c_read->add_option("count", read.count, "Number of values (string: words)")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 65535));
+    add_as(c_read);
+
+    WriteArgs write;
+    auto* c_write = app.add_subcommand("write", "Write consecutive values (01 02)");
+    c_write->add_option("address", write.address, "Start address")->required();
+    c_write->add_option("values", write.values, "Values to write")->required();
+    add_as(c_write);
+
+    FillArgs fill;
+    auto* c_fill = app.add_subcommand("fill", "Write one word to a range of words (01 03)");
+    c_fill->add_option("address", fill.address, "Start word address")->required();
+    c_fill->add_option("count", fill.count, "Number of words")->required();
+    c_fill->add_option("value", fill.value, "Word value (decimal or 0x hex)")->required();
+
+    TransferArgs transfer;
+    auto* c_transfer = app.add_subcommand("transfer", "Copy words inside the PLC (01 05)");
+    c_transfer->add_option("from", transfer.from, "Source word address")->required();
+    c_transfer->add_option("to", transfer.to, "Destination word address")->required();
+    c_transfer->add_option("count", transfer.count, "Number of words")->required();
+
+    ReadMultiArgs multi;
+    auto* c_multi =
+        app.add_subcommand("read-multi", "Read scattered addresses in one request (01 04)");
+    c_multi->add_option("addresses", multi.addresses, "Addresses")->required();
+
+    RawArgs raw;
+    auto* c_raw = app.add_subcommand(
+        "raw", "Send any command in hex and print the decoded answer (like W596 SendCmd)");
+    c_raw->add_option("command", raw.command, "Command code MRC SRC in hex, e.g. 0101")->required();
+    c_raw->add_option("parameters", raw.parameters, "Parameter bytes in hex (spaces allowed)");
+    c_raw->add_flag("--no-response", raw.no_response,
+                    "Set the ICF no-response bit and do not wait");
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        const int rc = app.exit(e);
+        return rc == 0 ? 0 : exit_usage;
+    }
+    Output out{g.json};
+    if (c_raw->parsed()) return run_raw(g, raw, out);
+    auto format = parse_format(as);
+    if (!format) return out.usage(fmt::format("unknown --as format '{}'", as));
+    if (c_read->parsed()) return run_read(g, read, *format, out);
+    if (c_write->parsed()) return run_write(g, write, *format, out);
+    if (c_fill->parsed()) return run_fill(g, fill, out);
+    if (c_transfer->parsed()) return run_transfer(g, transfer, out);
+    if (c_multi->parsed()) return run_read_multi(g, multi, out);
+    return exit_usage;
+}

@@ -1,0 +1,223 @@
+#include "cli/fins/value_format.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <span>
+
+#include <fmt/core.h>
+
+#include "fins/values.hpp"
+
+namespace fins::cli {
+
+namespace {
+
+struct FormatRow {
+    Format format;
+    std::string_view name;
+    std::size_t words;
+};
+
+constexpr FormatRow formats[] = {
+    {Format::int16, "int16", 1},   {Format::uint16, "uint16", 1}, {Format::int32, "int32", 2},
+    {Format::uint32, "uint32", 2}, {Format::float32, "float", 2}, {Format::float64, "double", 4},
+    {Format::bcd, "bcd", 1},       {Format::string, "string", 1}, {Format::bits, "bits", 0},
+    {Format::hex, "hex", 1},
+};
+
+template <class T>
+std::optional<T> parse_integer(std::string_view s) {
+    int base = 10;
+    bool negative = false;
+    if (!s.empty() && (s[0] == '-' || s[0] == '+')) {
+        negative = s[0] == '-';
+        s.remove_prefix(1);
+    }
+    if (s.size() > 2 && s[0] == '0' && (s[1] == 'x' || s[1] == 'X')) {
+        base = 16;
+        s.remove_prefix(2);
+    }
+    if (s.empty()) return std::nullopt;
+    long long v = 0;
+    auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v, base);
+    if (ec != std::errc{} || end != s.data() + s.size()) return std::nullopt;
+    if (negative) v = -v;
+    if (v < static_cast<long long>(std::numeric_limits<T>::min()) ||
+        v > static_cast<long long>(std::numeric_limits<T>::max()))
+        return std::nullopt;
+    return static_cast<T>(v);
+}
+
+std::optional<double> parse_real(std::string_view s) {
+    double v = 0;
+    auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (ec != std::errc{} || end != s.data() + s.size() || s.empty()) return std::nullopt;
+    return v;
+}
+
+template <class F>
+Printed number(F v) {
+    return {fmt::format("{}", v), nlohmann::json(v)};
+}
+
+Printed real(double v) {
+    // JSON has no NaN/Infinity: print those as strings so the document stays valid.
+    if (!std::isfinite(v)) return {fmt::format("{}", v), nlohmann::json(fmt::format("{}", v))};
+    return {fmt::format("{}", v), nlohmann::json(v)};
+}
+
+template <class Array>
+void append(std::vector<std::uint16_t>& out, const Array& words) {
+    out.insert(out.end(), words.begin(), words.end());
+}
+
+}  // namespace
+
+std::optional<Format> parse_format(std::string_view name) {
+    for (const auto& f : formats)
+        if (f.name == name) return f.format;
+    if (name == "float32") return Format::float32;
+    if (name == "float64") return Format::float64;
+    return std::nullopt;
+}
+
+std::string_view format_name(Format f) {
+    for (const auto& row : formats)
+        if (row.format == f) return row.name;
+    return "?";
+}
+
+std::size_t words_per_value(Format f) {
+    for (const auto& row : formats)
+        if (row.format == f) return row.words;
+    return 1;
+}
+
+std::optional<bool> parse_bit(std::string_view s) {
+    if (s == "1" || s == "on" || s == "ON" || s == "true") return true;
+    if (s == "0" || s == "off" || s == "OFF" || s == "false") return false;
+    return std::nullopt;
+}
+
+Result<std::vector<Printed>> print_words(Format f, const std::vector<std::uint16_t>& words) {
+    std::vector<Printed> out;
+    if (f == Format::string) {
+        const auto s = words_to_string(words);
+        out.push_back({nlohmann::json(s).dump(), nlohmann::json(s)});
+        return out;
+    }
+    const std::size_t step = words_per_value(f);
+    for (std::size_t i = 0; i + step <= words.size(); i += step) {
+        const Words w{words.data() + i, step};
+        switch (f) {
+            case Format::int16:
+                out.push_back(number(*words_to_int16(w)));
+                break;
+            case Format::uint16:
+                out.push_back(number(*words_to_uint16(w)));
+                break;
+            case Format::int32:
+                out.push_back(number(*words_to_int32(w)));
+                break;
+            case Format::uint32:
+                out.push_back(number(*words_to_uint32(w)));
+                break;
+            case Format::float32:
+                out.push_back(real(static_cast<double>(*words_to_float(w))));
+                break;
+            case Format::float64:
+                out.push_back(real(*words_to_double(w)));
+                break;
+            case Format::hex: {
+                auto t = fmt::format("0x{:04X}", w[0]);
+                out.push_back({t, nlohmann::json(t)});
+                break;
+            }
+            case Format::bcd: {
+                auto v = words_to_bcd16(w);
+                if (!v) return Unexpected(v.error());
+                out.push_back(number(*v));
+                break;
+            }
+            case Format::string:
+            case Format::bits:
+                break;
+        }
+    }
+    return out;
+}
+
+std::variant<std::vector<std::uint16_t>, ParseError> parse_words(
+    Format f, const std::vector<std::string>& values) {
+    std::vector<std::uint16_t> out;
+    if (f == Format::string) {
+        std::string joined;
+        for (std::size_t i = 0; i < values.size(); ++i)
+            joined += (i ? " " : "") + values[i];
+        auto w = string_to_words(joined);
+        if (!w) return ParseError{fmt::format("cannot write {:?} as a string", joined)};
+        return *w;
+    }
+    for (const auto& v : values) {
+        auto bad = [&] {
+            return ParseError{fmt::format("'{}' is not a valid {} value", v, format_name(f))};
+        };
+        switch (f) {
+            case Format::int16: {
+                auto x = parse_integer<std::int16_t>(v);
+                if (!x) return bad();
+                append(out, int16_to_words(*x));
+                break;
+            }
+            case Format::uint16:
+            case Format::hex: {
+                auto x = parse_integer<std::uint16_t>(v);
+                if (!x) return bad();
+                append(out, uint16_to_words(*x));
+                break;
+            }
+            case Format::int32: {
+                auto x = parse_integer<std::int32_t>(v);
+                if (!x) return bad();
+                append(out, int32_to_words(*x));
+                break;
+            }
+            case Format::uint32: {
+                auto x = parse_integer<std::uint32_t>(v);
+                if (!x) return bad();
+                append(out, uint32_to_words(*x));
+                break;
+            }
+            case Format::float32: {
+                auto x = parse_real(v);
+                if (!x) return bad();
+                append(out, float_to_words(static_cast<float>(*x)));
+                break;
+            }
+            case Format::float64: {
+                auto x = parse_real(v);
+                if (!x) return bad();
+                append(out, double_to_words(*x));
+                break;
+            }
+            case Format::bcd: {
+                auto x = parse_integer<std::uint16_t>(v);
+                auto w = x ? bcd16_to_words(*x) : Result<std::array<std::uint16_t, 1>>{};
+                if (!x || !w) return ParseError{fmt::format("'{}' is not BCD 0-9999", v)};
+                append(out, *w);
+                break;
+            }
+            case Format::bits: {
+                auto b = parse_bit(v);
+                if (!b) return ParseError{fmt::format("'{}' is not a bit (0/1/on/off)", v)};
+                out.push_back(*b ? 1 : 0);
+                break;
+            }
+            case Format::string:
+                break;
+        }
+    }
+    return out;
+}
+
+}  // namespace fins::cli

@@ -1,0 +1,67 @@
+// finsd's network front: FINS/UDP and FINS/TCP on one port, glued to the pure
+// Dispatcher. Everything runs on one asio::io_context thread, so the virtual PLC needs
+// no locks and every request sees the effects of the one before it.
+//
+// UDP: one datagram is one FINS frame; the response goes to the datagram's source
+//      address and port (what CS/CJ Ethernet units do with the dynamic conversion
+//      method, frames section 2).
+// TCP: the FINS/TCP envelope (frames section 3): node-address handshake with
+//      auto-assignment, then FRAME SEND packets in both directions. Each response is
+//      sent with one write; TCP_NODELAY keeps request/response traffic off delayed ACKs.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include <asio/io_context.hpp>
+
+#include "fins/error.hpp"
+#include "fins/frame.hpp"
+
+namespace fins::plc {
+class Plc;
+}
+
+namespace fins::server {
+
+struct ServerOptions {
+    std::string bind_address = "127.0.0.1";
+    std::uint16_t port = 9600;  // 0 picks a free port (tests)
+    bool udp = true;
+    bool tcp = true;
+    // 0 = derive: last octet of the bound IPv4 address, 1 on loopback or a wildcard.
+    std::uint8_t node = 0;
+    std::uint8_t network = 0;  // this node's FINS network address (00 = local network)
+    // W596 1-2: up to 16 FINS/TCP connections.
+    std::size_t max_tcp_connections = 16;
+};
+
+// The node number finsd takes when none is given (see ServerOptions::node).
+std::uint8_t derive_node(const std::string& bind_address) noexcept;
+
+class Server {
+  public:
+    // Binds the sockets and starts accepting; the caller runs `io`.
+    static Result<std::unique_ptr<Server>> start(asio::io_context& io, plc::Plc& plc,
+                                                 const ServerOptions& options);
+    ~Server();
+    Server(const Server&) = delete;
+    Server& operator=(const Server&) = delete;
+
+    [[nodiscard]] std::uint16_t udp_port() const noexcept;
+    [[nodiscard]] std::uint16_t tcp_port() const noexcept;
+    [[nodiscard]] NodeAddress address() const noexcept;
+    [[nodiscard]] std::size_t tcp_connections() const noexcept;
+
+    // Closes the sockets and every TCP session; pending handlers finish on `io`.
+    void stop();
+
+    struct Impl;
+
+  private:
+    explicit Server(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace fins::server
