@@ -10,9 +10,20 @@
 #include <cstdint>
 #include <optional>
 
+#include <memory>
+
 #include "fins/frame.hpp"
+#include "plc/clock.hpp"
+#include "plc/errors.hpp"
 #include "plc/io_memory.hpp"
+#include "plc/loop_control.hpp"
+#include "plc/messages.hpp"
+#include "plc/parameter_areas.hpp"
 #include "plc/profile.hpp"
+#include "plc/program.hpp"
+#include "plc/scan_cycle.hpp"
+#include "plc/storage.hpp"
+#include "plc/write_access_log.hpp"
 
 namespace fins::plc {
 
@@ -20,11 +31,24 @@ enum class OperatingMode : std::uint8_t { program, monitor, run };
 
 class Plc {
   public:
-    explicit Plc(Profile profile = cj2h());
+    // `storage` holds the state (nullptr: all on the heap, nothing retained). Every
+    // model takes its sections from it here; call storage().seal() afterwards.
+    explicit Plc(Profile profile = cj2h(), std::unique_ptr<Storage> storage = nullptr);
 
     [[nodiscard]] const Profile& profile() const noexcept { return memory_.profile(); }
     IoMemory& memory() noexcept { return memory_; }
     [[nodiscard]] const IoMemory& memory() const noexcept { return memory_; }
+
+    Storage& storage() noexcept { return *storage_; }
+    ParameterAreas& parameters() noexcept { return parameters_; }
+    UserProgram& program() noexcept { return program_; }
+    LoopControl& loop_control() noexcept { return loop_control_; }
+    Clock& clock() noexcept { return clock_; }
+    ScanCycle& scan_cycle() noexcept { return scan_cycle_; }
+    ErrorState& errors() noexcept { return errors_; }
+    [[nodiscard]] const ErrorState& errors() const noexcept { return errors_; }
+    Messages& messages() noexcept { return messages_; }
+    WriteAccessLog& write_access_log() noexcept { return write_access_log_; }
 
     [[nodiscard]] OperatingMode mode() const noexcept { return mode_; }
     void set_mode(OperatingMode mode) noexcept { mode_ = mode; }
@@ -57,7 +81,16 @@ class Plc {
     void set_dip_write_protection(bool on) noexcept { dip_write_protection_ = on; }
 
   private:
+    std::unique_ptr<Storage> storage_;  // first: every model below takes sections from it
     IoMemory memory_;
+    ParameterAreas parameters_;
+    UserProgram program_;
+    LoopControl loop_control_;
+    Clock clock_;
+    ScanCycle scan_cycle_;
+    ErrorState errors_;
+    Messages messages_;
+    WriteAccessLog write_access_log_;
     OperatingMode mode_ = OperatingMode::run;
     std::optional<NodeAddress> access_right_holder_;
     bool network_write_protection_ = false;

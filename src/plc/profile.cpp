@@ -21,6 +21,13 @@ bool Profile::accepts(const MemoryAreaSegment& segment) const noexcept {
     return true;
 }
 
+bool Profile::supports(CommandCode code) const noexcept {
+    if (commands.empty()) return true;
+    for (auto c : commands)
+        if (c == code.value()) return true;
+    return false;
+}
+
 Profile cj2h() {
     return Profile{};
 }

@@ -9,13 +9,44 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
+
+#include "fins/frame.hpp"
 
 #include "fins/memory_area.hpp"
 
 namespace fins::plc {
 
+// A unit mounted with the CPU Unit, as 05 01 (CPU Bus Unit configuration) and 05 02
+// (CONNECTION DATA READ) report it.
+struct UnitInfo {
+    std::uint8_t unit_address = 0;  // 10-1F CPU Bus Unit, 20-7F Special I/O Unit, E1 Inner Board
+    std::string model;              // up to 20 ASCII characters
+    std::uint16_t bus_unit_id = 0;  // 05 01 CPU Bus Unit model ID (bits 0-14)
+};
+
 struct Profile {
     std::string model = "CJ2H-CPU68-EIP";
+    std::string system_version = "02.00";  // 05 01 internal system version (20 ASCII)
+
+    // 05 01 area data and CPU information (W342 5-3-15).
+    std::uint16_t program_kwords = 100;     // UM (program area) size in K words
+    std::uint8_t iom_kbytes = 23;           // I/O memory size in K bytes
+    std::uint8_t timer_counter_kwords = 8;  // timer/counter size (x 1024)
+    std::uint8_t dip_switch = 0;            // pin k -> bit k (pin 1 = UM write protection)
+    std::uint8_t memory_card_type = 0x04;   // 00 none, 04 flash
+    std::uint16_t memory_card_kbytes = 0;   // 0 when no card is inserted
+    std::uint8_t racks = 1;                 // CPU Rack + expansion racks
+    bool battery = true;                    // 06 01 status bit 2
+    std::vector<UnitInfo> units;            // mounted units, ascending unit address
+
+    // The commands this model answers (MRC << 8 | SRC); empty = every command of the
+    // W342 table. NX CPU Units answer only the W596 2-2 subset and 0401 for the rest.
+    std::vector<std::uint16_t> commands;
+    // NX CPU Units return the fixed 05 01 / 06 01 values of W596 2-2.
+    bool nx_fixed_values = false;
+    // A Loop Control Board is mounted (02 40 ITEM read, seed 001).
+    bool loop_control = false;
 
     // W342 5-2-2: EM banks 0x00-0x18 on the largest CS/CJ models; CJ2H-CPU68 has 25.
     std::uint8_t em_banks = 25;
@@ -37,6 +68,8 @@ struct Profile {
 
     // True when this model accepts memory area code `segment.code` at all (1101 if not).
     [[nodiscard]] bool accepts(const MemoryAreaSegment& segment) const noexcept;
+    // True when this model answers `code` (else 0401 undefined command).
+    [[nodiscard]] bool supports(CommandCode code) const noexcept;
 };
 
 // CJ2H-CPU68-EIP: the default profile.

@@ -43,10 +43,13 @@ std::size_t Dispatcher::handle(Bytes request, MutableBytes out, const RequestCon
     Header response = response_header(header, self_);
     if (header.destination.node == broadcast_node) response.source.node = self_.node;
 
+    // Bits 6/7 of every end code report the CPU Unit's non-fatal/fatal errors (W342
+    // 5-1-3): 0040 is a normal completion on a CPU Unit with a battery error.
+    std::uint16_t flags = 0;
     const auto answer = [&](EndCode code) -> std::size_t {
         if (!reply) return 0;
         ByteWriter w(out);
-        write_response_prefix(w, response, command, static_cast<std::uint16_t>(code));
+        write_response_prefix(w, response, command, static_cast<std::uint16_t>(code) | flags);
         return w.overflowed() ? 0 : w.size();
     };
 
@@ -54,12 +57,14 @@ std::size_t Dispatcher::handle(Bytes request, MutableBytes out, const RequestCon
         code != EndCode::normal_completion)
         return answer(code);
 
+    flags = plc_.errors().end_code_flags();
     const auto decoded = decode_request(request);  // 1001 above 2,012 bytes
     if (!decoded) return answer(handlers::to_end_code(decoded.error()));
 
     const CommandInfo* info = find_command(command);
     const handlers::HandlerEntry* entry = handlers::find_handler(command);
-    if (info == nullptr || entry == nullptr) return answer(EndCode::undefined_command);
+    if (info == nullptr || entry == nullptr || !plc_.profile().supports(command))
+        return answer(EndCode::undefined_command);
 
     if (const auto code = handlers::check_execution_conditions(info->conditions, plc_,
                                                                header.source, context.link);
@@ -72,10 +77,10 @@ std::size_t Dispatcher::handle(Bytes request, MutableBytes out, const RequestCon
         out.subspan(data_offset, std::min(out.size() - data_offset, max_response_data_size)));
     handlers::HandlerContext handler_context{plc_, header, context};
     auto code = entry->function(handler_context, decoded->parameters, data);
-    if (code == EndCode::normal_completion && data.overflowed()) code = EndCode::response_too_long;
-    if (code != EndCode::normal_completion) return answer(code);
+    if (data.overflowed()) code = EndCode::response_too_long;
+    if (code != EndCode::normal_completion && !handler_context.keep_data) return answer(code);
 
-    const auto prefix = answer(EndCode::normal_completion);
+    const auto prefix = answer(code);
     return prefix == 0 ? 0 : prefix + data.size();
 }
 

@@ -29,7 +29,7 @@ struct RequestContext {
 };
 
 class Dispatcher {
-public:
+  public:
     // `self` is this node's address on the network (network, node, unit 00).
     Dispatcher(plc::Plc& plc, NodeAddress self) noexcept;
 
@@ -42,7 +42,7 @@ public:
     [[nodiscard]] const NodeAddress& self() const noexcept { return self_; }
     plc::Plc& plc() noexcept { return plc_; }
 
-private:
+  private:
     plc::Plc& plc_;
     NodeAddress self_;
 };

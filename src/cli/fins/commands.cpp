@@ -37,7 +37,9 @@ std::optional<NodeAddress> parse_node_address(const std::string& s) {
 }
 
 // Connects, or prints why not and sets `exit_code`.
-std::unique_ptr<Client> open(const GlobalOptions& g, Output& out, int& exit_code) {
+}  // namespace
+
+std::unique_ptr<Client> open_client(const GlobalOptions& g, Output& out, int& exit_code) {
     ClientOptions o;
     o.host = g.host;
     o.port = g.port;
@@ -67,6 +69,8 @@ std::unique_ptr<Client> open(const GlobalOptions& g, Output& out, int& exit_code
     }
     return std::move(*client);
 }
+
+namespace {
 
 std::optional<Address> address_or_usage(const std::string& text, Output& out, int& exit_code) {
     auto a = parse_address(text);
@@ -158,7 +162,7 @@ int run_read(const GlobalOptions& g, const ReadArgs& a, Format f, Output& out) {
     const bool bits = f == Format::bits || (start->bit.has_value() && f == Format::uint16);
     if (start->bit && !bits)
         return out.usage(fmt::format("{} names a bit: use --as bits", a.address));
-    auto client = open(g, out, rc);
+    auto client = open_client(g, out, rc);
     if (!client) return rc;
 
     nlohmann::json values = nlohmann::json::array();
@@ -201,7 +205,7 @@ int run_write(const GlobalOptions& g, const WriteArgs& a, Format f, Output& out)
     auto parsed = parse_words(bits ? Format::bits : f, a.values);
     if (auto* e = std::get_if<ParseError>(&parsed)) return out.usage(e->message);
     const auto& words = std::get<std::vector<std::uint16_t>>(parsed);
-    auto client = open(g, out, rc);
+    auto client = open_client(g, out, rc);
     if (!client) return rc;
     Result<void> r;
     if (bits) {
@@ -224,7 +228,7 @@ int run_fill(const GlobalOptions& g, const FillArgs& a, Output& out) {
     auto parsed = parse_words(Format::uint16, {a.value});
     if (auto* e = std::get_if<ParseError>(&parsed)) return out.usage(e->message);
     const auto value = std::get<std::vector<std::uint16_t>>(parsed).at(0);
-    auto client = open(g, out, rc);
+    auto client = open_client(g, out, rc);
     if (!client) return rc;
     if (auto r = client->fill(*start, a.count, value); !r)
         return out.failure(r.error(), fmt::format("fill {}", a.address));
@@ -240,7 +244,7 @@ int run_transfer(const GlobalOptions& g, const TransferArgs& a, Output& out) {
     if (!from) return rc;
     auto to = address_or_usage(a.to, out, rc);
     if (!to) return rc;
-    auto client = open(g, out, rc);
+    auto client = open_client(g, out, rc);
     if (!client) return rc;
     if (auto r = client->transfer(*from, *to, a.count); !r)
         return out.failure(r.error(), fmt::format("transfer {} -> {}", a.from, a.to));
@@ -258,7 +262,7 @@ int run_read_multi(const GlobalOptions& g, const ReadMultiArgs& a, Output& out) 
         if (!addr) return rc;
         addresses.push_back(*addr);
     }
-    auto client = open(g, out, rc);
+    auto client = open_client(g, out, rc);
     if (!client) return rc;
     auto r = client->read_multiple(addresses);
     if (!r) return out.failure(r.error(), "read-multi");
@@ -283,7 +287,7 @@ int run_raw(const GlobalOptions& g, const RawArgs& a, Output& out) {
         return out.usage(fmt::format("parameters are {} bytes; a FINS command carries at most {}",
                                      params->size(), max_parameter_size));
     int rc = exit_ok;
-    auto client = open(g, out, rc);
+    auto client = open_client(g, out, rc);
     if (!client) return rc;
     const CommandCode command{(*code)[0], (*code)[1]};
     if (a.no_response) {

@@ -5,7 +5,10 @@
 #include <system_error>
 #include <vector>
 
+#include <CLI/App.hpp>
 #include <nlohmann/json.hpp>
+
+#include "fins/client.hpp"
 
 #include "cli/fins/value_format.hpp"
 
@@ -75,5 +78,16 @@ int run_fill(const GlobalOptions& g, const FillArgs& a, Output& out);
 int run_transfer(const GlobalOptions& g, const TransferArgs& a, Output& out);
 int run_read_multi(const GlobalOptions& g, const ReadMultiArgs& a, Output& out);
 int run_raw(const GlobalOptions& g, const RawArgs& a, Output& out);
+
+// Verbs of the other command groups register themselves; a verb's callback runs after
+// the whole command line is parsed (global options may follow the verb) and stores the
+// process exit code in `exit_code`. Each group lives in its own verbs_<group>.cpp.
+void add_plc_data_verbs(CLI::App& app, const GlobalOptions& g, int& exit_code);  // 02 xx, 03 xx
+void add_control_verbs(CLI::App& app, const GlobalOptions& g, int& exit_code);   // 04-07 xx
+void add_diagnostic_verbs(CLI::App& app, const GlobalOptions& g,
+                          int& exit_code);  // 06 01, 09, 0C, 21, 23
+
+// Connects with the global options, or prints why not and sets `exit_code`.
+std::unique_ptr<Client> open_client(const GlobalOptions& g, Output& out, int& exit_code);
 
 }  // namespace fins::cli

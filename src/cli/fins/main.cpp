@@ -80,12 +80,18 @@ int main(int argc, char** argv) {
     c_raw->add_flag("--no-response", raw.no_response,
                     "Set the ICF no-response bit and do not wait");
 
+    int group_rc = -1;
+    add_plc_data_verbs(app, g, group_rc);
+    add_control_verbs(app, g, group_rc);
+    add_diagnostic_verbs(app, g, group_rc);
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         const int rc = app.exit(e);
         return rc == 0 ? 0 : exit_usage;
     }
+    if (group_rc >= 0) return group_rc;
     Output out{g.json};
     if (c_raw->parsed()) return run_raw(g, raw, out);
     auto format = parse_format(as);

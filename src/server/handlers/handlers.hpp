@@ -3,8 +3,8 @@
 // A handler receives the decoded command and the PLC, writes its response data (the
 // bytes after the end code) through a ByteWriter over the response buffer, and returns
 // the end code. On any end code other than 0000 the dispatcher discards the data and
-// answers the end code alone. Handlers never see the frame header checks or the
-// execution conditions: the dispatcher has done those (W342 5-1-2) before calling.
+// answers the end code alone, unless the handler set keep_data. Handlers never see the frame header
+// checks or the execution conditions: the dispatcher has done those (W342 5-1-2) before calling.
 //
 // One file per command group of W342 section 5: memory_area.cpp = 01 xx, ...
 #pragma once
@@ -29,6 +29,9 @@ struct HandlerContext {
     plc::Plc& plc;
     const Header& header;  // the request's header (source address for access rights ...)
     const RequestContext& request;
+    // Set by a handler whose data goes out with a non-zero end code: 02 01 past the
+    // area end (data + 1104), 21 02 (records + 1104), 0C 01 (3001 + the holder).
+    bool keep_data = false;
 };
 
 using HandlerFunction = EndCode (*)(HandlerContext& context, Bytes parameters, ByteWriter& out);
@@ -39,8 +42,22 @@ struct HandlerEntry {
 };
 
 // Every command this server implements; each also has a row in fins::command_table().
+// Built from the group tables below, ascending by command code.
 std::span<const HandlerEntry> handler_table() noexcept;
 const HandlerEntry* find_handler(CommandCode code) noexcept;
+
+// One table per command group of W342 section 5, each defined in its group's file.
+std::span<const HandlerEntry> memory_area_handlers() noexcept;     // 01 xx  memory_area.cpp
+std::span<const HandlerEntry> parameter_area_handlers() noexcept;  // 02 xx  parameter_area.cpp
+std::span<const HandlerEntry> program_area_handlers() noexcept;    // 03 xx  program_area.cpp
+std::span<const HandlerEntry> operating_mode_handlers() noexcept;  // 04 xx  operating_mode.cpp
+std::span<const HandlerEntry> configuration_handlers() noexcept;   // 05 xx  configuration.cpp
+std::span<const HandlerEntry> status_handlers() noexcept;          // 06 xx  status.cpp
+std::span<const HandlerEntry> clock_handlers() noexcept;           // 07 xx  clock.cpp
+std::span<const HandlerEntry> message_handlers() noexcept;         // 09 20  messages.cpp
+std::span<const HandlerEntry> access_right_handlers() noexcept;    // 0C xx  access_right.cpp
+std::span<const HandlerEntry> error_log_handlers() noexcept;       // 21 xx  error_log.cpp
+std::span<const HandlerEntry> forced_handlers() noexcept;          // 23 xx  forced.cpp
 
 // The execution conditions of W342 5-1-2, checked in this order: operating mode
 // (RUN 2206, MONITOR 2205, PROGRAM 2203), network write protection (2102, only for
@@ -51,6 +68,20 @@ EndCode check_execution_conditions(const ExecutionConditions& conditions, const 
 
 // FINS end codes pass through; any other error (not expected from a decoder) is 1004.
 EndCode to_end_code(const std::error_code& error) noexcept;
+
+// Decodes C's parameters (1001/1002/... from the codec) and runs its handler, an
+// `execute(HandlerContext&, const C&, ByteWriter&)` overload declared in this namespace.
+template <class C>
+EndCode handle(HandlerContext& context, Bytes parameters, ByteWriter& out) {
+    const auto command = C::decode(parameters);
+    if (!command) return to_end_code(command.error());
+    return execute(context, *command, out);
+}
+
+template <class C>
+constexpr HandlerEntry entry() noexcept {
+    return HandlerEntry{C::code, &handle<C>};
+}
 
 // 01 xx I/O memory area access (memory_area.cpp, W342 5-3-2 .. 5-3-6).
 EndCode execute(HandlerContext& context, const MemoryAreaRead& command, ByteWriter& out) noexcept;

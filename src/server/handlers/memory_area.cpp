@@ -85,4 +85,17 @@ EndCode execute(HandlerContext& context, const MemoryAreaTransfer& command, Byte
     return memory.transfer(*source, *destination);
 }
 
+namespace {
+
+constexpr HandlerEntry memory_area_table[] = {
+    entry<MemoryAreaRead>(),         entry<MemoryAreaWrite>(),    entry<MemoryAreaFill>(),
+    entry<MultipleMemoryAreaRead>(), entry<MemoryAreaTransfer>(),
+};
+
+}  // namespace
+
+std::span<const HandlerEntry> memory_area_handlers() noexcept {
+    return memory_area_table;
+}
+
 }  // namespace fins::server::handlers

@@ -1,7 +1,8 @@
-// The dispatch table: one row per implemented command, built from the command types.
-// A command's name and execution conditions come from fins::find_command (the codec's
-// W342 5-1-1/5-1-2 table); this table only says which function runs it.
-#include <array>
+// The dispatch table: the group tables joined and sorted once. A command's name and
+// execution conditions come from fins::find_command (the codec's W342 5-1-1/5-1-2
+// table); this table only says which function runs it.
+#include <algorithm>
+#include <vector>
 
 #include "server/handlers/handlers.hpp"
 
@@ -9,34 +10,39 @@ namespace fins::server::handlers {
 
 namespace {
 
-// Decodes C's parameters (1001/1002/... from the codec) and runs its handler.
-template <class C>
-EndCode handle(HandlerContext& context, Bytes parameters, ByteWriter& out) {
-    const auto command = C::decode(parameters);
-    if (!command) return to_end_code(command.error());
-    return execute(context, *command, out);
+std::vector<HandlerEntry> build() {
+    std::vector<HandlerEntry> all;
+    for (auto group :
+         {memory_area_handlers(), parameter_area_handlers(), program_area_handlers(),
+          operating_mode_handlers(), configuration_handlers(), status_handlers(), clock_handlers(),
+          message_handlers(), access_right_handlers(), error_log_handlers(), forced_handlers()})
+        all.insert(all.end(), group.begin(), group.end());
+    std::sort(all.begin(), all.end(), [](const HandlerEntry& a, const HandlerEntry& b) {
+        return a.code.value() < b.code.value();
+    });
+    return all;
 }
 
-template <class C>
-constexpr HandlerEntry entry() noexcept {
-    return HandlerEntry{C::code, &handle<C>};
-}
+// Built at load time (the group tables are constant-initialized), so the request path
+// never allocates.
+const std::vector<HandlerEntry> all_handlers = build();
 
-constexpr std::array handlers{
-    entry<MemoryAreaRead>(),         entry<MemoryAreaWrite>(),    entry<MemoryAreaFill>(),
-    entry<MultipleMemoryAreaRead>(), entry<MemoryAreaTransfer>(),
-};
+const std::vector<HandlerEntry>& table() {
+    return all_handlers;
+}
 
 }  // namespace
 
 std::span<const HandlerEntry> handler_table() noexcept {
-    return handlers;
+    return table();
 }
 
 const HandlerEntry* find_handler(CommandCode code) noexcept {
-    for (const auto& h : handlers)
-        if (h.code == code) return &h;
-    return nullptr;
+    const auto& all = table();
+    auto it =
+        std::lower_bound(all.begin(), all.end(), code.value(),
+                         [](const HandlerEntry& e, std::uint16_t v) { return e.code.value() < v; });
+    return it != all.end() && it->code == code ? &*it : nullptr;
 }
 
 EndCode to_end_code(const std::error_code& error) noexcept {

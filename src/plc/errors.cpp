@@ -1,0 +1,7 @@
+#include "plc/errors.hpp"
+
+namespace fins::plc {
+
+ErrorState::ErrorState(const Profile&, Storage&) {}
+
+}  // namespace fins::plc

@@ -1,0 +1,16 @@
+// The simulated scan cycle: cycle-time statistics for 06 20 (W342 5-3-18), and
+// the time base of the clock pulses and condition flags.
+// (Scaffolding: this class is being filled in by its issue-3 owner.)
+#pragma once
+
+#include "plc/profile.hpp"
+#include "plc/storage.hpp"
+
+namespace fins::plc {
+
+class ScanCycle {
+  public:
+    ScanCycle(const Profile& profile, Storage& storage);
+};
+
+}  // namespace fins::plc

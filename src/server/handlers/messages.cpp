@@ -1,0 +1,10 @@
+// 09 20 handlers. (Scaffolding: filled in by the issue-3 owner of this group.)
+#include "server/handlers/handlers.hpp"
+
+namespace fins::server::handlers {
+
+std::span<const HandlerEntry> message_handlers() noexcept {
+    return {};
+}
+
+}  // namespace fins::server::handlers
