@@ -3,6 +3,8 @@
 // (Scaffolding: this class is being filled in by its issue-3 owner.)
 #pragma once
 
+#include <chrono>
+
 #include "plc/profile.hpp"
 #include "plc/storage.hpp"
 
@@ -11,6 +13,9 @@ namespace fins::plc {
 class ScanCycle {
   public:
     ScanCycle(const Profile& profile, Storage& storage);
+    // Brings the simulated cycle up to `now`; the dispatcher calls it before every
+    // request. (Scaffolding: no-op until implemented.)
+    void advance(std::chrono::system_clock::time_point) noexcept {}
 };
 
 }  // namespace fins::plc

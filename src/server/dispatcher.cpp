@@ -57,6 +57,7 @@ std::size_t Dispatcher::handle(Bytes request, MutableBytes out, const RequestCon
         code != EndCode::normal_completion)
         return answer(code);
 
+    plc_.scan_cycle().advance(context.now);
     flags = plc_.errors().end_code_flags();
     const auto decoded = decode_request(request);  // 1001 above 2,012 bytes
     if (!decoded) return answer(handlers::to_end_code(decoded.error()));
@@ -78,6 +79,9 @@ std::size_t Dispatcher::handle(Bytes request, MutableBytes out, const RequestCon
     handlers::HandlerContext handler_context{plc_, header, context};
     auto code = entry->function(handler_context, decoded->parameters, data);
     if (data.overflowed()) code = EndCode::response_too_long;
+    // W342 5-3-30: the CPU Unit logs every FINS write command it receives.
+    if (!info->conditions.network_write_protected)
+        plc_.write_access_log().record(header.source, command, code, context.now);
     if (code != EndCode::normal_completion && !handler_context.keep_data) return answer(code);
 
     const auto prefix = answer(code);
