@@ -37,6 +37,7 @@ inline constexpr std::uint8_t default_gateway_count = 0x02;
 inline constexpr std::uint8_t local_network = 0x00;
 inline constexpr std::uint8_t broadcast_node = 0xFF;
 inline constexpr std::uint8_t cpu_unit = 0x00;
+inline constexpr std::uint8_t inner_board_unit = 0xE1;  // e.g. a Loop Control Board
 inline constexpr std::uint8_t network_unit = 0xFE;
 
 struct NodeAddress {

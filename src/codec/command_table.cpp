@@ -34,6 +34,8 @@ constexpr std::array commands{
     CommandInfo{{0x02, 0x01}, "PARAMETER AREA READ", "5-3-7", always},
     CommandInfo{{0x02, 0x02}, "PARAMETER AREA WRITE", "5-3-8", when(OK, OK, OK, NO, OK, NO, NO)},
     CommandInfo{{0x02, 0x03}, "PARAMETER AREA CLEAR", "5-3-9", when(OK, OK, OK, NO, OK, NO, NO)},
+    // Loop Control Board command (seed 001); a read, accepted in every state.
+    CommandInfo{{0x02, 0x40}, "READ MULTIPLE ITEMS FROM FUNCTION BLOCK", "seed 001", always},
     CommandInfo{{0x03, 0x06}, "PROGRAM AREA READ", "5-3-10", when(OK, OK, OK, OK, NO, OK, OK)},
     CommandInfo{{0x03, 0x07}, "PROGRAM AREA WRITE", "5-3-11", when(NO, NO, OK, NO, OK, NO, NO)},
     CommandInfo{{0x03, 0x08}, "PROGRAM AREA CLEAR", "5-3-12", when(NO, NO, OK, NO, OK, NO, NO)},
@@ -52,7 +54,9 @@ constexpr std::array commands{
     // handler itself refuses the clear variant while another device holds the access
     // right. 5-3-22 gives "OK" for network write protection where 5-1-2 says Disabled.
     CommandInfo{{0x09, 0x20}, "MESSAGE READ/CLEAR", "5-3-21", when(OK, OK, OK, OK, OK, OK, NO)},
-    CommandInfo{{0x0C, 0x01}, "ACCESS RIGHT ACQUIRE", "5-3-24", guarded_write},
+    // 5-1-2 marks 0C 01 "Disabled" while another device holds the right; the handler
+    // refuses it itself so that its 3001 answer can name the holder (5-3-24).
+    CommandInfo{{0x0C, 0x01}, "ACCESS RIGHT ACQUIRE", "5-3-24", when(OK, OK, OK, OK, OK, OK, NO)},
     CommandInfo{{0x0C, 0x02}, "ACCESS RIGHT FORCED ACQUIRE", "5-3-25", always},
     CommandInfo{{0x0C, 0x03}, "ACCESS RIGHT RELEASE", "5-3-26", always},
     // 5-3-27 gives "OK" for network write protection; 5-1-2 (and 5-1-1 note 1) Disabled.

@@ -3,7 +3,9 @@
 #include "plc/io_memory.hpp"
 
 #include <algorithm>
+#include <array>
 #include <limits>
+#include <string_view>
 #include <utility>
 
 namespace fins::plc {
@@ -61,22 +63,69 @@ std::uint8_t element_bytes(ElementKind kind) noexcept {
     return 1;
 }
 
-IoMemory::IoMemory(Profile profile) : profile_(std::move(profile)) {
+namespace {
+
+constexpr std::array<WordRange, 5> retained_aux{{
+    {100, 200},  // A100-A199 Error Log Area
+    {300, 301},  // A300 Error Log Pointer
+    {510, 521},  // A510-A520 Startup, Power Interruption, Operation Start/End Times, count
+    {523, 524},  // A523 Total Power ON Time
+    {720, 750},  // A720-A749 Power ON Clock Data 1-10
+}};
+
+// Zeroes `words` except the runs in `keep` (sorted, non-overlapping).
+void clear_except(std::span<std::uint16_t> words, std::span<const WordRange> keep) noexcept {
+    std::size_t from = 0;
+    for (const auto& r : keep) {
+        const auto first = std::min<std::size_t>(r.first, words.size());
+        std::fill(words.begin() + static_cast<std::ptrdiff_t>(std::min(from, first)),
+                  words.begin() + static_cast<std::ptrdiff_t>(first), std::uint16_t{0});
+        from = std::max(from, std::min<std::size_t>(r.end, words.size()));
+    }
+    std::fill(words.begin() + static_cast<std::ptrdiff_t>(std::min(from, words.size())),
+              words.end(), std::uint16_t{0});
+}
+
+std::span<std::uint16_t> take(Storage& storage, std::string_view name, std::size_t count,
+                              Retention retention) {
+    return storage.array<std::uint16_t>(name, count, retention);
+}
+
+}  // namespace
+
+std::span<const WordRange> retained_auxiliary_words() noexcept {
+    return retained_aux;
+}
+
+IoMemory::IoMemory(Profile profile, Storage& storage) : profile_(std::move(profile)) {
     profile_.timers = std::min(profile_.timers, max_timers);
     profile_.counters = std::min(profile_.counters, max_counters);
-    cio_.assign(profile_.cio_words, 0);
-    cio_forced_.assign(profile_.cio_words, 0);
-    work_.assign(profile_.work_words, 0);
-    work_forced_.assign(profile_.work_words, 0);
-    holding_.assign(profile_.holding_words, 0);
-    holding_forced_.assign(profile_.holding_words, 0);
-    auxiliary_.assign(profile_.auxiliary_words, 0);
-    dm_.assign(profile_.dm_words, 0);
-    em_.assign(profile_.em_banks, std::vector<std::uint16_t>(profile_.em_bank_words, 0));
+    // The 5-2-2 table addresses banks 00-18 (25 banks).
+    profile_.em_banks = std::min<std::uint8_t>(profile_.em_banks, 0x19);
+    constexpr auto R = Retention::retained;
+    constexpr auto C = Retention::cleared;
+    cio_ = take(storage, "io.cio", profile_.cio_words, C);
+    cio_forced_ = take(storage, "io.cio.forced", profile_.cio_words, C);
+    work_ = take(storage, "io.work", profile_.work_words, C);
+    work_forced_ = take(storage, "io.work.forced", profile_.work_words, C);
+    holding_ = take(storage, "io.holding", profile_.holding_words, R);
+    holding_forced_ = take(storage, "io.holding.forced", profile_.holding_words, C);
+    auxiliary_ = take(storage, "io.auxiliary", profile_.auxiliary_words, R);
+    dm_ = take(storage, "io.dm", profile_.dm_words, R);
+    em_ = take(storage, "io.em", std::size_t{profile_.em_banks} * profile_.em_bank_words, R);
     const auto tc = counter_base + profile_.counters;
-    timer_counter_pv_.assign(tc, 0);
-    completion_flags_.assign((tc + bits_per_word - 1) / bits_per_word, 0);
-    completion_forced_.assign(completion_flags_.size(), 0);
+    const auto flag_words = (tc + bits_per_word - 1) / bits_per_word;
+    timer_counter_pv_ = take(storage, "io.tc.pv", tc, R);
+    completion_flags_ = take(storage, "io.tc.flags", flag_words, R);
+    completion_forced_ = take(storage, "io.tc.forced", flag_words, C);
+
+    // Cleared parts of the partly retained sections: the timers (indexes below
+    // counter_base; counter_base is a multiple of 16, so whole flag words) and A.
+    const WordRange counters{counter_base, tc};
+    clear_except(timer_counter_pv_, std::span<const WordRange>(&counters, 1));
+    const WordRange counter_flags{counter_base / bits_per_word, flag_words};
+    clear_except(completion_flags_, std::span<const WordRange>(&counter_flags, 1));
+    clear_except(auxiliary_, retained_aux);
 }
 
 std::span<std::uint16_t> IoMemory::words(Region region, std::uint8_t bank) noexcept {
@@ -92,11 +141,9 @@ std::span<std::uint16_t> IoMemory::words(Region region, std::uint8_t bank) noexc
         case Region::dm:
             return dm_;
         case Region::em:
-            if (bank < em_.size()) return em_[bank];
-            return {};
+            return em_bank(bank);
         case Region::em_current:
-            if (current_em_bank_ < em_.size()) return em_[current_em_bank_];
-            return {};
+            return em_bank(current_em_bank_);
         case Region::timer_counter:
             return timer_counter_pv_;
         case Region::data_register:
@@ -104,6 +151,12 @@ std::span<std::uint16_t> IoMemory::words(Region region, std::uint8_t bank) noexc
         default:
             return {};
     }
+}
+
+std::span<std::uint16_t> IoMemory::em_bank(std::uint8_t bank) noexcept {
+    const std::size_t size = profile_.em_bank_words;
+    if (bank >= profile_.em_banks || (std::size_t{bank} + 1) * size > em_.size()) return {};
+    return em_.subspan(std::size_t{bank} * size, size);
 }
 
 std::span<const std::uint16_t> IoMemory::words(Region region, std::uint8_t bank) const noexcept {
@@ -136,7 +189,7 @@ void IoMemory::set_completion_flag(std::uint32_t index, bool on) noexcept {
 }
 
 bool IoMemory::set_current_em_bank(std::uint8_t bank) noexcept {
-    if (bank >= em_.size()) return false;
+    if (bank >= profile_.em_banks) return false;
     current_em_bank_ = bank;
     return true;
 }
@@ -204,8 +257,8 @@ bool IoMemory::is_completion_flag_forced(std::uint32_t index) const noexcept {
 }
 
 void IoMemory::release_all_forced() noexcept {
-    for (auto* v : {&cio_forced_, &work_forced_, &holding_forced_, &completion_forced_})
-        std::fill(v->begin(), v->end(), std::uint16_t{0});
+    for (auto v : {cio_forced_, work_forced_, holding_forced_, completion_forced_})
+        std::fill(v.begin(), v.end(), std::uint16_t{0});
 }
 
 // The storage indexes [first, end) around `index` that both the segment and the model
@@ -267,7 +320,7 @@ Result<ElementRange> IoMemory::locate(const MemoryAddress& start, std::uint32_t 
                         : EndCode::area_classification_missing);
     if (!segment->allows(use) || !profile_.accepts(*segment))
         return fail(EndCode::area_classification_missing);
-    if (segment->region == Region::em_current && current_em_bank_ >= em_.size())
+    if (segment->region == Region::em_current && current_em_bank_ >= profile_.em_banks)
         return fail(EndCode::area_classification_missing);
     if (start.word < segment->first_word)  // find_segment contract, checked anyway
         return fail(EndCode::address_range_error);

@@ -4,7 +4,7 @@
 //
 // Storage regions (fins::Region):
 //   cio, work, holding, auxiliary, dm   words, sized from the Profile
-//   em                                  one word vector per bank the Profile has
+//   em                                  one run of words per bank the Profile has
 //   em_current                          the bank named by current_em_bank() (default 0)
 //   timer_counter                       PVs + completion flags; timers at index 0-4095,
 //                                       counters at counter_base + n
@@ -12,6 +12,16 @@
 //   index_register / data_register      IR0-15 (32-bit) / DR0-15
 //   clock_pulse, condition_flag,        derived or constant, read-only
 //   access_error_flag
+// Retention (W342 / CS/CJ operation manuals "status at power ON"; docs/profiles.md):
+// every region lives in a plc::Storage section. Retained (battery-backed, kept across
+// restarts when finsd has a data directory): H, D, every EM bank, counter PVs and
+// counter completion flags, and the Auxiliary Area words of retained_auxiliary_words().
+// Cleared at every start: CIO, W, timer PVs and completion flags, the rest of A, task
+// flags, IR/DR, the current EM bank number, every forced-bit mask ("Forced Status
+// Hold at Startup" left at its default, OFF). A region that is only partly retained
+// (A, T/C PVs and flags) is one retained section whose cleared words the constructor
+// zeroes, so the request path writes straight into the section either way.
+//
 // CIO, W, H and the T/C completion flags also carry a forced-bit mask. A forced bit's
 // stored value is its forced value; FINS writes, fills and transfers leave forced
 // bits unchanged (W342 5-3-4 "clear the force set/reset to write the data").
@@ -32,6 +42,7 @@
 #include "fins/error.hpp"
 #include "fins/memory_area.hpp"
 #include "plc/profile.hpp"
+#include "plc/storage.hpp"
 
 namespace fins::plc {
 
@@ -93,9 +104,26 @@ struct ElementRange {
     }
 };
 
+// A run of Auxiliary Area words [first, end).
+struct WordRange {
+    std::uint32_t first = 0;
+    std::uint32_t end = 0;
+};
+
+// The battery-backed Auxiliary Area words of a CS/CJ CPU Unit (status at power ON
+// "Retained"): A100-A199 Error Log Area, A300 Error Log Pointer, A510-A511 Startup
+// Time, A512-A513 Power Interruption Time, A514 Number of Power Interruptions,
+// A515-A517 Operation Start Time, A518-A520 Operation End Time, A523 Total Power ON
+// Time, A720-A749 Power ON Clock Data 1-10. Every other A word is cleared at start.
+std::span<const WordRange> retained_auxiliary_words() noexcept;
+
 class IoMemory {
   public:
-    explicit IoMemory(Profile profile);
+    // Takes every region from `storage` (section names "io.*"; see the retention
+    // table above). `storage` must outlive this object.
+    IoMemory(Profile profile, Storage& storage);
+    IoMemory(const IoMemory&) = delete;
+    IoMemory& operator=(const IoMemory&) = delete;
 
     [[nodiscard]] const Profile& profile() const noexcept { return profile_; }
 
@@ -179,6 +207,8 @@ class IoMemory {
     [[nodiscard]] bool writable(const MemoryAreaSegment& segment, std::uint16_t word,
                                 std::uint32_t index) const noexcept;
     std::span<std::uint16_t> forced_storage(Region region) noexcept;
+    // Bank `bank` of em_; empty when the profile lacks it.
+    std::span<std::uint16_t> em_bank(std::uint8_t bank) noexcept;
 
     // Element accessors used by read/write; indexes are range-checked (0 / ignored).
     [[nodiscard]] bool bit_at(const ElementRange& r, std::uint64_t position) const noexcept;
@@ -190,16 +220,18 @@ class IoMemory {
                                        TimePoint now) const noexcept;
 
     Profile profile_;
-    std::vector<std::uint16_t> cio_, cio_forced_;
-    std::vector<std::uint16_t> work_, work_forced_;
-    std::vector<std::uint16_t> holding_, holding_forced_;
-    std::vector<std::uint16_t> auxiliary_;
-    std::vector<std::uint16_t> dm_;
-    std::vector<std::vector<std::uint16_t>> em_;
+    // Sections of the Storage passed to the constructor.
+    std::span<std::uint16_t> cio_, cio_forced_;
+    std::span<std::uint16_t> work_, work_forced_;
+    std::span<std::uint16_t> holding_, holding_forced_;
+    std::span<std::uint16_t> auxiliary_;
+    std::span<std::uint16_t> dm_;
+    std::span<std::uint16_t> em_;  // every bank, em_bank_words each, bank 0 first
     std::uint8_t current_em_bank_ = 0;
-    std::vector<std::uint16_t> timer_counter_pv_;   // counter_base + counters entries
-    std::vector<std::uint16_t> completion_flags_;   // packed, 16 flags per word
-    std::vector<std::uint16_t> completion_forced_;  // packed forced mask
+    std::span<std::uint16_t> timer_counter_pv_;   // counter_base + counters entries
+    std::span<std::uint16_t> completion_flags_;   // packed, 16 flags per word
+    std::span<std::uint16_t> completion_forced_;  // packed forced mask
+    // Cleared at every start like the sections above; plain members (nothing to keep).
     std::array<std::uint8_t, task_count> task_status_{};
     std::uint32_t task_flags_ = 0;
     std::array<std::uint32_t, register_count> index_registers_{};

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "plc/io_memory.hpp"
+#include "plc/scan_cycle.hpp"
 
 namespace fins::plc {
 
@@ -86,10 +87,14 @@ std::uint8_t IoMemory::flag_at(const ElementRange& r, std::uint32_t index,
         case Region::task_flag:
             return r.kind == ElementKind::task_status ? task_status(index)
                                                       : static_cast<std::uint8_t>(task_flag(index));
+        // Area 07 comes from the scan cycle's time base: values refreshed at the start of
+        // the cycle in progress (scan_cycle.hpp).
         case Region::clock_pulse:
-            return index < clock_pulse_count && clock_pulse(static_cast<ClockPulse>(index), now);
+            return index < clock_pulse_count &&
+                   ScanCycle::clock_pulse(profile_, static_cast<ClockPulse>(index), now);
         case Region::condition_flag:
-            return index < bits_per_word && condition_flag(static_cast<ConditionFlag>(index));
+            return index < bits_per_word &&
+                   ScanCycle::condition_flag(static_cast<ConditionFlag>(index));
         case Region::access_error_flag:
             return access_error_flag_ ? 1 : 0;
         default:

@@ -7,10 +7,12 @@
 // execution conditions (e.g. 03 07 PROGRAM AREA WRITE answers 2206 until STOP).
 #pragma once
 
+#include <chrono>
+#include <cstddef>
 #include <cstdint>
-#include <optional>
-
 #include <memory>
+#include <optional>
+#include <vector>
 
 #include "fins/frame.hpp"
 #include "plc/clock.hpp"
@@ -28,6 +30,28 @@
 namespace fins::plc {
 
 enum class OperatingMode : std::uint8_t { program, monitor, run };
+
+// PLC Setup "Write Protection from FINS Commands Sent to CPU Units via Networks"
+// (W342 5-1-2 note 5, W596 2-5). Which network nodes' FINS write commands answer 2102:
+enum class NetworkWriteProtection : std::uint8_t {
+    off,                // none
+    all,                // every network node
+    listed,             // only the listed nodes (note 5: "from specified network nodes")
+    all_except_listed,  // every node but the listed ones (the CS/CJ PLC Setup's "nodes
+                        // excluded from write protection")
+};
+
+// At most 32 listed nodes, as the CS/CJ PLC Setup's excluded-nodes table holds.
+inline constexpr std::size_t max_protection_nodes = 32;
+// A listed entry with this node number matches every node of its network.
+inline constexpr std::uint8_t any_node = 0xFF;
+
+struct NetworkWriteProtectionSetting {
+    NetworkWriteProtection mode = NetworkWriteProtection::off;
+    // Network + node of the requests' source address (SNA, SA1; the unit is ignored).
+    // Compared exactly as the request header carries them; node FF = any node.
+    std::vector<NodeAddress> nodes;
+};
 
 class Plc {
   public:
@@ -51,7 +75,11 @@ class Plc {
     WriteAccessLog& write_access_log() noexcept { return write_access_log_; }
 
     [[nodiscard]] OperatingMode mode() const noexcept { return mode_; }
+    // Sets the mode without touching the scan cycle (tests and power-on only).
     void set_mode(OperatingMode mode) noexcept { mode_ = mode; }
+    // Changes the operating mode as 04 01/04 02 do: leaving PROGRAM starts the program
+    // (the scan cycle restarts its statistics), entering PROGRAM stops it.
+    void change_mode(OperatingMode mode, std::chrono::system_clock::time_point now) noexcept;
 
     // The node holding the access right (0C 01/02), if any (W342 5-3-1 "Access Right").
     [[nodiscard]] const std::optional<NodeAddress>& access_right_holder() const noexcept {
@@ -66,11 +94,26 @@ class Plc {
     }
 
     // PLC Setup "Write Protection from FINS Commands Sent to CPU Units via Networks"
-    // (W342 5-1-2 note 5).
+    // (W342 5-1-2 note 5). True when the protection is on in any mode.
     [[nodiscard]] bool network_write_protection() const noexcept {
+        return network_write_protection_.mode != NetworkWriteProtection::off;
+    }
+    // On: every network node (NetworkWriteProtection::all); off: none. The node list
+    // is kept for a later listed mode.
+    void set_network_write_protection(bool on) noexcept {
+        network_write_protection_.mode =
+            on ? NetworkWriteProtection::all : NetworkWriteProtection::off;
+    }
+    // Takes at most max_protection_nodes entries (the rest are dropped). Allocates:
+    // a configuration call, never on the request path.
+    void set_network_write_protection_setting(NetworkWriteProtectionSetting setting);
+    [[nodiscard]] const NetworkWriteProtectionSetting& network_write_protection_setting()
+        const noexcept {
         return network_write_protection_;
     }
-    void set_network_write_protection(bool on) noexcept { network_write_protection_ = on; }
+    // True when a FINS write command from `source` (arrived over a network) is refused
+    // with 2102 under the current setting.
+    [[nodiscard]] bool network_write_protected_from(const NodeAddress& source) const noexcept;
 
     // UM read protection set from a Peripheral Device.
     [[nodiscard]] bool um_read_protection() const noexcept { return um_read_protection_; }
@@ -93,7 +136,7 @@ class Plc {
     WriteAccessLog write_access_log_;
     OperatingMode mode_ = OperatingMode::run;
     std::optional<NodeAddress> access_right_holder_;
-    bool network_write_protection_ = false;
+    NetworkWriteProtectionSetting network_write_protection_;
     bool um_read_protection_ = false;
     bool dip_write_protection_ = false;
 };

@@ -4,11 +4,16 @@
 // Sizes are the I/O memory sizes of W342 5-2-2 (CS/CJ mode). Region storage in
 // IoMemory is allocated from these numbers; an address that the 5-2-2 table accepts
 // but that lies beyond the profile's size answers like an address outside the area
-// (1103 start / 1104 end).
+// (1103 start / 1104 end). An area the model does not have at all answers 1101.
+//
+// The registry (profiles(), find_profile()) holds the models finsd can be: see
+// docs/profiles.md for the table and where each figure comes from.
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "fins/frame.hpp"
@@ -22,18 +27,24 @@ namespace fins::plc {
 struct UnitInfo {
     std::uint8_t unit_address = 0;  // 10-1F CPU Bus Unit, 20-7F Special I/O Unit, E1 Inner Board
     std::string model;              // up to 20 ASCII characters
-    std::uint16_t bus_unit_id = 0;  // 05 01 CPU Bus Unit model ID (bits 0-14)
+    std::uint16_t bus_unit_id = 0;  // 05 01 CPU Bus Unit model ID (bits 0-14); 0: not published
 };
 
+// DIP switch pin 1 (UM write protection) in Profile::dip_switch: pin k is bit k-1.
+inline constexpr std::uint8_t dip_pin1 = 0x01;
+
 struct Profile {
+    // Registry key (lower case, e.g. "cj2h"); also the identity of a state file
+    // (Storage::open), so two profiles with different memory layouts never share one.
+    std::string name = "cj2h";
     std::string model = "CJ2H-CPU68-EIP";
     std::string system_version = "02.00";  // 05 01 internal system version (20 ASCII)
 
     // 05 01 area data and CPU information (W342 5-3-15).
-    std::uint16_t program_kwords = 100;     // UM (program area) size in K words
-    std::uint8_t iom_kbytes = 23;           // I/O memory size in K bytes
-    std::uint8_t timer_counter_kwords = 8;  // timer/counter size (x 1024)
-    std::uint8_t dip_switch = 0;            // pin k -> bit k (pin 1 = UM write protection)
+    std::uint16_t program_kwords = 250;     // UM (program area) size in K words (catalogue steps)
+    std::uint8_t iom_kbytes = 23;           // I/O memory size in K bytes ("always 23")
+    std::uint8_t timer_counter_kwords = 8;  // timer/counter size (x 1024, "always 8")
+    std::uint8_t dip_switch = 0;            // pin k -> bit k-1 (pin 1 = UM write protection)
     std::uint8_t memory_card_type = 0x04;   // 00 none, 04 flash
     std::uint16_t memory_card_kbytes = 0;   // 0 when no card is inserted
     std::uint8_t racks = 1;                 // CPU Rack + expansion racks
@@ -55,22 +66,33 @@ struct Profile {
     std::uint32_t cio_words = 6144;                 // CIO 0000-6143
     std::uint32_t work_words = 512;                 // W000-511
     std::uint32_t holding_words = 512;              // H000-511
-    std::uint32_t auxiliary_words = 960;            // A000-959
+    std::uint32_t auxiliary_words = 960;            // A000-959; 0 = no Auxiliary Area
     std::uint32_t auxiliary_read_only_words = 448;  // A000-447 are read-only (W342 5-2-2)
-    std::uint32_t timers = 4096;                    // T0000-4095
-    std::uint32_t counters = 4096;                  // C0000-4095
+    std::uint32_t timers = 4096;                    // T0000-4095; 0 = no timers
+    std::uint32_t counters = 4096;                  // C0000-4095; 0 = no counters
     std::uint32_t dm_words = 32768;                 // D00000-32767
 
     // W342 5-2-2 note 2: only CJ2 CPU Units accept 50-5F for EM banks 0-F.
     bool cj2_em_codes = true;
     // CS/CJ CPU Units accept the CVM1/CV-series codes of 5-2-2 (80, 82, 90-97 ...).
     bool cv_mode_codes = true;
+    // The CPU Unit's own areas: task flags (06, 46), IR/DR (DC, BC, 9C), clock pulses,
+    // condition flags and the access error flag (07), the EM current bank (0A, 98,
+    // BC 0F00). NX CPU Units have none of them (W596 2-2: "only areas that exist in
+    // the memory of CJ-series Units": CIO, WR, HR, DM, EM).
+    bool cpu_areas = true;
 
     // True when this model accepts memory area code `segment.code` at all (1101 if not).
     [[nodiscard]] bool accepts(const MemoryAreaSegment& segment) const noexcept;
     // True when this model answers `code` (else 0401 undefined command).
     [[nodiscard]] bool supports(CommandCode code) const noexcept;
 };
+
+// Every profile finsd knows, CJ2H first (the default).
+std::span<const Profile> profiles() noexcept;
+// The profile whose name or model equals `name`, ignoring case ("cj2h",
+// "CJ2H-CPU68-EIP", "nx102-9000" ...); nullptr when there is none.
+const Profile* find_profile(std::string_view name) noexcept;
 
 // CJ2H-CPU68-EIP: the default profile.
 Profile cj2h();

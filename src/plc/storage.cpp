@@ -51,6 +51,8 @@ enum class StorageError : int {
     layout_mismatch,
     in_use,
     too_many_sections,
+    duplicate_section,
+    profile_id_too_long,
 };
 
 class StorageCategory final : public std::error_category {
@@ -72,6 +74,10 @@ class StorageCategory final : public std::error_category {
                 return "state file is in use by another finsd";
             case StorageError::too_many_sections:
                 return "too many retained sections";
+            case StorageError::duplicate_section:
+                return "two retained sections of the same name";
+            case StorageError::profile_id_too_long:
+                return "profile id too long for a state file";
         }
         return "storage error";
     }
@@ -131,6 +137,9 @@ Storage::~Storage() = default;
 
 Result<std::unique_ptr<Storage>> Storage::open(const std::filesystem::path& dir,
                                                std::string_view profile_id) {
+    // The header keeps the id NUL-terminated; a longer one could never match again.
+    if (profile_id.size() >= profile_size)
+        return Unexpected(make(StorageError::profile_id_too_long));
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);
     if (ec) return Unexpected(ec);
@@ -163,8 +172,9 @@ Result<std::unique_ptr<Storage>> Storage::open(const std::filesystem::path& dir,
         std::uint64_t end = page;
         for (std::uint32_t i = 0; i < hd.count; ++i) {
             const auto& e = hd.entries[i];
-            // Sections are laid out in order, page aligned, inside the file.
-            if (e.offset != end || e.offset + e.size > size ||
+            // Sections are laid out in order, page aligned, inside the file (no sum
+            // below may wrap: e.offset == end <= size is checked first).
+            if (e.offset != end || e.offset > size || e.size > size - e.offset ||
                 ::strnlen(e.name, name_size) == name_size)
                 return Unexpected(make(StorageError::damaged));
             end = e.offset + round_up(std::max<std::uint64_t>(e.size, 1));
@@ -207,6 +217,13 @@ std::span<std::byte> Storage::section(std::string_view name, std::size_t bytes, 
         if (!s.problem) s.problem = make(StorageError::too_many_sections);
         return s.on_heap(bytes);
     }
+    // A duplicate could not be told apart from its twin when the file is reopened.
+    for (std::uint32_t i = 0; i < hd.count; ++i)
+        if (name ==
+            std::string_view(hd.entries[i].name, ::strnlen(hd.entries[i].name, name_size))) {
+            if (!s.problem) s.problem = make(StorageError::duplicate_section);
+            return s.on_heap(bytes);
+        }
     const std::uint64_t offset = hd.file_size;
     const std::uint64_t end = offset + round_up(std::max<std::size_t>(bytes, 1));
     if (::ftruncate(s.fd, static_cast<off_t>(end)) != 0) {

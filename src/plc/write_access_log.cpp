@@ -1,7 +1,38 @@
 #include "plc/write_access_log.hpp"
 
+#include <algorithm>
+
+#include "plc/clock.hpp"
+
 namespace fins::plc {
 
-WriteAccessLog::WriteAccessLog(const Profile&, Storage&) {}
+WriteAccessLog::WriteAccessLog(const Profile&, Storage& storage)
+    : state_(storage.object<State>("write_access_log", Retention::retained)) {
+    // A damaged state file must not index past the records.
+    if (state_.count > log_max_records) state_.count = log_max_records;
+}
+
+void WriteAccessLog::record(const NodeAddress& source, CommandCode command, EndCode,
+                            std::chrono::system_clock::time_point now) noexcept {
+    const LogTime time = clock_ != nullptr ? to_log_time(clock_->read(now)) : to_log_time(now);
+    const WriteAccessRecord entry{source, 0x00, command, time};
+    const std::uint32_t sequence = ++state_.sequence;
+    auto* const begin = state_.slots.begin();
+    auto* const end = begin + state_.count;
+    auto* same = std::find_if(begin, end, [&source](const Slot& s) {
+        return s.record.source.network == source.network && s.record.source.node == source.node;
+    });
+    if (same != end) {
+        *same = Slot{entry, sequence};
+        return;
+    }
+    if (state_.count == log_max_records) {
+        auto* oldest = std::min_element(
+            begin, end, [](const Slot& a, const Slot& b) { return a.sequence < b.sequence; });
+        std::copy(oldest + 1, end, oldest);
+        --state_.count;
+    }
+    state_.slots[state_.count++] = Slot{entry, sequence};
+}
 
 }  // namespace fins::plc

@@ -14,17 +14,27 @@ namespace {
 
 constexpr std::size_t response_prefix_size = header_size + command_code_size + end_code_size;
 
-// Is the frame for this CPU Unit? DNA 00 or ours; DA1 00 (local), ours or FF
-// (broadcast, answered like our own node); DA2 00 (the CPU Unit).
-// A wrong network or node answers 0201, any other unit 0202.
-EndCode check_destination(const NodeAddress& destination, const NodeAddress& self) noexcept {
+// Is the frame for this node? DNA 00 or ours; DA1 00 (local), ours or FF (broadcast,
+// answered like our own node); DA2 00 (the CPU Unit) or E1 when the profile has a Loop
+// Control Board (Inner Board). A wrong network or node answers 0201, any other unit 0202.
+EndCode check_destination(const NodeAddress& destination, const NodeAddress& self,
+                          const plc::Profile& profile) noexcept {
     if (destination.network != local_network && destination.network != self.network)
         return EndCode::destination_node_not_in_network;
     if (destination.node != 0x00 && destination.node != self.node &&
         destination.node != broadcast_node)
         return EndCode::destination_node_not_in_network;
+    if (destination.unit == inner_board_unit && profile.loop_control)
+        return EndCode::normal_completion;
     if (destination.unit != cpu_unit) return EndCode::unit_missing;
     return EndCode::normal_completion;
+}
+
+// Which unit runs a command: 02 40 belongs to the Loop Control Board (seed 001), every
+// other command to the CPU Unit. A command sent to the wrong one is undefined there.
+bool served_by(std::uint8_t unit, CommandCode command) noexcept {
+    const bool board_command = command == CommandCode{0x02, 0x40};
+    return unit == inner_board_unit ? board_command : !board_command;
 }
 
 }  // namespace
@@ -45,26 +55,30 @@ std::size_t Dispatcher::handle(Bytes request, MutableBytes out, const RequestCon
 
     // Bits 6/7 of every end code report the CPU Unit's non-fatal/fatal errors (W342
     // 5-1-3): 0040 is a normal completion on a CPU Unit with a battery error.
-    std::uint16_t flags = 0;
+    // Read when the answer is built, so an ERROR CLEAR that removed the last error
+    // already answers without the flag.
+    bool cpu_reached = false;
     const auto answer = [&](EndCode code) -> std::size_t {
         if (!reply) return 0;
+        const std::uint16_t flags = cpu_reached ? plc_.errors().end_code_flags() : 0;
         ByteWriter w(out);
         write_response_prefix(w, response, command, static_cast<std::uint16_t>(code) | flags);
         return w.overflowed() ? 0 : w.size();
     };
 
-    if (const auto code = check_destination(header.destination, self_);
+    if (const auto code = check_destination(header.destination, self_, plc_.profile());
         code != EndCode::normal_completion)
         return answer(code);
 
     plc_.scan_cycle().advance(context.now);
-    flags = plc_.errors().end_code_flags();
+    cpu_reached = true;
     const auto decoded = decode_request(request);  // 1001 above 2,012 bytes
     if (!decoded) return answer(handlers::to_end_code(decoded.error()));
 
     const CommandInfo* info = find_command(command);
     const handlers::HandlerEntry* entry = handlers::find_handler(command);
-    if (info == nullptr || entry == nullptr || !plc_.profile().supports(command))
+    if (info == nullptr || entry == nullptr || !plc_.profile().supports(command) ||
+        !served_by(header.destination.unit, command))
         return answer(EndCode::undefined_command);
 
     if (const auto code = handlers::check_execution_conditions(info->conditions, plc_,

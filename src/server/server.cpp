@@ -9,16 +9,17 @@
 
 #include "server/dispatcher.hpp"
 #include "server/tcp_session.hpp"
+#include "transport/transport.hpp"
 
 namespace fins::server {
 
 std::uint8_t derive_node(const std::string& bind_address) noexcept {
     std::error_code ec;
     const auto ip = asio::ip::make_address(bind_address, ec);
-    if (ec || !ip.is_v4() || ip.is_loopback() || ip.is_unspecified()) return 1;
-    const auto last = ip.to_v4().to_bytes()[3];
+    if (ec || ip.is_unspecified()) return 1;
+    const auto node = transport::node_from_address(ip);
     // .0 and .255 are not host numbers; a FINS node must be 1-254.
-    return (last == 0 || last == 255) ? 1 : last;
+    return (node == 0 || node == 255) ? 1 : node;
 }
 
 struct Server::Impl {

@@ -17,14 +17,14 @@ TimePoint after(std::chrono::system_clock::duration d) {
 }
 
 TEST(IoMemory, W342_5_2_1_WordsAreBigEndian) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     m.words(Region::dm)[10] = 0x1234;
     m.words(Region::dm)[11] = 0xABCD;
     EXPECT_EQ(read(m, at(0x82, 10), 2), (Bytes8{0x12, 0x34, 0xAB, 0xCD}));
 }
 
 TEST(IoMemory, W342_5_2_1_BitRunsContinueIntoTheNextWord) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     m.words(Region::cio)[10] = 0x8000;  // CIO10.15
     m.words(Region::cio)[11] = 0x0002;  // CIO11.01
     EXPECT_EQ(read(m, at(0x30, 10, 15), 3), (Bytes8{1, 0, 1}));
@@ -34,13 +34,13 @@ TEST(IoMemory, W342_5_2_1_BitRunsContinueIntoTheNextWord) {
 }
 
 TEST(IoMemory, BitWriteTakesAnyNonZeroByteAsOn) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     ASSERT_EQ(write(m, at(0x02, 5, 0), 3, {0x00, 0x01, 0xFF}), 0);
     EXPECT_EQ(m.words(Region::dm)[5], 0x0006);
 }
 
 TEST(IoMemory, W342_5_2_1_DoubleWordIndexRegisterIsBigEndian) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     m.index_registers()[3] = 0x01020304;
     EXPECT_EQ(read(m, at(0xDC, 0x0103), 1), (Bytes8{1, 2, 3, 4}));
     ASSERT_EQ(write(m, at(0xDC, 0x0100), 1, {0xDE, 0xAD, 0xBE, 0xEF}), 0);
@@ -48,7 +48,7 @@ TEST(IoMemory, W342_5_2_1_DoubleWordIndexRegisterIsBigEndian) {
 }
 
 TEST(IoMemory, W342_5_2_2_RegistersTasksAndEmBankNumber) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     m.words(Region::data_register)[15] = 0x0F0F;
     m.set_task_flag(31, true);
     m.set_task_status(2, 0x81);
@@ -61,7 +61,7 @@ TEST(IoMemory, W342_5_2_2_RegistersTasksAndEmBankNumber) {
 }
 
 TEST(IoMemory, W342_5_2_2_CurrentEmBankIsTheSelectedBank) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     m.words(Region::em, 0)[7] = 0x0007;
     m.words(Region::em, 5)[7] = 0x0507;
     EXPECT_EQ(read(m, at(0x98, 7), 1), (Bytes8{0x00, 0x07}));
@@ -72,7 +72,7 @@ TEST(IoMemory, W342_5_2_2_CurrentEmBankIsTheSelectedBank) {
 }
 
 TEST(IoMemory, W342_5_2_1_ForcedStatusEncodings) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     ASSERT_TRUE(m.force_bit(Region::cio, 10, 3, true));
     ASSERT_TRUE(m.force_bit(Region::cio, 10, 4, false));
     m.words(Region::cio)[10] |= 0x0001;
@@ -86,7 +86,7 @@ TEST(IoMemory, W342_5_2_1_ForcedStatusEncodings) {
 }
 
 TEST(IoMemory, W342_5_3_3_WritesDoNotChangeForcedBits) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     ASSERT_TRUE(m.force_bit(Region::work, 3, 0, true));
     ASSERT_TRUE(m.force_bit(Region::work, 3, 15, false));
     ASSERT_EQ(write(m, at(0xB1, 3), 1, {0xFF, 0xFE}), 0);
@@ -104,7 +104,7 @@ TEST(IoMemory, W342_5_3_3_WritesDoNotChangeForcedBits) {
 }
 
 TEST(IoMemory, ForcingOnlyAppliesToCioWorkHoldingAndCompletionFlags) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     EXPECT_FALSE(m.force_bit(Region::dm, 0, 0, true));
     EXPECT_FALSE(m.force_bit(Region::auxiliary, 500, 0, true));
     EXPECT_FALSE(m.force_bit(Region::cio, 6144, 0, true));
@@ -115,7 +115,7 @@ TEST(IoMemory, ForcingOnlyAppliesToCioWorkHoldingAndCompletionFlags) {
 }
 
 TEST(IoMemory, W342_5_3_3_WriteLengthMismatchIs1003AndWritesNothing) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     EXPECT_EQ(write(m, at(0x82, 0), 2, {0x11, 0x11, 0x22}), 0x1003);
     EXPECT_EQ(write(m, at(0x82, 0), 2, {0x11, 0x11, 0x22, 0x22, 0x33}), 0x1003);
     EXPECT_EQ(m.words(Region::dm)[0], 0);
@@ -124,7 +124,7 @@ TEST(IoMemory, W342_5_3_3_WriteLengthMismatchIs1003AndWritesNothing) {
 }
 
 TEST(IoMemory, W342_5_3_3_PvWriteLeavesCompletionFlags) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     m.set_completion_flag(7, true);
     ASSERT_EQ(write(m, at(0x89, 7), 1, {0x01, 0x00}), 0);
     EXPECT_EQ(m.words(Region::timer_counter)[7], 0x0100);
@@ -132,7 +132,7 @@ TEST(IoMemory, W342_5_3_3_PvWriteLeavesCompletionFlags) {
 }
 
 TEST(IoMemory, W342_5_3_4_FillOnPvsTurnsCompletionFlagsOffExceptForced) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     for (std::uint32_t i = counter_base; i < counter_base + 4; ++i)
         m.set_completion_flag(i, true);
     ASSERT_TRUE(m.force_completion_flag(counter_base + 2, true));
@@ -147,7 +147,7 @@ TEST(IoMemory, W342_5_3_4_FillOnPvsTurnsCompletionFlagsOffExceptForced) {
 }
 
 TEST(IoMemory, W342_5_3_4_FillKeepsForcedBits) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     ASSERT_TRUE(m.force_bit(Region::cio, 1, 0, false));
     const auto r = m.locate(at(0xB0, 0), 3, use_word_ops, Intent::write);
     ASSERT_TRUE(r);
@@ -166,7 +166,7 @@ EndCode transfer(IoMemory& m, MemoryAddress from, MemoryAddress to, std::uint32_
 }
 
 TEST(IoMemory, W342_5_3_6_OverlappingTransferCopiesTheSourceFirst) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     auto dm = m.words(Region::dm);
     for (std::uint16_t i = 0; i < 6; ++i)
         dm[i] = static_cast<std::uint16_t>(i + 1);
@@ -179,7 +179,7 @@ TEST(IoMemory, W342_5_3_6_OverlappingTransferCopiesTheSourceFirst) {
 }
 
 TEST(IoMemory, W342_5_3_6_TransferBetweenABankAndTheCurrentBankOverlaps) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     ASSERT_TRUE(m.set_current_em_bank(3));
     auto e3 = m.words(Region::em, 3);
     for (std::uint16_t i = 0; i < 4; ++i)
@@ -190,7 +190,7 @@ TEST(IoMemory, W342_5_3_6_TransferBetweenABankAndTheCurrentBankOverlaps) {
 }
 
 TEST(IoMemory, W342_5_3_6_TransferKeepsForcedBitsAndCompletionFlags) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     m.words(Region::dm)[0] = 0x0000;
     m.words(Region::dm)[1] = 0x1234;
     m.words(Region::cio)[100] = 0xFFFF;
@@ -220,7 +220,7 @@ TEST(IoMemory, W342_5_2_2_ClockPulsesAreOnForTheFirstHalfOfEachPeriod) {
 }
 
 TEST(IoMemory, W342_5_2_2_Area07ReadsPulsesAndConditionFlags) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     EXPECT_EQ(read(m, at(0x07, 0x0000), 5, after(milliseconds(1705))), (Bytes8{1, 0, 0, 1, 1}));
     EXPECT_EQ(read(m, at(0x07, 0x1000), 11), Bytes8(11, 0));
     EXPECT_EQ(read(m, at(0x07, 0x100E), 2), (Bytes8{0, 1}));  // Always OFF, Always ON

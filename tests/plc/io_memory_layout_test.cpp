@@ -16,7 +16,7 @@ TEST(Profile, W342_5_2_2_Cj2hDefaults) {
 }
 
 TEST(IoMemory, W342_5_2_2_RegionSizes) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     EXPECT_EQ(m.words(Region::cio).size(), 6144U);
     EXPECT_EQ(m.words(Region::work).size(), 512U);
     EXPECT_EQ(m.words(Region::holding).size(), 512U);
@@ -42,7 +42,7 @@ TEST(IoMemory, ElementSizesAgreeWithTheAreaTable) {
 }
 
 TEST(IoMemory, W342_5_2_2_LastAddressOfEveryAreaIsAccepted) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     EXPECT_EQ(code_of(m.locate(at(0xB0, 6143), 1, use_read, Intent::read)), 0);
     EXPECT_EQ(code_of(m.locate(at(0x30, 6143, 15), 1, use_read, Intent::read)), 0);
     EXPECT_EQ(code_of(m.locate(at(0xB1, 511), 1, use_read, Intent::read)), 0);
@@ -57,7 +57,7 @@ TEST(IoMemory, W342_5_2_2_LastAddressOfEveryAreaIsAccepted) {
 }
 
 TEST(IoMemory, LocateMapsCountersAfterTimers) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     const auto r = m.locate(at(0x89, 0x8005), 1, use_read, Intent::read);
     ASSERT_TRUE(r);
     EXPECT_EQ(r->index, counter_base + 5);
@@ -65,7 +65,7 @@ TEST(IoMemory, LocateMapsCountersAfterTimers) {
 }
 
 TEST(IoMemory, W342_5_1_3_UnknownOrUnlistedCodeIs1101) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     EXPECT_EQ(code_of(m.locate(at(0xFF, 0), 1, use_read, Intent::read)), 0x1101);
     EXPECT_EQ(code_of(m.locate(at(0x09, 0), 1, use_write, Intent::write)), 0x1101);
     EXPECT_EQ(code_of(m.locate(at(0x30, 0), 1, use_word_ops, Intent::write)), 0x1101);
@@ -77,7 +77,7 @@ TEST(IoMemory, W342_5_1_3_UnknownOrUnlistedCodeIs1101) {
 }
 
 TEST(IoMemory, W342_5_1_3_StartOutsideTheAreaIs1103) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     EXPECT_EQ(code_of(m.locate(at(0xB0, 6144), 1, use_read, Intent::read)), 0x1103);
     EXPECT_EQ(code_of(m.locate(at(0x82, 0x8000), 1, use_read, Intent::read)), 0x1103);
     EXPECT_EQ(code_of(m.locate(at(0x89, 0x1000), 1, use_read, Intent::read)), 0x1103);
@@ -86,7 +86,7 @@ TEST(IoMemory, W342_5_1_3_StartOutsideTheAreaIs1103) {
 }
 
 TEST(IoMemory, W342_5_2_1_BitNumberChecksAre1103) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     EXPECT_EQ(code_of(m.locate(at(0x30, 10, 0x10), 1, use_read, Intent::read)), 0x1103);
     EXPECT_EQ(code_of(m.locate(at(0x30, 10, 0x0F), 1, use_read, Intent::read)), 0);
     EXPECT_EQ(code_of(m.locate(at(0x82, 10, 0x01), 1, use_read, Intent::read)), 0x1103);
@@ -95,7 +95,7 @@ TEST(IoMemory, W342_5_2_1_BitNumberChecksAre1103) {
 }
 
 TEST(IoMemory, W342_5_1_3_EndPastTheAreaIs1104) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     EXPECT_EQ(code_of(m.locate(at(0x82, 32767), 2, use_read, Intent::read)), 0x1104);
     EXPECT_EQ(code_of(m.locate(at(0x82, 32000), 768, use_read, Intent::read)), 0);
     EXPECT_EQ(code_of(m.locate(at(0x82, 32000), 769, use_read, Intent::read)), 0x1104);
@@ -106,7 +106,7 @@ TEST(IoMemory, W342_5_1_3_EndPastTheAreaIs1104) {
 }
 
 TEST(IoMemory, CountZeroValidatesTheStartOnly) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     const auto r = m.locate(at(0x82, 32767), 0, use_read, Intent::read);
     ASSERT_TRUE(r);
     EXPECT_EQ(r->byte_size(), 0U);
@@ -116,7 +116,7 @@ TEST(IoMemory, CountZeroValidatesTheStartOnly) {
 }
 
 TEST(IoMemory, W342_5_2_2_AuxiliaryA000ToA447IsReadOnly) {
-    IoMemory m(cj2h());
+    HeapMemory m(cj2h());
     EXPECT_EQ(code_of(m.locate(at(0xB3, 447), 1, use_write, Intent::write)), 0x2101);
     EXPECT_EQ(code_of(m.locate(at(0xB3, 448), 1, use_write, Intent::write)), 0);
     EXPECT_EQ(code_of(m.locate(at(0xB3, 447), 1, use_read, Intent::read)), 0);
@@ -129,7 +129,7 @@ TEST(IoMemory, W342_5_2_2_AuxiliaryA000ToA447IsReadOnly) {
 TEST(IoMemory, W342_5_1_3_EmBankTheModelLacksIs1101) {
     Profile p = cj2h();
     p.em_banks = 3;
-    IoMemory m(p);
+    HeapMemory m(p);
     EXPECT_EQ(code_of(m.locate(at(0xA2, 0), 1, use_read, Intent::read)), 0);
     EXPECT_EQ(code_of(m.locate(at(0xA3, 0), 1, use_read, Intent::read)), 0x1101);
     EXPECT_EQ(code_of(m.locate(at(0x23, 0), 1, use_write, Intent::write)), 0x1101);
@@ -142,7 +142,7 @@ TEST(IoMemory, W342_5_1_3_EmBankTheModelLacksIs1101) {
 TEST(IoMemory, W342_5_1_3_NoEmAtAllMakesCurrentBankCodes1101) {
     Profile p = cj2h();
     p.em_banks = 0;
-    IoMemory m(p);
+    HeapMemory m(p);
     EXPECT_EQ(code_of(m.locate(at(0x98, 0), 1, use_read, Intent::read)), 0x1101);
     EXPECT_EQ(code_of(m.locate(at(0x0A, 0, 3), 1, use_read, Intent::read)), 0x1101);
     EXPECT_EQ(code_of(m.locate(at(0xBC, 0x0F00), 1, use_read, Intent::read)), 0x1101);
@@ -150,11 +150,11 @@ TEST(IoMemory, W342_5_1_3_NoEmAtAllMakesCurrentBankCodes1101) {
 }
 
 TEST(IoMemory, W342_5_2_2_Note2_Cj2OnlyEmCodes) {
-    IoMemory cj2(cj2h());
+    HeapMemory cj2(cj2h());
     EXPECT_EQ(code_of(cj2.locate(at(0x53, 0), 1, use_read, Intent::read)), 0);
     Profile p = cj2h();
     p.cj2_em_codes = false;
-    IoMemory other(p);
+    HeapMemory other(p);
     EXPECT_EQ(code_of(other.locate(at(0x53, 0), 1, use_read, Intent::read)), 0x1101);
     EXPECT_EQ(code_of(other.locate(at(0xA3, 0), 1, use_read, Intent::read)), 0);
 }
@@ -162,7 +162,7 @@ TEST(IoMemory, W342_5_2_2_Note2_Cj2OnlyEmCodes) {
 TEST(IoMemory, W342_5_2_2_CvModeCodesFollowTheProfile) {
     Profile p = cj2h();
     p.cv_mode_codes = false;
-    IoMemory m(p);
+    HeapMemory m(p);
     EXPECT_EQ(code_of(m.locate(at(0x80, 0), 1, use_read, Intent::read)), 0x1101);
     EXPECT_EQ(code_of(m.locate(at(0x90, 0), 1, use_read, Intent::read)), 0x1101);
     // 82 and 98 are CS/CJ codes as well.
@@ -174,7 +174,7 @@ TEST(IoMemory, SmallerModelSizesBoundAddresses) {
     Profile p = cj2h();
     p.dm_words = 10000;
     p.timers = 256;
-    IoMemory m(p);
+    HeapMemory m(p);
     EXPECT_EQ(code_of(m.locate(at(0x82, 9999), 1, use_read, Intent::read)), 0);
     EXPECT_EQ(code_of(m.locate(at(0x82, 10000), 1, use_read, Intent::read)), 0x1103);
     EXPECT_EQ(code_of(m.locate(at(0x82, 9990), 11, use_read, Intent::read)), 0x1104);
@@ -188,7 +188,7 @@ TEST(IoMemory, EveryCodeAndWordNeverEscapesStorage) {
     Profile p = cj2h();
     p.em_banks = 2;
     p.dm_words = 100;
-    IoMemory m(p);
+    HeapMemory m(p);
     for (unsigned code = 0; code < 256; ++code)
         for (unsigned word : {0U, 1U, 99U, 100U, 0x01FFU, 0x0F00U, 0x7FFFU, 0x8FFFU, 0xFFFFU})
             for (unsigned count : {0U, 1U, 2U, 17U, 1000U, 65535U}) {

@@ -2,11 +2,23 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "plc/io_memory.hpp"
+#include "plc/storage.hpp"
 
 namespace fins::plc::test {
+
+// Owns the heap Storage an IoMemory takes its regions from (base-from-member: the
+// Storage is constructed first).
+struct HeapStorage {
+    Storage storage;
+};
+class HeapMemory : private HeapStorage, public IoMemory {
+  public:
+    explicit HeapMemory(Profile profile) : HeapStorage{}, IoMemory(std::move(profile), storage) {}
+};
 
 // 0 on success, else the FINS end code a locate() failed with.
 inline std::uint16_t code_of(const Result<ElementRange>& r) {

@@ -1,10 +1,188 @@
-// (Scaffolding: implemented by the issue-3 owner of errors/messages.)
+// `finsd ctl --socket PATH VERB ...`: sends one request to a running finsd's control
+// channel (server/control.hpp) and prints the answer line.
+//
+//   status                          the JSON snapshot
+//   battery-error on|off            low battery (error 00F7) / battery replaced
+//   fal N [MESSAGE]                 FAL N, N = 1-511, message up to 16 characters
+//   fals N [MESSAGE]                FALS N (fatal: the CPU stops)
+//   error CODE                      any other W342 5-3-27 error code, hex (0203, 80F0)
+//   clear-errors [CODE]             every error (and the battery cause), or one code
+//   message N [TEXT]                registers MSG N (0-7); without TEXT unregisters it
+//   write-protect on|off            network write protection (PLC Setup, all nodes)
+//   mode program|monitor|run        operating mode
+//   release-access                  drops the access right (as 0C 03)
+//   send JSON                       any request line as is
+//
+// Exit codes: 0 the server answered "ok"; 2 usage error or the server refused the
+// request (its message on stderr); 3 cannot connect, or no answer within 5 s.
 #include "cli/finsd/ctl.hpp"
+
+#include <poll.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <optional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 namespace fins::cli {
 
-int run_ctl(int, char**) {
-    return 2;
+namespace {
+
+constexpr int exit_ok = 0;
+constexpr int exit_usage = 2;
+constexpr int exit_io = 3;
+constexpr int answer_timeout_ms = 5000;
+constexpr std::size_t max_answer_size = 1 << 20;
+
+struct Fd {
+    int fd = -1;
+    ~Fd() {
+        if (fd >= 0) ::close(fd);
+    }
+};
+
+// Sends `request` (one line) and returns the answer line, or prints why not.
+std::optional<std::string> send_request(const std::string& path, const std::string& request) {
+    sockaddr_un address{};
+    if (path.size() >= sizeof address.sun_path) {
+        std::fprintf(stderr, "finsd ctl: socket path too long: %s\n", path.c_str());
+        return std::nullopt;
+    }
+    address.sun_family = AF_UNIX;
+    std::memcpy(address.sun_path, path.data(), path.size());
+    Fd s{::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0)};
+    if (s.fd < 0 ||
+        ::connect(s.fd, reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0) {
+        std::fprintf(stderr, "finsd ctl: cannot connect to %s: %s\n", path.c_str(),
+                     std::strerror(errno));
+        return std::nullopt;
+    }
+    const std::string line = request + "\n";
+    for (std::size_t sent = 0; sent < line.size();) {
+        const auto n = ::send(s.fd, line.data() + sent, line.size() - sent, MSG_NOSIGNAL);
+        if (n <= 0) {
+            std::fprintf(stderr, "finsd ctl: send: %s\n", std::strerror(errno));
+            return std::nullopt;
+        }
+        sent += static_cast<std::size_t>(n);
+    }
+    std::string answer;
+    const auto deadline =
+        std::chrono::steady_clock::now() + std::chrono::milliseconds(answer_timeout_ms);
+    while (answer.size() < max_answer_size) {
+        const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+            deadline - std::chrono::steady_clock::now());
+        pollfd p{s.fd, POLLIN, 0};
+        if (left.count() <= 0 || ::poll(&p, 1, static_cast<int>(left.count())) <= 0) break;
+        char buf[4096];
+        const auto n = ::recv(s.fd, buf, sizeof buf, 0);
+        if (n <= 0) break;
+        answer.append(buf, static_cast<std::size_t>(n));
+        if (const auto end = answer.find('\n'); end != std::string::npos) {
+            answer.resize(end);
+            return answer;
+        }
+    }
+    std::fprintf(stderr, "finsd ctl: no answer from %s\n", path.c_str());
+    return std::nullopt;
+}
+
+}  // namespace
+
+int run_ctl(int argc, char** argv) {
+    using Json = nlohmann::json;
+    CLI::App app{"finsd ctl: change a running finsd through its control socket"};
+    app.name("finsd ctl");
+    app.require_subcommand(1);
+    std::string socket;
+    app.add_option("--socket", socket, "The control socket (finsd --control PATH)")->required();
+
+    Json request;
+    std::string on_off;
+    unsigned number = 0;
+    std::string text;
+    std::string code;
+    std::string mode;
+    std::string raw;
+    const auto add_on_off = [&](const char* name, const char* help, const char* cmd) {
+        auto* c = app.add_subcommand(name, help);
+        c->add_option("state", on_off, "on or off")
+            ->required()
+            ->check(CLI::IsMember({"on", "off"}));
+        c->callback([&, cmd] { request = {{"cmd", cmd}, {"on", on_off == "on"}}; });
+    };
+    const auto add_fal = [&](const char* name, const char* help) {
+        auto* c = app.add_subcommand(name, help);
+        c->add_option("number", number, "1-511")->required()->check(CLI::Range(1, 511));
+        c->add_option("message", text, "Up to 16 ASCII characters");
+        c->callback([&, name] {
+            request = {{"cmd", name}, {"number", number}, {"message", text}};
+        });
+    };
+
+    app.add_subcommand("status", "Print the JSON status snapshot")->callback([&] {
+        request = {{"cmd", "status"}};
+    });
+    add_on_off("battery-error", "Low battery (error 00F7) on, or battery replaced",
+               "battery_error");
+    add_fal("fal", "Raise FAL N (non-fatal error 4100+N)");
+    add_fal("fals", "Raise FALS N (fatal error C100+N: the CPU stops)");
+    auto* c_error = app.add_subcommand("error", "Raise another W342 5-3-27 error code");
+    c_error->add_option("code", code, "Hex error code, e.g. 0203 or 80F0")->required();
+    c_error->callback([&] { request = {{"cmd", "error"}, {"code", code}}; });
+    auto* c_clear = app.add_subcommand("clear-errors", "Clear every error, or one code");
+    c_clear->add_option("code", code, "Hex error code (default: all)");
+    c_clear->callback([&] {
+        request = {{"cmd", "clear_errors"}};
+        if (!code.empty()) request["code"] = code;
+    });
+    auto* c_msg = app.add_subcommand("message", "Register MSG N, or unregister it without TEXT");
+    c_msg->add_option("number", number, "0-7")->required()->check(CLI::Range(0, 7));
+    auto* text_option = c_msg->add_option("text", text, "Up to 32 ASCII characters");
+    c_msg->callback([&] {
+        request = {{"cmd", "message"}, {"number", number}};
+        if (text_option->count() > 0) request["text"] = text;
+    });
+    add_on_off("write-protect", "Network write protection (all nodes) on or off",
+               "network_write_protection");
+    auto* c_mode = app.add_subcommand("mode", "Set the operating mode");
+    c_mode->add_option("mode", mode, "program, monitor or run")
+        ->required()
+        ->check(CLI::IsMember({"program", "monitor", "run"}));
+    c_mode->callback([&] { request = {{"cmd", "mode"}, {"mode", mode}}; });
+    app.add_subcommand("release-access", "Release the access right (as 0C 03)")->callback([&] {
+        request = {{"cmd", "release_access_right"}};
+    });
+    auto* c_send = app.add_subcommand("send", "Send one request line as is");
+    c_send->add_option("json", raw, "The request, e.g. '{\"cmd\":\"status\"}'")->required();
+
+    try {
+        // argv[0] is "ctl": CLI11 skips it as the program name.
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        const int rc = app.exit(e);
+        return rc == 0 ? exit_ok : exit_usage;
+    }
+    const std::string line = c_send->parsed() ? raw : request.dump();
+    if (line.find('\n') != std::string::npos) {
+        std::fprintf(stderr, "finsd ctl: a request is one line\n");
+        return exit_usage;
+    }
+    const auto answer = send_request(socket, line);
+    if (!answer) return exit_io;
+    std::printf("%s\n", answer->c_str());
+    const Json doc = Json::parse(*answer, nullptr, false);
+    if (doc.is_object() && doc.contains("ok") && doc["ok"] == true) return exit_ok;
+    if (doc.is_object() && doc.contains("error") && doc["error"].is_string())
+        std::fprintf(stderr, "finsd ctl: %s\n", doc["error"].get<std::string>().c_str());
+    return exit_usage;
 }
 
 }  // namespace fins::cli

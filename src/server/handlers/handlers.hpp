@@ -53,6 +53,7 @@ std::span<const HandlerEntry> program_area_handlers() noexcept;    // 03 xx  pro
 std::span<const HandlerEntry> operating_mode_handlers() noexcept;  // 04 xx  operating_mode.cpp
 std::span<const HandlerEntry> configuration_handlers() noexcept;   // 05 xx  configuration.cpp
 std::span<const HandlerEntry> status_handlers() noexcept;          // 06 xx  status.cpp
+std::span<const HandlerEntry> cpu_status_handlers() noexcept;      // 06 01  cpu_status.cpp
 std::span<const HandlerEntry> clock_handlers() noexcept;           // 07 xx  clock.cpp
 std::span<const HandlerEntry> message_handlers() noexcept;         // 09 20  messages.cpp
 std::span<const HandlerEntry> access_right_handlers() noexcept;    // 0C xx  access_right.cpp

@@ -12,10 +12,10 @@ namespace {
 
 std::vector<HandlerEntry> build() {
     std::vector<HandlerEntry> all;
-    for (auto group :
-         {memory_area_handlers(), parameter_area_handlers(), program_area_handlers(),
-          operating_mode_handlers(), configuration_handlers(), status_handlers(), clock_handlers(),
-          message_handlers(), access_right_handlers(), error_log_handlers(), forced_handlers()})
+    for (auto group : {memory_area_handlers(), parameter_area_handlers(), program_area_handlers(),
+                       operating_mode_handlers(), configuration_handlers(), status_handlers(),
+                       cpu_status_handlers(), clock_handlers(), message_handlers(),
+                       access_right_handlers(), error_log_handlers(), forced_handlers()})
         all.insert(all.end(), group.begin(), group.end());
     std::sort(all.begin(), all.end(), [](const HandlerEntry& a, const HandlerEntry& b) {
         return a.code.value() < b.code.value();

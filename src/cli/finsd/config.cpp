@@ -1,0 +1,340 @@
+// The TOML loader of finsd's configuration file (config.hpp). Each key is read with
+// its type and range checked; the first problem ends the load with a message naming
+// the file position and the dotted key.
+#include "cli/finsd/config.hpp"
+
+#include <algorithm>
+#include <cstdint>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+namespace fins::cli::finsd {
+
+namespace {
+
+// A table's entries in file order (toml::table iterates in key order): the first
+// problem reported is the first in the file, and [memory] entries are written in the
+// order they are written down (later ones win where they overlap).
+std::vector<std::pair<const toml::key*, const toml::node*>> in_file_order(const toml::table& t) {
+    std::vector<std::pair<const toml::key*, const toml::node*>> entries;
+    for (auto&& [k, v] : t)
+        entries.emplace_back(&k, &v);
+    std::stable_sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
+        const auto& x = a.first->source().begin;
+        const auto& y = b.first->source().begin;
+        return x.line != y.line ? x.line < y.line : x.column < y.column;
+    });
+    return entries;
+}
+
+class Loader {
+  public:
+    Loader(std::string_view source, Settings& settings) : source_(source), s_(settings) {}
+
+    Expected<void> load(const toml::table& root) {
+        for (const auto& [key_ptr, node_ptr] : in_file_order(root)) {
+            const toml::key& key = *key_ptr;
+            const toml::node& node = *node_ptr;
+            const std::string k(key.str());
+            Expected<void> r;
+            if (k == "profile")
+                r = text(key, node, k, s_.profile);
+            else if (k == "mode")
+                r = mode(key, node);
+            else if (k == "data_dir")
+                r = path(key, node, k, s_.data_dir);
+            else if (k == "control")
+                r = path(key, node, k, s_.control_socket);
+            else if (k == "log_level")
+                r = text(key, node, k, s_.log_level);
+            else if (k == "network")
+                r = section(key, node, k, &Loader::network);
+            else if (k == "protection")
+                r = section(key, node, k, &Loader::protection);
+            else if (k == "memory")
+                r = section(key, node, k, &Loader::memory);
+            else if (k == "inject")
+                r = section(key, node, k, &Loader::inject);
+            else
+                r = fail(key, k, "unknown key");
+            if (!r) return r;
+        }
+        return {};
+    }
+
+  private:
+    using Handler = Expected<void> (Loader::*)(const toml::key&, const toml::node&,
+                                               const std::string&);
+
+    tl::unexpected<Error> fail(const toml::key& key, std::string_view path,
+                               std::string_view message) const {
+        return fail_at(key.source(), path, message);
+    }
+    tl::unexpected<Error> fail_at(const toml::source_region& where, std::string_view path,
+                                  std::string_view message) const {
+        return tl::unexpected<Error>(fmt::format("{}:{}:{}: {}: {}", source_, where.begin.line,
+                                                 where.begin.column, path, message));
+    }
+    std::string position(const toml::key& key) const {
+        return fmt::format("{}:{}:{}", source_, key.source().begin.line, key.source().begin.column);
+    }
+
+    Expected<void> section(const toml::key& key, const toml::node& node, const std::string& path,
+                           Handler handler) {
+        const auto* table = node.as_table();
+        if (table == nullptr) return fail(key, path, "must be a table");
+        for (const auto& [k, v] : in_file_order(*table)) {
+            const std::string child = path + "." + std::string(k->str());
+            if (auto r = (this->*handler)(*k, *v, child); !r) return r;
+        }
+        return {};
+    }
+
+    Expected<void> text(const toml::key& key, const toml::node& node, const std::string& path,
+                        std::string& out) const {
+        const auto* v = node.as_string();
+        if (v == nullptr) return fail(key, path, "must be a string");
+        out = v->get();
+        return {};
+    }
+    Expected<void> path(const toml::key& key, const toml::node& node, const std::string& p,
+                        std::optional<std::filesystem::path>& out) const {
+        std::string value;
+        if (auto r = text(key, node, p, value); !r) return r;
+        if (value.empty()) return fail(key, p, "must not be empty");
+        out = value;
+        return {};
+    }
+    Expected<void> flag(const toml::key& key, const toml::node& node, const std::string& path,
+                        bool& out) const {
+        const auto* v = node.as_boolean();
+        if (v == nullptr) return fail(key, path, "must be true or false");
+        out = v->get();
+        return {};
+    }
+    Expected<std::int64_t> integer(const toml::key& key, const toml::node& node,
+                                   const std::string& path, std::int64_t lo,
+                                   std::int64_t hi) const {
+        const auto* v = node.as_integer();
+        if (v == nullptr) return fail(key, path, "must be an integer");
+        if (v->get() < lo || v->get() > hi)
+            return fail(key, path, fmt::format("{} is not {}-{}", v->get(), lo, hi));
+        return v->get();
+    }
+
+    Expected<void> mode(const toml::key& key, const toml::node& node) {
+        std::string value;
+        if (auto r = text(key, node, "mode", value); !r) return r;
+        const auto m = parse_mode(value);
+        if (!m) return fail(key, "mode", fmt::format("'{}' is not program, monitor or run", value));
+        s_.mode = *m;
+        return {};
+    }
+
+    Expected<void> network(const toml::key& key, const toml::node& node, const std::string& p) {
+        const std::string_view k = key.str();
+        if (k == "bind") return text(key, node, p, s_.bind);
+        if (k == "udp") return flag(key, node, p, s_.udp);
+        if (k == "tcp") return flag(key, node, p, s_.tcp);
+        std::int64_t lo = 0;
+        std::int64_t hi = 0;
+        if (k == "node")
+            hi = 254;
+        else if (k == "network")
+            hi = 127;
+        else if (k == "port")
+            hi = 65535;
+        else if (k == "max_connections") {
+            lo = 1;
+            hi = 254;
+        } else
+            return fail(key, p, "unknown key");
+        const auto v = integer(key, node, p, lo, hi);
+        if (!v) return tl::unexpected<Error>(v.error());
+        if (k == "node") s_.node = static_cast<std::uint8_t>(*v);
+        if (k == "network") s_.network = static_cast<std::uint8_t>(*v);
+        if (k == "port") s_.port = static_cast<std::uint16_t>(*v);
+        if (k == "max_connections") s_.max_connections = static_cast<std::size_t>(*v);
+        return {};
+    }
+
+    Expected<void> protection(const toml::key& key, const toml::node& node, const std::string& p) {
+        const std::string_view k = key.str();
+        if (k == "um_read") return flag(key, node, p, s_.um_read_protection);
+        if (k == "dip_write") return flag(key, node, p, s_.dip_write_protection);
+        if (k == "network_write") {
+            std::string value;
+            if (auto r = text(key, node, p, value); !r) return r;
+            const auto mode = parse_protection(value);
+            if (!mode)
+                return fail(
+                    key, p,
+                    fmt::format("'{}' is not off, all, listed or all-except-listed", value));
+            s_.network_write_protection.mode = *mode;
+            return {};
+        }
+        if (k != "nodes") return fail(key, p, "unknown key");
+        const auto* list = node.as_array();
+        if (list == nullptr) return fail(key, p, "must be an array of \"network.node\" strings");
+        if (list->size() > plc::max_protection_nodes)
+            return fail(key, p, fmt::format("more than {} nodes", plc::max_protection_nodes));
+        s_.network_write_protection.nodes.clear();
+        for (std::size_t i = 0; i < list->size(); ++i) {
+            const auto* item = (*list)[i].as_string();
+            const auto n = item != nullptr ? parse_node(item->get()) : std::nullopt;
+            if (!n)
+                return fail(key, fmt::format("{}[{}]", p, i),
+                            "must be \"network.node\" (network 0-127, node 1-254 or *)");
+            s_.network_write_protection.nodes.push_back(*n);
+        }
+        return {};
+    }
+
+    Expected<void> memory(const toml::key& key, const toml::node& node, const std::string&) {
+        const std::string p = "memory.\"" + std::string(key.str()) + "\"";
+        MemoryInit entry;
+        entry.key = std::string(key.str());
+        entry.where = position(key);
+        const auto address = parse_address(entry.key);
+        if (!address) return fail(key, p, "not a PLC address (e.g. D100, H0, CIO10.13, E3_100)");
+        entry.address = *address;
+        const bool bit = address->bit.has_value();
+        const bool wide = address->area == Area::index_register;
+        const std::int64_t hi = bit ? 1 : wide ? 0xFFFFFFFF : 0xFFFF;
+        const std::int64_t lo = bit ? 0 : wide ? std::numeric_limits<std::int32_t>::min() : -32768;
+        const auto element = [&](const toml::node& n) -> Expected<std::uint32_t> {
+            if (const auto* b = n.as_boolean(); b != nullptr && bit) return b->get() ? 1U : 0U;
+            if (const auto* i = n.as_integer(); i != nullptr && i->get() >= lo && i->get() <= hi)
+                return static_cast<std::uint32_t>(i->get());
+            return fail(key, p,
+                        bit ? "bit values are true/false (or 0/1)"
+                            : fmt::format("word values are integers {}..{}", lo, hi));
+        };
+        if (const auto* list = node.as_array()) {
+            if (list->empty()) return fail(key, p, "empty array");
+            for (const auto& n : *list) {
+                const auto v = element(n);
+                if (!v) return tl::unexpected<Error>(v.error());
+                entry.values.push_back(*v);
+            }
+        } else {
+            const auto v = element(node);
+            if (!v) return tl::unexpected<Error>(v.error());
+            entry.values.push_back(*v);
+        }
+        s_.memory.push_back(std::move(entry));
+        return {};
+    }
+
+    Expected<plc::FalInjection> fal(const toml::key& key, const toml::node& node,
+                                    const std::string& p) const {
+        const auto* t = node.as_table();
+        if (t == nullptr) return fail(key, p, "must be { number = 1-511, message = \"...\" }");
+        plc::FalInjection f;
+        for (const auto& [key_ptr, node_ptr] : in_file_order(*t)) {
+            const toml::key& k = *key_ptr;
+            const toml::node& v = *node_ptr;
+            const std::string child = p + "." + std::string(k.str());
+            if (k.str() == "number") {
+                const auto n = integer(k, v, child, 1, 511);
+                if (!n) return tl::unexpected<Error>(n.error());
+                f.number = static_cast<std::uint16_t>(*n);
+            } else if (k.str() == "message") {
+                if (auto r = text(k, v, child, f.message); !r) return tl::unexpected(r.error());
+            } else {
+                return fail(k, child, "unknown key");
+            }
+        }
+        if (f.number == 0) return fail(key, p + ".number", "missing");
+        return f;
+    }
+
+    Expected<void> inject(const toml::key& key, const toml::node& node, const std::string& p) {
+        const std::string_view k = key.str();
+        auto& in = s_.inject;
+        if (k == "battery_error") return flag(key, node, p, in.battery_error);
+        if (k == "fals") {
+            const auto f = fal(key, node, p);
+            if (!f) return tl::unexpected<Error>(f.error());
+            in.fals = *f;
+        } else if (k == "fal") {
+            const auto* list = node.as_array();
+            if (list == nullptr) return fail(key, p, "must be an array of { number, message }");
+            in.fal.clear();
+            for (std::size_t i = 0; i < list->size(); ++i) {
+                const auto f = fal(key, (*list)[i], fmt::format("{}[{}]", p, i));
+                if (!f) return tl::unexpected<Error>(f.error());
+                in.fal.push_back(*f);
+            }
+        } else if (k == "messages") {
+            const auto* t = node.as_table();
+            if (t == nullptr) return fail(key, p, "must be a table { 0 = \"text\", ... }");
+            for (const auto& [key_ptr, node_ptr] : in_file_order(*t)) {
+                const toml::key& n = *key_ptr;
+                const toml::node& v = *node_ptr;
+                const std::string child = p + "." + std::string(n.str());
+                const std::string_view digit = n.str();
+                if (digit.size() != 1 || digit[0] < '0' || digit[0] > '7')
+                    return fail(n, child, "message numbers are 0-7");
+                std::string value;
+                if (auto r = text(n, v, child, value); !r) return r;
+                in.messages[static_cast<std::size_t>(digit[0] - '0')] = value;
+            }
+        } else if (k == "errors") {
+            const auto* list = node.as_array();
+            if (list == nullptr) return fail(key, p, "must be an array of error codes");
+            in.errors.clear();
+            for (std::size_t i = 0; i < list->size(); ++i) {
+                const auto v = integer(key, (*list)[i], fmt::format("{}[{}]", p, i), 0, 0xFFFF);
+                if (!v) return tl::unexpected<Error>(v.error());
+                in.errors.push_back(static_cast<std::uint16_t>(*v));
+            }
+        } else {
+            return fail(key, p, "unknown key");
+        }
+        // The injections' own rules (plc/injections.hpp): "fal[0].message: longer than
+        // 16 characters" becomes "inject.fal[0].message: longer than 16 characters".
+        if (const auto e = plc::validate(in); !e.empty()) {
+            const auto colon = std::min(e.find(": "), e.size());
+            return fail(key, "inject." + e.substr(0, colon),
+                        colon < e.size() ? std::string_view(e).substr(colon + 2) : "invalid");
+        }
+        return {};
+    }
+
+    std::string_view source_;
+    Settings& s_;
+};
+
+}  // namespace
+
+Expected<void> load_config_text(std::string_view text, std::string_view source,
+                                Settings& settings) {
+    toml::table root;
+    try {
+        root = toml::parse(text, source);
+    } catch (const toml::parse_error& e) {
+        return tl::unexpected<Error>(fmt::format("{}:{}:{}: {}", source, e.source().begin.line,
+                                                 e.source().begin.column, e.description()));
+    }
+    Settings copy = settings;  // all or nothing
+    if (auto r = Loader(source, copy).load(root); !r) return r;
+    settings = std::move(copy);
+    return {};
+}
+
+Expected<void> load_config_file(const std::filesystem::path& file, Settings& settings) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) return tl::unexpected<Error>(fmt::format("{}: cannot read the file", file.string()));
+    std::ostringstream text;
+    text << in.rdbuf();
+    return load_config_text(text.str(), file.string(), settings);
+}
+
+}  // namespace fins::cli::finsd

@@ -1,0 +1,112 @@
+// Running build/bin/finsd from a test: a scratch directory, a config file in it, the
+// process with "--port 0", its "listening <port>" line, and clients to it. Every wait
+// is bounded (process.hpp).
+#pragma once
+
+#include <unistd.h>
+
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "fins/client.hpp"
+#include "process.hpp"
+
+namespace fins::test {
+
+inline const std::string finsd_path = std::string(FINS_BIN_DIR) + "/finsd";
+
+class ScratchDir {
+  public:
+    explicit ScratchDir(const std::string& tag) {
+        static std::atomic<int> n{0};
+        path_ = std::filesystem::temp_directory_path() /
+                ("finskit-" + tag + "-" + std::to_string(::getpid()) + "-" + std::to_string(n++));
+        std::filesystem::remove_all(path_);
+        std::filesystem::create_directories(path_);
+    }
+    ~ScratchDir() {
+        std::error_code ec;
+        std::filesystem::remove_all(path_, ec);
+    }
+    ScratchDir(const ScratchDir&) = delete;
+    ScratchDir& operator=(const ScratchDir&) = delete;
+
+    [[nodiscard]] const std::filesystem::path& path() const { return path_; }
+    // Writes `text` to <dir>/<name> and returns the file's path as a string.
+    std::string write(const std::string& name, const std::string& text) const {
+        std::ofstream(path_ / name, std::ios::binary) << text;
+        return (path_ / name).string();
+    }
+
+  private:
+    std::filesystem::path path_;
+};
+
+// finsd with `args` after "--port 0 --log-level warn". started() is false when it exited
+// before listening; result() then holds its exit code and stderr.
+class Finsd {
+  public:
+    explicit Finsd(std::vector<std::string> args) {
+        std::vector<std::string> argv{finsd_path, "--port", "0", "--log-level", "warn"};
+        argv.insert(argv.end(), args.begin(), args.end());
+        child_ = std::make_unique<Child>(argv);
+        const std::string line = child_->read_line(std::chrono::seconds(20));
+        if (line.rfind("listening ", 0) == 0) {
+            port_ = static_cast<std::uint16_t>(std::stoul(line.substr(10)));
+        } else {
+            result_ = child_->wait(std::chrono::seconds(20));
+        }
+    }
+    [[nodiscard]] bool started() const { return port_ != 0; }
+    [[nodiscard]] std::uint16_t port() const { return port_; }
+    [[nodiscard]] const RunResult& result() const { return result_; }
+    [[nodiscard]] pid_t pid() const { return child_->pid(); }
+
+    std::unique_ptr<Client> client(bool tcp = false) const {
+        ClientOptions o;
+        o.port = port_;
+        o.protocol = tcp ? ClientOptions::Protocol::tcp : ClientOptions::Protocol::udp;
+        o.timeout = std::chrono::milliseconds(3000);
+        auto c = Client::connect(o);
+        EXPECT_TRUE(c.has_value()) << (c ? "" : c.error().message());
+        return c ? std::move(*c) : nullptr;
+    }
+    // Sends `signal` and waits for the exit: the exit code (128 + n for a signal).
+    RunResult stop(int signal = SIGTERM) {
+        child_->terminate(signal);
+        result_ = child_->wait(std::chrono::seconds(20));
+        return result_;
+    }
+
+  private:
+    std::unique_ptr<Child> child_;
+    std::uint16_t port_ = 0;
+    RunResult result_;
+};
+
+inline Address addr(const std::string& text) {
+    auto a = parse_address(text);
+    EXPECT_TRUE(a.has_value()) << text;
+    return a.value_or(Address{});
+}
+
+// `count` words from `text`; empty when the read failed.
+inline std::vector<std::uint16_t> words_of(Client& c, const std::string& text, std::size_t count) {
+    auto r = c.read_words(addr(text), count);
+    EXPECT_TRUE(r.has_value()) << text << ": " << (r ? "" : r.error().message());
+    return r.value_or(std::vector<std::uint16_t>{});
+}
+
+// The end code of a raw request without the flag bits 6/7 (0xFFFF when no answer came).
+inline unsigned end_code(Client& c, CommandCode code, const std::vector<std::uint8_t>& params) {
+    auto r = c.send_raw(code, params);
+    return r ? static_cast<unsigned>(r->code.end_code()) : 0xFFFFU;
+}
+
+}  // namespace fins::test

@@ -1,0 +1,176 @@
+// Retained memory survives SIGKILL: finsd with --data-dir acknowledges thousands of
+// writes to D, H, EM and counter words, is killed without a chance to flush, and a new
+// finsd on the same directory reads every acknowledged value back. CIO, W, timers and
+// the cleared Auxiliary Area words start at zero again.
+#include <signal.h>
+
+#include <functional>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include "finsd_run.hpp"
+
+namespace fins::test {
+namespace {
+
+struct Word {
+    std::string address;
+    std::uint16_t value;
+};
+
+// Distinct non-zero values: 40503 is odd, so i -> i * 40503 + 1 is a bijection mod 2^16.
+std::uint16_t value_of(std::size_t i) {
+    return static_cast<std::uint16_t>(i * 40503U + 1U);
+}
+
+// 5,000 distinct retained words: D0-1999, H0-499, 80 words in each of the 25 EM banks,
+// C0-499.
+std::vector<Word> retained_words() {
+    std::vector<std::string> addresses;
+    for (int i = 0; i < 2000; ++i)
+        addresses.push_back(fmt::format("D{}", i));
+    for (int i = 0; i < 500; ++i)
+        addresses.push_back(fmt::format("H{}", i));
+    for (int bank = 0; bank < 25; ++bank)
+        for (int i = 0; i < 80; ++i)
+            addresses.push_back(fmt::format("E{:X}_{}", bank, i * 409));  // banks in hex
+    for (int i = 0; i < 500; ++i)
+        addresses.push_back(fmt::format("C{}", i));
+    std::vector<Word> words;
+    for (std::size_t i = 0; i < addresses.size(); ++i)
+        words.push_back({addresses[i], value_of(i)});
+    return words;
+}
+
+// 01 02 parameters writing `value` to one word.
+std::vector<std::uint8_t> write_params(const std::string& text, std::uint16_t value) {
+    const auto m = to_memory_address(addr(text), Access::word);
+    EXPECT_TRUE(m.has_value()) << text;
+    const auto a = m.value_or(MemoryAddress{});
+    return {a.area_code,
+            static_cast<std::uint8_t>(a.word >> 8),
+            static_cast<std::uint8_t>(a.word),
+            0x00,
+            0x00,
+            0x01,
+            static_cast<std::uint8_t>(value >> 8),
+            static_cast<std::uint8_t>(value)};
+}
+
+const CommandCode memory_write{0x01, 0x02};
+
+TEST(Sigkill, AcknowledgedWritesSurviveAndClearedAreasStartAtZero) {
+    ScratchDir dir("sigkill");
+    const std::string data = (dir.path() / "data").string();
+    const auto words = retained_words();
+    ASSERT_EQ(words.size(), 5000u);
+    std::size_t acknowledged = 0;
+    {
+        Finsd d({"--profile", "cj2h", "--data-dir", data});
+        ASSERT_TRUE(d.started()) << d.result().err;
+        auto c = d.client(true);
+        ASSERT_NE(c, nullptr);
+        for (const auto& w : words)
+            if (end_code(*c, memory_write, write_params(w.address, w.value)) == 0) ++acknowledged;
+        // Cleared areas, and A: A448 cleared, A510 (Startup Time) retained.
+        const std::vector<std::uint16_t> marks(100, 0xA5A5);
+        for (const char* cleared : {"CIO0", "W0", "T0"})
+            ASSERT_TRUE(c->write_words(addr(cleared), marks).has_value()) << cleared;
+        ASSERT_TRUE(c->write_words(addr("A448"), std::vector<std::uint16_t>(10, 0x0448)));
+        ASSERT_TRUE(c->write_words(addr("A510"), std::vector<std::uint16_t>(11, 0x0510)));
+        const auto killed = d.stop(SIGKILL);  // no flush, no destructor
+        EXPECT_EQ(killed.exit_code, 128 + SIGKILL);
+    }
+    EXPECT_EQ(acknowledged, words.size());
+
+    Finsd d({"--profile", "cj2h", "--data-dir", data});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    auto c = d.client(true);
+    ASSERT_NE(c, nullptr);
+    std::size_t lost = 0;
+    const auto check_run = [&](const std::string& first, std::size_t from, std::size_t count) {
+        const auto got = words_of(*c, first, count);
+        ASSERT_EQ(got.size(), count) << first;
+        for (std::size_t i = 0; i < count; ++i)
+            if (got[i] != words[from + i].value) ++lost;
+    };
+    check_run("D0", 0, 2000);
+    check_run("H0", 2000, 500);
+    for (std::size_t i = 2500; i < 4500; ++i) {  // EM words are spread out: one by one
+        const auto got = words_of(*c, words[i].address, 1);
+        if (got.size() != 1 || got[0] != words[i].value) ++lost;
+    }
+    check_run("C0", 4500, 500);
+    std::cout << "[ sigkill ] acknowledged " << acknowledged << " writes, lost " << lost << "\n";
+    RecordProperty("acknowledged", static_cast<int>(acknowledged));
+    RecordProperty("lost", static_cast<int>(lost));
+    EXPECT_EQ(lost, 0u);
+
+    for (const char* cleared : {"CIO0", "W0", "T0"})
+        EXPECT_EQ(words_of(*c, cleared, 100), std::vector<std::uint16_t>(100, 0)) << cleared;
+    EXPECT_EQ(words_of(*c, "A448", 10), std::vector<std::uint16_t>(10, 0));
+    EXPECT_EQ(words_of(*c, "A510", 11), std::vector<std::uint16_t>(11, 0x0510));
+}
+
+// SIGKILL while 32 writes are in flight: every write acknowledged before the kill is
+// in the state file afterwards.
+TEST(Sigkill, KillWithWritesInFlightLosesNoAcknowledgedWrite) {
+    ScratchDir dir("sigkill");
+    const std::string data = (dir.path() / "data").string();
+    constexpr std::size_t total = 4000;
+    constexpr std::size_t kill_after = 2500;
+    constexpr std::size_t window = 32;
+    std::vector<std::vector<std::uint8_t>> params;
+    for (std::size_t i = 0; i < total; ++i)
+        params.push_back(write_params(fmt::format("D{}", 10000 + i), value_of(i)));
+    std::vector<bool> acked(total, false);
+    std::size_t acknowledged = 0;
+    {
+        Finsd d({"--profile", "cs1h", "--data-dir", data});
+        ASSERT_TRUE(d.started()) << d.result().err;
+        auto c = d.client(true);
+        ASSERT_NE(c, nullptr);
+        std::size_t next = 0;
+        bool killed = false;
+        std::function<void()> send_next = [&] {
+            if (killed || next >= total) return;
+            const std::size_t i = next++;
+            c->async_send_raw(memory_write, params[i], [&, i](Result<RawResponse> r) {
+                if (r && r->code.ok()) {
+                    acked[i] = true;
+                    if (++acknowledged == kill_after) {
+                        ::kill(d.pid(), SIGKILL);
+                        killed = true;
+                    }
+                }
+                send_next();
+            });
+        };
+        for (std::size_t k = 0; k < window; ++k)
+            send_next();
+        c->run();
+        EXPECT_TRUE(killed);
+        d.stop(SIGKILL);  // reap
+    }
+    EXPECT_GE(acknowledged, kill_after);
+
+    Finsd d({"--profile", "cs1h", "--data-dir", data});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    auto c = d.client(true);
+    ASSERT_NE(c, nullptr);
+    const auto got = words_of(*c, "D10000", total);
+    ASSERT_EQ(got.size(), total);
+    std::size_t lost = 0;
+    for (std::size_t i = 0; i < total; ++i)
+        if (acked[i] && got[i] != value_of(i)) ++lost;
+    std::cout << "[ sigkill ] in flight: acknowledged " << acknowledged << " writes, lost " << lost
+              << "\n";
+    EXPECT_EQ(lost, 0u);
+}
+
+}  // namespace
+}  // namespace fins::test

@@ -1,0 +1,207 @@
+// Conformance oracle for 02 01 .. 02 03 and 03 06 .. 03 08: Wireshark's FINS dissector
+// decodes what our client and server exchange on loopback, flags nothing as malformed
+// (no expert warning or error) and reads back the parameter area codes, words, counts,
+// program numbers, addresses and clear codes we meant. 02 40 is a Loop Control Board
+// command the dissector does not know, so it is not sent here.
+//
+// Needs tshark and permission to capture on `lo`; without them the test is skipped.
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <asio/io_context.hpp>
+#include <asio/post.hpp>
+
+#include "fins/client.hpp"
+#include "fins/commands/parameter_area.hpp"
+#include "fins/commands/program_area.hpp"
+#include "plc/plc.hpp"
+#include "process.hpp"
+#include "server/server.hpp"
+
+namespace fins::test {
+namespace {
+
+constexpr const char* tshark = "/usr/bin/tshark";
+constexpr long severity_warning = 0x00600000;  // epan/proto.h PI_WARN
+
+// finsd in this process, in PROGRAM mode (03 07 and 03 08 refuse RUN).
+class ProgramModeServer {
+  public:
+    ProgramModeServer() {
+        plc_.set_mode(plc::OperatingMode::program);
+        server::ServerOptions options;
+        options.port = 0;
+        auto s = server::Server::start(io_, plc_, options);
+        if (!s) throw std::runtime_error("server start: " + s.error().message());
+        server_ = std::move(*s);
+        port_ = server_->tcp_port() != 0 ? server_->tcp_port() : server_->udp_port();
+        thread_ = std::thread([this] { io_.run(); });
+    }
+    ~ProgramModeServer() {
+        asio::post(io_, [this] {
+            server_->stop();
+            io_.stop();
+        });
+        thread_.join();
+    }
+    [[nodiscard]] std::uint16_t port() const { return port_; }
+    std::unique_ptr<Client> client(bool tcp) {
+        ClientOptions o;
+        o.port = port_;
+        o.protocol = tcp ? ClientOptions::Protocol::tcp : ClientOptions::Protocol::udp;
+        auto c = Client::connect(o);
+        return c ? std::move(*c) : nullptr;
+    }
+
+  private:
+    asio::io_context io_{1};
+    plc::Plc plc_;
+    std::unique_ptr<server::Server> server_;
+    std::uint16_t port_ = 0;
+    std::thread thread_;
+};
+
+std::vector<std::string> split(const std::string& s, char sep) {
+    std::vector<std::string> out(1);
+    for (char c : s) {
+        if (c == sep)
+            out.emplace_back();
+        else
+            out.back() += c;
+    }
+    return out;
+}
+
+const std::vector<std::string> fields = {
+    "omron.command",        "omron.parameter_area_code", "omron.word",      "omron.numwords",
+    "omron.program_number", "omron.word.begin",          "omron.clearcode", "omron.response.code",
+    "_ws.malformed",        "_ws.expert.severity"};
+
+RunResult decode(const std::string& capture, const std::string& port) {
+    std::vector<std::string> argv{tshark,
+                                  "-r",
+                                  capture,
+                                  "-d",
+                                  "udp.port==" + port + ",omron",
+                                  "-d",
+                                  "tcp.port==" + port + ",omron",
+                                  "-Y",
+                                  "omron",
+                                  "-T",
+                                  "fields",
+                                  "-E",
+                                  "separator=|"};
+    for (const auto& f : fields) {
+        argv.push_back("-e");
+        argv.push_back(f);
+    }
+    return run(argv);
+}
+
+std::vector<std::vector<std::string>> parse_rows(const std::string& out) {
+    std::vector<std::vector<std::string>> rows;
+    std::istringstream lines(out);
+    for (std::string line; std::getline(lines, line);) {
+        auto f = split(line, '|');
+        if (f.size() == fields.size())
+            rows.push_back(f);
+        else
+            ADD_FAILURE() << "unexpected tshark line: " << line;
+    }
+    return rows;
+}
+
+TEST(TsharkPlcData, DissectorReadsParameterAndProgramAreaTrafficWithoutComplaint) {
+    if (!std::filesystem::exists(tshark)) GTEST_SKIP() << "tshark is not installed";
+    ProgramModeServer server;
+    const auto dir = std::filesystem::temp_directory_path() /
+                     ("fins-tshark-plc-data-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    const auto capture = (dir / "capture.pcapng").string();
+    const std::string port = std::to_string(server.port());
+    Child dump({tshark, "-i", "lo", "-f", "port " + port, "-w", capture});
+    if (!dump.wait_for_stderr("Capture started"))
+        GTEST_SKIP() << "cannot capture on lo (needs root or the wireshark group)";
+
+    const std::vector<std::uint8_t> two_words{0x0A, 0x0B, 0x0C, 0x0D};
+    const std::vector<std::uint8_t> program(8, 0x5A);
+    for (bool tcp : {false, true}) {
+        auto c = server.client(tcp);
+        ASSERT_NE(c, nullptr);
+        ASSERT_TRUE(c->send(ParameterAreaWrite{0x8013, 0x01FE, 2, true, two_words}));
+        ASSERT_TRUE(c->send(ParameterAreaRead{0x8013, 0x01FE, 2, false}));
+        ASSERT_TRUE(c->send(ParameterAreaRead{0x8010, 0x0000, 498, false}));
+        EXPECT_FALSE(c->send(ParameterAreaRead{0x8011, 0x0000, 1, false}));  // 1101
+        ASSERT_TRUE(c->send(ParameterAreaClear{0x8013, 0, 512, false, 0}));
+        ASSERT_TRUE(c->send(ProgramAreaWrite{0xFFFF, 0x100, 8, true, program}));
+        ASSERT_TRUE(c->send(ProgramAreaRead{0xFFFF, 0x100, 8, false}));
+        ASSERT_TRUE(c->send(ProgramAreaClear{0xFFFF, clear_with_interrupt_tasks}));
+    }
+    // Read the growing capture (bounded) until the last exchange (03 08 over both
+    // transports: 4 frames) is in it, then stop the capture.
+    RunResult decoded;
+    std::vector<std::vector<std::string>> rows;
+    for (int attempt = 0; attempt < 60; ++attempt) {
+        decoded = decode(capture, port);
+        rows = parse_rows(decoded.out);
+        int clears = 0;
+        for (const auto& r : rows)
+            clears += r[0] == "0x0308" ? 1 : 0;
+        if (clears == 4) break;
+    }
+    dump.terminate(SIGINT);
+    dump.wait();
+    ASSERT_EQ(decoded.exit_code, 0) << decoded.err;
+    SCOPED_TRACE("tshark fields:\n" + decoded.out + decoded.err);
+    std::map<std::string, int> commands;
+    std::map<std::string, int> seen;  // "command|area|word|numwords|program|begin|clear"
+    std::map<std::string, int> end_codes;
+    int malformed_error_answers = 0;
+    for (const auto& r : rows) {
+        if (r[0].empty()) continue;  // FINS/TCP handshake frames
+        // The 4.0 dissector reads a 02 01 response's echo fields without checking that an
+        // error answer carries only the end code (as every FINS unit sends it), so the
+        // 1101 answers alone come out "malformed"; everything else must decode cleanly.
+        if (r[0] == "0x0201" && r[1].empty()) {
+            ++malformed_error_answers;
+            continue;
+        }
+        EXPECT_TRUE(r[8].empty()) << "malformed: " << r[0];
+        for (const auto& s : split(r[9], ',')) {
+            if (!s.empty()) {
+                EXPECT_LT(std::stol(s), severity_warning) << r[0];
+            }
+        }
+        ++commands[r[0]];
+        ++seen[r[0] + "|" + r[1] + "|" + r[2] + "|" + r[3] + "|" + r[4] + "|" + r[5] + "|" + r[6]];
+        if (!r[7].empty()) ++end_codes[r[0] + " " + r[7]];
+    }
+    EXPECT_EQ(malformed_error_answers, 2);
+    for (const char* c : {"0x0202", "0x0203", "0x0306", "0x0307", "0x0308"})
+        EXPECT_EQ(commands[c], 2 * 2) << c;
+    EXPECT_EQ(commands["0x0201"], 2 * 2 * 3 - 2);
+    // Field by field; the read answers echo area/word or program/address with the count
+    // (bit 15 on the routing tables' last word), the write answer of 03 07 its command.
+    EXPECT_EQ((seen["0x0202|0x8013|0x01fe|0x8002|||"]), 2);
+    EXPECT_EQ((seen["0x0201|0x8013|0x01fe|0x0002|||"]), 2);
+    EXPECT_EQ((seen["0x0201|0x8013|0x01fe|0x8002|||"]), 2);
+    EXPECT_EQ((seen["0x0201|0x8010|0x0000|0x01f2|||"]), 2 * 2);
+    EXPECT_EQ((seen["0x0201|0x8011|0x0000|0x0001|||"]), 2);
+    EXPECT_EQ((seen["0x0203|0x8013|0x0000|0x0200|||"]), 2);
+    EXPECT_EQ((seen["0x0306|||0x0008|0xffff|0x00000100|"]), 2 * 2);
+    EXPECT_EQ((seen["0x0307|||0x8008|0xffff|0x00000100|"]), 2 * 2);
+    EXPECT_EQ((seen["0x0308||||0xffff||0x10"]), 2);
+    for (const char* c : {"0x0202", "0x0203", "0x0306", "0x0307", "0x0308"})
+        EXPECT_EQ(end_codes[std::string(c) + " 0x0000"], 2) << c;
+    EXPECT_EQ(end_codes["0x0201 0x0000"], 2 * 2);
+    std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace fins::test

@@ -1,0 +1,273 @@
+// plc::Storage: heap mode, and the state file of a data directory (restore after a
+// reopen, refusal of foreign, damaged or mismatching files, the lock, restarting an
+// unfinished creation).
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "plc/storage.hpp"
+
+namespace fins::plc::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr auto R = Retention::retained;
+constexpr auto C = Retention::cleared;
+
+// Header offsets of the state file (storage.cpp): magic 0, version 8, complete 12,
+// profile 16, file_size 80, count 88, entries from 96 (64 bytes: name 40, offset, size).
+constexpr std::streamoff version_at = 8;
+constexpr std::streamoff first_entry_offset_at = 96 + 40;
+
+class StorageFile : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        static std::atomic<int> n{0};
+        dir_ = fs::temp_directory_path() /
+               ("finskit-storage-" + std::to_string(::getpid()) + "-" + std::to_string(n++));
+        fs::remove_all(dir_);
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+    [[nodiscard]] fs::path state() const { return dir_ / "finsd.state"; }
+
+    // Creates a sealed state file with a retained "a" (100 words) and "b" (10 words).
+    void create(std::string_view profile = "p1") {
+        auto s = Storage::open(dir_, profile);
+        ASSERT_TRUE(s) << s.error().message();
+        auto a = (*s)->array<std::uint16_t>("a", 100, R);
+        auto b = (*s)->array<std::uint16_t>("b", 10, R);
+        ASSERT_EQ(a.size(), 100u);
+        a[99] = 0xA099;
+        b[0] = 0xB000;
+        ASSERT_TRUE((*s)->seal());
+    }
+    void poke(std::streamoff at, const void* bytes, std::size_t n) {
+        std::fstream f(state(), std::ios::in | std::ios::out | std::ios::binary);
+        f.seekp(at);
+        f.write(static_cast<const char*>(bytes), static_cast<std::streamsize>(n));
+    }
+    static std::string message(const Result<std::unique_ptr<Storage>>& r) {
+        return r ? std::string("opened") : r.error().message();
+    }
+
+    fs::path dir_;
+};
+
+TEST(Storage, HeapModeIsZeroedAndNeverRestored) {
+    Storage s;
+    auto a = s.array<std::uint16_t>("a", 1000, R);
+    auto b = s.array<std::uint32_t>("b", 3, C);
+    auto& o = s.object<std::uint64_t>("o", R);
+    ASSERT_EQ(a.size(), 1000u);
+    ASSERT_EQ(b.size(), 3u);
+    for (auto w : a)
+        EXPECT_EQ(w, 0);
+    EXPECT_EQ(o, 0u);
+    a[999] = 7;
+    b[2] = 9;
+    EXPECT_NE(static_cast<void*>(a.data()), static_cast<void*>(b.data()));
+    EXPECT_TRUE(s.seal());
+    EXPECT_FALSE(s.restored());
+    EXPECT_TRUE(s.path().empty());
+    s.flush();
+    EXPECT_TRUE(s.array<std::uint16_t>("empty", 0, R).empty());
+}
+
+TEST_F(StorageFile, RetainedSectionsAreRestoredClearedOnesAreNot) {
+    {
+        auto s = Storage::open(dir_, "cj2h");
+        ASSERT_TRUE(s) << s.error().message();
+        EXPECT_FALSE((*s)->restored());
+        EXPECT_EQ((*s)->path(), state());
+        auto kept = (*s)->array<std::uint16_t>("kept", 40000, R);
+        auto gone = (*s)->array<std::uint16_t>("gone", 100, C);
+        auto& obj = (*s)->object<std::uint64_t>("obj", R);
+        kept[0] = 1;
+        kept[39999] = 0xBEEF;
+        gone[5] = 5;
+        obj = 0x0102030405060708;
+        ASSERT_TRUE((*s)->seal());
+        // Never flushed: a write to the shared mapping is in the file once made.
+    }
+    auto s = Storage::open(dir_, "cj2h");
+    ASSERT_TRUE(s) << s.error().message();
+    EXPECT_TRUE((*s)->restored());
+    auto kept = (*s)->array<std::uint16_t>("kept", 40000, R);
+    auto gone = (*s)->array<std::uint16_t>("gone", 100, C);
+    auto& obj = (*s)->object<std::uint64_t>("obj", R);
+    ASSERT_TRUE((*s)->seal());
+    EXPECT_EQ(kept[0], 1);
+    EXPECT_EQ(kept[39999], 0xBEEF);
+    EXPECT_EQ(gone[5], 0);
+    EXPECT_EQ(obj, 0x0102030405060708u);
+    // Cleared sections take no room in the file: header page + 80,000 bytes + 8 bytes.
+    EXPECT_EQ(fs::file_size(state()), 4096u + 81920u + 4096u);
+}
+
+TEST_F(StorageFile, ForeignProfileIsRefused) {
+    create("cj2h");
+    const auto r = Storage::open(dir_, "cs1h");
+    ASSERT_FALSE(r);
+    EXPECT_EQ(std::string(r.error().category().name()), "fins.storage");
+    EXPECT_NE(message(r).find("another PLC profile"), std::string::npos) << message(r);
+    EXPECT_TRUE(Storage::open(dir_, "cj2h"));  // untouched
+}
+
+TEST_F(StorageFile, TruncatedHeaderIsRefused) {
+    create();
+    fs::resize_file(state(), 100);
+    const auto r = Storage::open(dir_, "p1");
+    EXPECT_NE(message(r).find("not a finsd state file"), std::string::npos) << message(r);
+    EXPECT_EQ(fs::file_size(state()), 100u);  // never replaced
+}
+
+TEST_F(StorageFile, ForeignFileIsRefused) {
+    fs::create_directories(dir_);
+    {
+        std::ofstream f(state(), std::ios::binary);
+        const std::string junk(8192, 'x');
+        f << junk;
+    }
+    EXPECT_NE(message(Storage::open(dir_, "p1")).find("not a finsd state file"), std::string::npos);
+    EXPECT_EQ(fs::file_size(state()), 8192u);
+}
+
+TEST_F(StorageFile, CorruptedMagicVersionOrSectionTableIsRefused) {
+    create();
+    poke(0, "XINSKIT", 7);
+    EXPECT_NE(message(Storage::open(dir_, "p1")).find("not a finsd state file"), std::string::npos);
+    poke(0, "FINSKIT", 7);
+    ASSERT_TRUE(Storage::open(dir_, "p1"));
+
+    const std::uint32_t v = 99;
+    poke(version_at, &v, sizeof v);
+    EXPECT_NE(message(Storage::open(dir_, "p1")).find("unsupported"), std::string::npos);
+    const std::uint32_t one = 1;
+    poke(version_at, &one, sizeof one);
+    ASSERT_TRUE(Storage::open(dir_, "p1"));
+
+    const std::uint64_t bad_offset = 4096 * 3;
+    poke(first_entry_offset_at, &bad_offset, sizeof bad_offset);
+    EXPECT_NE(message(Storage::open(dir_, "p1")).find("damaged"), std::string::npos);
+    const std::uint64_t huge = ~std::uint64_t{0};
+    const std::uint64_t page = 4096;
+    poke(first_entry_offset_at, &page, sizeof page);
+    poke(first_entry_offset_at + 8, &huge, sizeof huge);  // size that would wrap
+    EXPECT_NE(message(Storage::open(dir_, "p1")).find("damaged"), std::string::npos);
+}
+
+TEST_F(StorageFile, TruncatedSectionsAreRefused) {
+    create();
+    fs::resize_file(state(), fs::file_size(state()) - 4096);
+    EXPECT_NE(message(Storage::open(dir_, "p1")).find("damaged"), std::string::npos);
+    fs::resize_file(state(), fs::file_size(state()) + 3 * 4096);
+    EXPECT_NE(message(Storage::open(dir_, "p1")).find("damaged"), std::string::npos);
+}
+
+TEST_F(StorageFile, LayoutMismatchIsReportedBySealAndLeavesTheFileAlone) {
+    create();
+    {  // a section of another size
+        auto s = Storage::open(dir_, "p1");
+        ASSERT_TRUE(s);
+        (*s)->array<std::uint16_t>("a", 101, R);
+        (*s)->array<std::uint16_t>("b", 10, R);
+        const auto sealed = (*s)->seal();
+        ASSERT_FALSE(sealed);
+        EXPECT_NE(sealed.error().message().find("memory layout"), std::string::npos);
+    }
+    {  // a section missing
+        auto s = Storage::open(dir_, "p1");
+        ASSERT_TRUE(s);
+        (*s)->array<std::uint16_t>("a", 100, R);
+        EXPECT_FALSE((*s)->seal());
+    }
+    {  // an extra section
+        auto s = Storage::open(dir_, "p1");
+        ASSERT_TRUE(s);
+        (*s)->array<std::uint16_t>("a", 100, R);
+        (*s)->array<std::uint16_t>("b", 10, R);
+        (*s)->array<std::uint16_t>("c", 10, R);
+        EXPECT_FALSE((*s)->seal());
+    }
+    {  // the same name twice
+        auto s = Storage::open(dir_, "p1");
+        ASSERT_TRUE(s);
+        (*s)->array<std::uint16_t>("a", 100, R);
+        (*s)->array<std::uint16_t>("a", 100, R);
+        EXPECT_FALSE((*s)->seal());
+    }
+    auto s = Storage::open(dir_, "p1");
+    ASSERT_TRUE(s);
+    auto a = (*s)->array<std::uint16_t>("a", 100, R);
+    auto b = (*s)->array<std::uint16_t>("b", 10, R);
+    ASSERT_TRUE((*s)->seal());
+    EXPECT_EQ(a[99], 0xA099);
+    EXPECT_EQ(b[0], 0xB000);
+}
+
+TEST_F(StorageFile, SecondOpenWhileInUseIsRefused) {
+    auto first = Storage::open(dir_, "p1");
+    ASSERT_TRUE(first);
+    const auto second = Storage::open(dir_, "p1");
+    ASSERT_FALSE(second);
+    EXPECT_NE(message(second).find("in use"), std::string::npos) << message(second);
+    first->reset();
+    EXPECT_TRUE(Storage::open(dir_, "p1"));
+}
+
+TEST_F(StorageFile, UnfinishedCreationStartsOver) {
+    {
+        auto s = Storage::open(dir_, "p1");
+        ASSERT_TRUE(s);
+        auto a = (*s)->array<std::uint16_t>("a", 100, R);
+        a[0] = 42;
+        // No seal(): as if the process died while the models were taking sections.
+    }
+    auto s = Storage::open(dir_, "other");  // the unfinished file binds nothing
+    ASSERT_TRUE(s) << message(s);
+    EXPECT_FALSE((*s)->restored());
+    auto x = (*s)->array<std::uint16_t>("x", 5, R);
+    ASSERT_TRUE((*s)->seal());
+    EXPECT_EQ(x[0], 0);
+    EXPECT_EQ(fs::file_size(state()), 2u * 4096u);
+}
+
+TEST_F(StorageFile, DuplicateSectionOnCreationFailsSeal) {
+    auto s = Storage::open(dir_, "p1");
+    ASSERT_TRUE(s);
+    auto a = (*s)->array<std::uint16_t>("a", 4, R);
+    auto again = (*s)->array<std::uint16_t>("a", 4, R);
+    EXPECT_NE(static_cast<void*>(a.data()), static_cast<void*>(again.data()));
+    const auto sealed = (*s)->seal();
+    ASSERT_FALSE(sealed);
+    EXPECT_NE(sealed.error().message().find("same name"), std::string::npos);
+}
+
+TEST_F(StorageFile, OverlongProfileIdIsRefused) {
+    EXPECT_FALSE(Storage::open(dir_, std::string(64, 'p')));
+    EXPECT_TRUE(Storage::open(dir_, std::string(63, 'p')));
+}
+
+TEST_F(StorageFile, FlushAndReopenManyTimes) {
+    for (int round = 0; round < 5; ++round) {
+        auto s = Storage::open(dir_, "p1");
+        ASSERT_TRUE(s);
+        auto& counter = (*s)->object<std::uint32_t>("counter", R);
+        ASSERT_TRUE((*s)->seal());
+        EXPECT_EQ(counter, static_cast<std::uint32_t>(round));
+        ++counter;
+        (*s)->flush();
+    }
+}
+
+}  // namespace
+}  // namespace fins::plc::test
