@@ -12,15 +12,14 @@
 //   index_register / data_register      IR0-15 (32-bit) / DR0-15
 //   clock_pulse, condition_flag,        derived or constant, read-only
 //   access_error_flag
-// Retention (W342 / CS/CJ operation manuals "status at power ON"; docs/profiles.md):
-// every region lives in a plc::Storage section. Retained (battery-backed, kept across
-// restarts when finsd has a data directory): H, D, every EM bank, counter PVs and
-// counter completion flags, and the Auxiliary Area words of retained_auxiliary_words().
-// Cleared at every start: CIO, W, timer PVs and completion flags, the rest of A, task
-// flags, IR/DR, the current EM bank number, every forced-bit mask ("Forced Status
-// Hold at Startup" left at its default, OFF). A region that is only partly retained
-// (A, T/C PVs and flags) is one retained section whose cleared words the constructor
-// zeroes, so the request path writes straight into the section either way.
+// Retention (W342 / CS/CJ operation manuals "status at power ON"; README (profiles and
+// configuration)): every region lives in a plc::Storage section. Retained (battery-backed, kept
+// across restarts when finsd has a data directory): H, D, every EM bank, counter PVs and counter
+// completion flags, and the Auxiliary Area words of retained_auxiliary_words(). Cleared at every
+// start: CIO, W, timer PVs and completion flags, the rest of A, task flags, IR/DR, the current EM
+// bank number, every forced-bit mask ("Forced Status Hold at Startup" left at its default, OFF). A
+// region that is only partly retained (A, T/C PVs and flags) is one retained section whose cleared
+// words the constructor zeroes, so the request path writes straight into the section either way.
 //
 // CIO, W, H and the T/C completion flags also carry a forced-bit mask. A forced bit's
 // stored value is its forced value; FINS writes, fills and transfers leave forced

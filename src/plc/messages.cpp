@@ -19,12 +19,12 @@ bool Messages::set(std::size_t number, std::string_view text) noexcept {
 
 void Messages::clear(std::uint8_t mask) noexcept {
     for (std::size_t n = 0; n < count; ++n)
-        if ((mask >> n) & 1U) state_.sizes[n] = 0;
+        if ((static_cast<unsigned>(mask) >> n) & 1U) state_.sizes[n] = 0;
     state_.present = static_cast<std::uint8_t>(state_.present & ~mask);
 }
 
 bool Messages::registered(std::size_t number) const noexcept {
-    return number < count && ((state_.present >> number) & 1U) != 0;
+    return number < count && ((static_cast<unsigned>(state_.present) >> number) & 1U) != 0;
 }
 
 std::string_view Messages::text(std::size_t number) const noexcept {

@@ -1,5 +1,5 @@
 // The profile registry. Figures are Omron catalogue figures as recalled for each model
-// (docs/profiles.md says which are choices rather than catalogue data).
+// (README (profiles and configuration) says which are choices rather than catalogue data).
 #include "plc/profile.hpp"
 
 #include <array>

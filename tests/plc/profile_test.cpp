@@ -1,5 +1,5 @@
 // The profile registry: every model's sizes, the area codes it accepts and the
-// commands it answers (docs/profiles.md is the table these tests pin).
+// commands it answers (README (profiles and configuration) is the table these tests pin).
 #include <set>
 #include <string>
 

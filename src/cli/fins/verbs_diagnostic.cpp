@@ -91,7 +91,7 @@ std::string trim(std::string s) {
 Json bit_names(std::uint16_t word, const std::array<const char*, 16>& names, std::string& text) {
     Json list = Json::array();
     for (unsigned bit = 16; bit-- > 0;) {
-        if (((word >> bit) & 1U) == 0) continue;
+        if (((static_cast<unsigned>(word) >> bit) & 1U) == 0) continue;
         const std::string name = names[bit] ? names[bit] : fmt::format("bit {}", bit);
         list.push_back(name);
         text += (text.empty() ? "" : ", ") + name;
@@ -171,7 +171,7 @@ int run_status(const GlobalOptions& g, Output& out) {
     Json messages = Json::array();
     std::string message_text;
     for (unsigned n = 0; n < msg_count; ++n)
-        if ((s->messages >> n) & 1U) {
+        if ((static_cast<unsigned>(s->messages) >> n) & 1U) {
             messages.push_back(n);
             message_text += fmt::format("{}MSG {}", message_text.empty() ? "" : ", ", n);
         }
@@ -227,7 +227,7 @@ int run_messages(const GlobalOptions& g, Output& out, const DiagnosticArgs& a) {
     std::string text;
     std::size_t i = 0;
     for (unsigned n = 0; n < msg_count; ++n) {
-        if (((r->messages >> n) & 1U) == 0 || i >= r->texts.size()) continue;
+        if (((static_cast<unsigned>(r->messages) >> n) & 1U) == 0 || i >= r->texts.size()) continue;
         const std::string t = trim(r->texts[i++]);
         list.push_back({{"number", n}, {"text", t}});
         text += t.empty() ? fmt::format("MSG {}\n", n) : fmt::format("MSG {}  {}\n", n, t);

@@ -1,4 +1,5 @@
-// finsd: a virtual Omron CPU Unit (docs/profiles.md) answering FINS over UDP and TCP.
+// finsd: a virtual Omron CPU Unit answering FINS over UDP and TCP (README: profiles and
+// configuration).
 //
 //   finsd [--config FILE] [flags]   serve; flags override the file (config.hpp)
 //   finsd ctl ...                   the control channel's client (ctl.hpp)
@@ -67,7 +68,7 @@ int configure(int argc, char** argv, Settings& settings) {
     unsigned node = 0, network = 0;
     std::size_t max_connections = 0;
     bool udp = true, tcp = true, um_read = false, dip_write = false, list = false;
-    app.add_option("--config", config, "TOML configuration file (docs/profiles.md)");
+    app.add_option("--config", config, "TOML configuration file (keys: see README)");
     auto* o_profile = app.add_option("--profile", profile, "PLC profile (--list-profiles)");
     app.add_flag("--list-profiles", list, "Print the known profiles and exit");
     auto* o_mode =
