@@ -42,7 +42,7 @@ for target in fuzz_frame fuzz_tcp fuzz_address fuzz_dispatch; do
   if "$root/build-fuzz/bin/$target" -max_total_time="$fuzz_seconds" -print_final_stats=0 \
       "$corpus" >"$corpus.log" 2>&1; then
     fuzz_ok=$((fuzz_ok + 1))
-    echo "$target: $(grep -Eo '#[0-9]+ +DONE.*' "$corpus.log" | tail -n 1)"
+    echo "$target: $(grep -Eo 'Done [0-9]+ runs in [0-9]+ second' "$corpus.log" | tail -n 1)s"
   else
     echo "$target FAILED"; tail -n 40 "$corpus.log"; exit 1
   fi
