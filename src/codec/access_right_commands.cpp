@@ -1,13 +1,13 @@
 // 0C 01 .. 0C 03 access right commands (W342 5-3-24 .. 5-3-26, frames 6/0C01).
 // Each command is the 2-byte program number alone; its value is the handler's to check.
+#include "codec/command_codec.hpp"
 #include "fins/commands/access_right.hpp"
 
 namespace fins {
-namespace {
 
-Unexpected malformed() {
-    return Unexpected(make_error_code(ClientError::malformed_response));
-}
+using codec::malformed;
+
+namespace {
 
 // The program number, or 1002 / 1001 for a block that is not exactly 2 bytes.
 Result<std::uint16_t> read_program_number(Bytes parameters) noexcept {

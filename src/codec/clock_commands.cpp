@@ -1,23 +1,21 @@
 // CLOCK READ 07 01 and CLOCK WRITE 07 02 (W342 5-3-19, 5-3-20; frames 5.3, 6/0701,
 // 6/0702).
+#include "codec/command_codec.hpp"
 #include "fins/commands/clock.hpp"
 
 #include <array>
 
 namespace fins {
+
+using codec::end_code;
+using codec::malformed;
+
 namespace {
 
 constexpr std::size_t clock_read_size = 7;  // 6 BCD fields + day of week
 constexpr std::size_t clock_write_min = 5;  // year .. minute
 constexpr std::size_t clock_write_max = 7;  // + second + day of week
 constexpr std::uint8_t not_bcd = 0xFF;
-
-Unexpected end_code(EndCode e) {
-    return Unexpected(make_error_code(e));
-}
-Unexpected malformed() {
-    return Unexpected(make_error_code(ClientError::malformed_response));
-}
 
 std::uint8_t bcd_or_invalid(std::uint8_t value) noexcept {
     return value <= 99 ? to_bcd(value) : not_bcd;

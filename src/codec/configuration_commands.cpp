@@ -1,8 +1,13 @@
 // CPU UNIT DATA READ 05 01 and CONNECTION DATA READ 05 02 (W342 5-3-15, 5-3-16;
 // frames 6/0501, 6/0502).
+#include "codec/command_codec.hpp"
 #include "fins/commands/configuration.hpp"
 
 namespace fins {
+
+using codec::end_code;
+using codec::malformed;
+
 namespace {
 
 // libfins' 05 01 layout has a 1-byte remote I/O field (frames 10, item 1).
@@ -11,13 +16,6 @@ constexpr std::size_t connection_entry_size = 1 + connection_model_size;
 constexpr std::size_t system_use_reserved = cpu_system_use_size - 2;
 constexpr std::size_t bus_unit_reserved = cpu_bus_unit_block_size - 2 * cpu_bus_unit_slots;
 constexpr std::uint8_t racks_mask = 0x0F;  // CPU information bits 0-3
-
-Unexpected end_code(EndCode e) {
-    return Unexpected(make_error_code(e));
-}
-Unexpected malformed() {
-    return Unexpected(make_error_code(ClientError::malformed_response));
-}
 
 void zeros(ByteWriter& w, std::size_t n) noexcept {
     w.text({}, n, 0x00);

@@ -6,9 +6,14 @@
 // echo mismatch is malformed_response.
 #include <bit>
 
+#include "codec/command_codec.hpp"
 #include "fins/commands/diagnostics.hpp"
 
 namespace fins {
+
+using codec::end_code;
+using codec::malformed;
+
 namespace {
 
 constexpr std::uint16_t variant_mask = 0xC000;
@@ -16,13 +21,6 @@ constexpr std::uint16_t reserved_msg_bits = 0x3F00;  // bits 13-8 of read / clea
 constexpr std::uint16_t variant_read = 0x0000;
 constexpr std::uint16_t variant_clear = message_clear_bit;
 constexpr std::uint16_t variant_fal = fal_read_bit;
-
-Unexpected end_code(EndCode e) {
-    return Unexpected(make_error_code(e));
-}
-Unexpected malformed() {
-    return Unexpected(make_error_code(ClientError::malformed_response));
-}
 
 // The one parameter word of 09 20, or 1002/1001.
 Result<std::uint16_t> parameter_word(Bytes parameters) noexcept {

@@ -1,26 +1,19 @@
 // 21 01 .. 21 41: ERROR CLEAR, ERROR LOG READ/CLEAR, FINS WRITE ACCESS LOG READ/CLEAR
 // (W342 5-3-27 .. 5-3-31, frames 6/2101 .. 6/2141; record layout seed 003 p.208).
+#include "codec/command_codec.hpp"
 #include "fins/commands/error_log.hpp"
 
 #include <array>
 
 namespace fins {
+
+using codec::check_fixed;
+using codec::end_code;
+using codec::malformed;
+
 namespace {
 
 constexpr std::size_t read_size = 4;  // beginning record, number of records
-
-Unexpected end_code(EndCode e) {
-    return Unexpected(make_error_code(e));
-}
-Unexpected malformed() {
-    return Unexpected(make_error_code(ClientError::malformed_response));
-}
-
-std::error_code check_fixed(Bytes parameters, std::size_t size) noexcept {
-    if (parameters.size() < size) return make_error_code(EndCode::command_too_short);
-    if (parameters.size() > size) return make_error_code(EndCode::command_too_long);
-    return {};
-}
 
 Result<EmptyResponse> expect_empty(Bytes data) {
     if (!data.empty()) return malformed();

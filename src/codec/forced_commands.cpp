@@ -1,18 +1,12 @@
 // 23 01 FORCED SET/RESET and 23 02 FORCED SET/RESET CANCEL (W342 5-3-44, 5-3-45,
 // frames 6/2301).
+#include "codec/command_codec.hpp"
 #include "fins/commands/forced.hpp"
 
 namespace fins {
-namespace {
 
-Unexpected end_code(EndCode e) {
-    return Unexpected(make_error_code(e));
-}
-Unexpected malformed() {
-    return Unexpected(make_error_code(ClientError::malformed_response));
-}
-
-}  // namespace
+using codec::end_code;
+using codec::malformed;
 
 bool is_force_action(std::uint16_t value) noexcept {
     switch (static_cast<ForceAction>(value)) {

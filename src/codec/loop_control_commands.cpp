@@ -3,23 +3,21 @@
 // Server side (decode): errors are the Loop Control Board's own response codes for the
 // command's shape (1001, 1002, 1003); block and ITEM checks belong to the handler.
 // Client side (decode_response): any length or order mismatch is malformed_response.
+#include "codec/command_codec.hpp"
 #include "fins/commands/loop_control.hpp"
 
 #include <utility>
 
 namespace fins {
+
+using codec::end_code;
+using codec::malformed;
+
 namespace {
 
 constexpr std::size_t fixed_size = 4;  // block address, number of ITEMs
 constexpr std::size_t max_parameters = max_loop_command_bytes - command_code_size;
 constexpr std::size_t min_parameters = min_loop_command_bytes - command_code_size;
-
-Unexpected end_code(EndCode e) {
-    return Unexpected(make_error_code(e));
-}
-Unexpected malformed() {
-    return Unexpected(make_error_code(ClientError::malformed_response));
-}
 
 }  // namespace
 

@@ -3,9 +3,15 @@
 // Server side (decode): errors are the end codes the CPU Unit answers, 1002 for a
 // command shorter than its fixed part and 1001 for one longer than it.
 // Client side (decode_response): any length or echo mismatch is malformed_response.
+#include "codec/command_codec.hpp"
 #include "fins/commands/memory_area.hpp"
 
 namespace fins {
+
+using codec::check_fixed;
+using codec::end_code;
+using codec::malformed;
+
 namespace {
 
 // Fixed parameter sizes (frames 6).
@@ -13,13 +19,6 @@ constexpr std::size_t read_size = memory_address_size + 2;          // address, 
 constexpr std::size_t write_fixed_size = memory_address_size + 2;   // then the data
 constexpr std::size_t fill_size = memory_address_size + 2 + 2;      // address, count, value
 constexpr std::size_t transfer_size = 2 * memory_address_size + 2;  // src, dst, count
-
-Unexpected end_code(EndCode e) {
-    return Unexpected(make_error_code(e));
-}
-Unexpected malformed() {
-    return Unexpected(make_error_code(ClientError::malformed_response));
-}
 
 void write_address(ByteWriter& w, const MemoryAddress& a) noexcept {
     w.u8(a.area_code);
@@ -36,11 +35,6 @@ MemoryAddress read_address(ByteReader& r) noexcept {
 }
 
 // Checks a parameter block against a fixed size before anything is read from it.
-std::error_code check_fixed(Bytes parameters, std::size_t size) noexcept {
-    if (parameters.size() < size) return make_error_code(EndCode::command_too_short);
-    if (parameters.size() > size) return make_error_code(EndCode::command_too_long);
-    return {};
-}
 
 Result<EmptyResponse> expect_empty(Bytes data) {
     if (!data.empty()) return malformed();

@@ -1,15 +1,15 @@
 // RUN 04 01 and STOP 04 02 (W342 5-3-13, 5-3-14; frames 6/0401, 6/0402).
+#include "codec/command_codec.hpp"
 #include "fins/commands/operating_mode.hpp"
 
 namespace fins {
+
+using codec::end_code;
+
 namespace {
 
 constexpr std::size_t program_number_size = 2;
 constexpr std::size_t run_max_size = program_number_size + 1;  // + mode byte
-
-Unexpected end_code(EndCode e) {
-    return Unexpected(make_error_code(e));
-}
 
 Result<EmptyResponse> expect_empty(Bytes data) {
     if (!data.empty()) return Unexpected(make_error_code(ClientError::malformed_response));

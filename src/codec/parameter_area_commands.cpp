@@ -4,11 +4,17 @@
 // Server side (decode): errors are the end codes the CPU Unit answers, 1002 for a
 // command shorter than its fixed part and 1001 for one longer than it.
 // Client side (decode_response): any length or echo mismatch is malformed_response.
+#include "codec/command_codec.hpp"
 #include "fins/commands/parameter_area.hpp"
 
 #include <charconv>
 
 namespace fins {
+
+using codec::check_fixed;
+using codec::end_code;
+using codec::malformed;
+
 namespace {
 
 // Parameter sizes (frames 6): area code, beginning word, number of words [, data].
@@ -25,19 +31,6 @@ constexpr ParameterAreaInfo areas[] = {
     {parameter_area_io_table, "io-table", "I/O table registration", 1280, 0x0400, true},
     {parameter_area_routing_tables, "routing", "routing tables", 512, 0x0900, false},
 };
-
-Unexpected end_code(EndCode e) {
-    return Unexpected(make_error_code(e));
-}
-Unexpected malformed() {
-    return Unexpected(make_error_code(ClientError::malformed_response));
-}
-
-std::error_code check_fixed(Bytes parameters, std::size_t size) noexcept {
-    if (parameters.size() < size) return make_error_code(EndCode::command_too_short);
-    if (parameters.size() > size) return make_error_code(EndCode::command_too_long);
-    return {};
-}
 
 std::uint16_t with_flag(std::uint16_t count, bool last) noexcept {
     return static_cast<std::uint16_t>((count & word_count_mask) | (last ? last_word_bit : 0));

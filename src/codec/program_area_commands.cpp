@@ -3,9 +3,15 @@
 // Server side (decode): errors are the end codes the CPU Unit answers, 1002 for a
 // command shorter than its fixed part and 1001 for one longer than it.
 // Client side (decode_response): any length or echo mismatch is malformed_response.
+#include "codec/command_codec.hpp"
 #include "fins/commands/program_area.hpp"
 
 namespace fins {
+
+using codec::check_fixed;
+using codec::end_code;
+using codec::malformed;
+
 namespace {
 
 // Parameter sizes (frames 6): program number (2), beginning address (4), bytes (2).
@@ -13,19 +19,6 @@ constexpr std::size_t read_size = 8;
 constexpr std::size_t write_fixed_size = 8;
 constexpr std::size_t clear_size = 3;  // program number (2), clear code (1)
 constexpr std::size_t echo_size = 8;   // response: program number, address, bytes
-
-Unexpected end_code(EndCode e) {
-    return Unexpected(make_error_code(e));
-}
-Unexpected malformed() {
-    return Unexpected(make_error_code(ClientError::malformed_response));
-}
-
-std::error_code check_fixed(Bytes parameters, std::size_t size) noexcept {
-    if (parameters.size() < size) return make_error_code(EndCode::command_too_short);
-    if (parameters.size() > size) return make_error_code(EndCode::command_too_long);
-    return {};
-}
 
 std::uint16_t with_flag(std::uint16_t count, bool last) noexcept {
     return static_cast<std::uint16_t>((count & program_count_mask) | (last ? program_last_bit : 0));

@@ -1,14 +1,14 @@
 // CYCLE TIME READ 06 20 (W342 5-3-18; frames 6/0620).
+#include "codec/command_codec.hpp"
 #include "fins/commands/status.hpp"
 
 namespace fins {
+
+using codec::end_code;
+
 namespace {
 
 constexpr std::size_t cycle_times_size = 3 * 4;  // average, maximum, minimum
-
-Unexpected end_code(EndCode e) {
-    return Unexpected(make_error_code(e));
-}
 
 }  // namespace
 
