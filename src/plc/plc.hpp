@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "fins/frame.hpp"
@@ -118,6 +119,10 @@ class Plc {
     // UM read protection set from a Peripheral Device.
     [[nodiscard]] bool um_read_protection() const noexcept { return um_read_protection_; }
     void set_um_read_protection(bool on) noexcept { um_read_protection_ = on; }
+    // The password a Programming Device gives to release UM read protection (set with
+    // the protection, W342 5-1-3 2602 "incorrect password"); empty = none.
+    [[nodiscard]] const std::string& um_password() const noexcept { return um_password_; }
+    void set_um_password(std::string password) { um_password_ = std::move(password); }
 
     // DIP switch pin 1 ON: UM write-protected.
     [[nodiscard]] bool dip_write_protection() const noexcept { return dip_write_protection_; }
@@ -138,6 +143,7 @@ class Plc {
     std::optional<NodeAddress> access_right_holder_;
     NetworkWriteProtectionSetting network_write_protection_;
     bool um_read_protection_ = false;
+    std::string um_password_;
     bool dip_write_protection_ = false;
 };
 

@@ -12,6 +12,7 @@
 //   {"cmd":"message","number":3,"text":"TEXT"}      registers MSG 3; no "text" (or
 //                                                   null) unregisters it
 //   {"cmd":"network_write_protection","on":true}    PLC Setup write protection (all nodes)
+//   {"cmd":"um_read_protection","on":false,"password":"..."}  UM read protection
 //   {"cmd":"mode","mode":"program"}                 program, monitor or run
 //   {"cmd":"release_access_right"}                  as 0C 03 from any node
 // Anything else answers {"error":"..."} and the connection stays open. A line longer
@@ -148,7 +149,8 @@ Json status(plc::Plc& plc) {
                 {"error_log_records", errors.log_size()},
                 {"write_access_log_records", plc.write_access_log().size()},
                 {"access_right_holder", holder},
-                {"network_write_protection", plc.network_write_protection()}};
+                {"network_write_protection", plc.network_write_protection()},
+                {"um_read_protection", plc.um_read_protection()}};
 }
 
 Json raise_fal(plc::Plc& plc, const Json& j, bool fals, plc::ErrorState::TimePoint now) {
@@ -206,6 +208,19 @@ Json handle(plc::Plc& plc, const Json& j) {
         const auto on = flag(j, "on");
         if (!on) return fail("\"on\" must be true or false");
         plc.set_network_write_protection(*on);
+    } else if (cmd == "um_read_protection") {
+        // What a Programming Device does: protecting may set a password; releasing a
+        // password-protected UM needs it (W342 5-1-3 2602 "incorrect password").
+        const auto on = flag(j, "on");
+        if (!on) return fail("\"on\" must be true or false");
+        const auto it = j.find("password");
+        const std::string given = it != j.end() && it->is_string() ? it->get<std::string>() : "";
+        if (*on) {
+            if (!given.empty()) plc.set_um_password(given);
+        } else if (!plc.um_password().empty() && given != plc.um_password()) {
+            return fail("incorrect password");
+        }
+        plc.set_um_read_protection(*on);
     } else if (cmd == "mode") {
         const auto it = j.find("mode");
         const std::string m = it != j.end() && it->is_string() ? it->get<std::string>() : "";

@@ -101,6 +101,14 @@ errors = [0x0203]
     EXPECT_TRUE(validate(s).has_value());
 }
 
+TEST(FinsdSettings, UmPasswordIsPrintableAsciiUpTo16) {
+    EXPECT_EQ(load("[protection]\npassword = \"PLC-2026\"\n").um_password, "PLC-2026");
+    EXPECT_NE(error_of("[protection]\npassword = \"\"\n").find("1-16 printable"),
+              std::string::npos);
+    EXPECT_NE(error_of("[protection]\npassword = \"12345678901234567\"\n").find("1-16"),
+              std::string::npos);
+}
+
 TEST(FinsdSettings, AFailedLoadChangesNothing) {
     Settings s;
     auto r = load_config_text("profile = \"cs1h\"\n[network]\nport = -1\n", "t.toml", s);

@@ -194,6 +194,23 @@ TEST_F(Control, MessagesModeProtectionAndAccessRight) {
     EXPECT_TRUE(plc_.network_write_protection());
 }
 
+// Like a Programming Device: protecting may set a password, releasing needs it
+// (W342 5-1-3 2602 "incorrect password"); a wrong one leaves the UM protected.
+TEST_F(Control, UmReadProtectionIsReleasedOnlyWithItsPassword) {
+    ControlClient c(path_);
+    EXPECT_EQ(c.request(R"({"cmd":"um_read_protection","on":true,"password":"SECRET"})")["ok"],
+              true);
+    EXPECT_EQ(status(c)["um_read_protection"], true);
+    auto wrong = c.request(R"({"cmd":"um_read_protection","on":false,"password":"nope"})");
+    EXPECT_EQ(wrong["error"], "incorrect password");
+    EXPECT_EQ(c.request(R"({"cmd":"um_read_protection","on":false})")["error"],
+              "incorrect password");
+    EXPECT_EQ(status(c)["um_read_protection"], true);
+    EXPECT_EQ(c.request(R"({"cmd":"um_read_protection","on":false,"password":"SECRET"})")["ok"],
+              true);
+    EXPECT_EQ(status(c)["um_read_protection"], false);
+}
+
 TEST_F(Control, BadRequestsAnswerAnErrorAndKeepTheConnection) {
     ControlClient c(path_);
     const std::vector<std::string> garbage = {

@@ -168,6 +168,17 @@ class Loader {
         const std::string_view k = key.str();
         if (k == "um_read") return flag(key, node, p, s_.um_read_protection);
         if (k == "dip_write") return flag(key, node, p, s_.dip_write_protection);
+        if (k == "password") {
+            std::string value;
+            if (auto r = text(key, node, p, value); !r) return r;
+            // CJ2 CPU Units take 16 characters (CS/CJ 8); printable ASCII.
+            const bool printable = std::all_of(value.begin(), value.end(),
+                                               [](char c) { return c >= 0x20 && c < 0x7F; });
+            if (value.empty() || value.size() > 16 || !printable)
+                return fail(key, p, "must be 1-16 printable ASCII characters");
+            s_.um_password = value;
+            return {};
+        }
         if (k == "network_write") {
             std::string value;
             if (auto r = text(key, node, p, value); !r) return r;

@@ -53,6 +53,7 @@ struct Settings {
     // [protection]
     plc::NetworkWriteProtectionSetting network_write_protection;
     bool um_read_protection = false;
+    std::string um_password;            // [protection] password: releases UM read protection (ctl)
     bool dip_write_protection = false;  // DIP switch pin 1 ON
 
     std::vector<MemoryInit> memory;  // [memory]

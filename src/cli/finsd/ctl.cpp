@@ -9,6 +9,7 @@
 //   clear-errors [CODE]             every error (and the battery cause), or one code
 //   message N [TEXT]                registers MSG N (0-7); without TEXT unregisters it
 //   write-protect on|off            network write protection (PLC Setup, all nodes)
+//   um-protect on|off [PASSWORD]    UM read protection; releasing needs the password
 //   mode program|monitor|run        operating mode
 //   release-access                  drops the access right (as 0C 03)
 //   send JSON                       any request line as is
@@ -152,6 +153,14 @@ int run_ctl(int argc, char** argv) {
     });
     add_on_off("write-protect", "Network write protection (all nodes) on or off",
                "network_write_protection");
+    std::string password;
+    auto* c_um = app.add_subcommand("um-protect", "UM read protection on or off (with PASSWORD)");
+    c_um->add_option("state", on_off, "on or off")->required()->check(CLI::IsMember({"on", "off"}));
+    c_um->add_option("password", password, "Password: sets it (on) or releases with it (off)");
+    c_um->callback([&] {
+        request = {{"cmd", "um_read_protection"}, {"on", on_off == "on"}};
+        if (!password.empty()) request["password"] = password;
+    });
     auto* c_mode = app.add_subcommand("mode", "Set the operating mode");
     c_mode->add_option("mode", mode, "program, monitor or run")
         ->required()

@@ -162,6 +162,7 @@ int serve(const Settings& s) {
     plc.change_mode(s.mode, std::chrono::system_clock::now());
     plc.set_network_write_protection_setting(s.network_write_protection);
     plc.set_um_read_protection(s.um_read_protection);
+    plc.set_um_password(s.um_password);
     plc.set_dip_write_protection(s.dip_write_protection);
     fins::plc::apply(s.inject, plc, std::chrono::system_clock::now());
 
