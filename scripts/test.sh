@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # The whole test suite, as CI runs it: installs what is missing, then
-#   1. Release build with warnings as errors, all tests (unit, loopback integration,
-#      CLI, tshark conformance);
-#   2. ASan+UBSan debug build, all tests again;
-#   3. libFuzzer targets over every decoder, briefly each.
+#   1. an ASan+UBSan build with warnings as errors, and every test under it (unit,
+#      loopback integration, CLI, tshark conformance, SIGKILL);
+#   2. the libFuzzer targets over every decoder and the dispatcher, briefly each.
+# (One instrumented build instead of a Release one and an instrumented one keeps the
+# suite inside its time budget on 2 cores; scripts/run.sh builds Release.)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
@@ -20,11 +21,6 @@ run_ctest() {
   summary+=("$label: $(grep -E 'tests passed' "$log" | tail -n 1)")
   rm -f "$log"
 }
-
-echo "== release build"
-"$root/scripts/build.sh" release
-echo "== release tests"
-run_ctest build release
 
 echo "== ASan+UBSan build"
 "$root/scripts/build.sh" asan
@@ -52,6 +48,5 @@ summary+=("fuzz: $fuzz_ok targets ran clean")
 
 echo "== summary"
 printf '%s\n' "${summary[@]}"
-total=$(ctest --test-dir build -N | grep -Eo 'Total Tests: [0-9]+' | grep -Eo '[0-9]+')
 asan_total=$(ctest --test-dir build-asan -N | grep -Eo 'Total Tests: [0-9]+' | grep -Eo '[0-9]+')
-echo "$((total + asan_total + fuzz_ok)) passed, 0 failed"
+echo "$((asan_total + fuzz_ok)) passed, 0 failed"
