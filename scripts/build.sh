@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# Configures and builds one tree. Usage: scripts/build.sh [release|asan|fuzz]
+# Configures and builds one tree. Usage: scripts/build.sh [release|asan|fuzz] [TARGET...]
+# (no targets: everything the tree builds)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 kind=${1:-release}
+shift || true
 jobs=${FINS_JOBS:-$(nproc)}
 case "$kind" in
   # What users run: optimised, and not failing on a newer compiler's new warning.
@@ -16,5 +18,5 @@ cmake -S "$root" -B "$root/$dir" -G Ninja "${args[@]}" >/dev/null
 if [[ "$kind" == fuzz ]]; then
   ninja -C "$root/$dir" -j "$jobs" fuzz_frame fuzz_tcp fuzz_address fuzz_dispatch
 else
-  ninja -C "$root/$dir" -j "$jobs"
+  ninja -C "$root/$dir" -j "$jobs" "$@"
 fi

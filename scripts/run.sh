@@ -5,5 +5,5 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 "$root/scripts/deps.sh"
-"$root/scripts/build.sh" release
+"$root/scripts/build.sh" release finsd fins fins_load fins_micro
 exec "$root/build/bin/finsd" --bind 127.0.0.1 --port 9600 "$@"
