@@ -48,7 +48,7 @@ std::error_code make_error_code(EndCode e) noexcept;
 
 // Raw end-code word as received, with the flag bits.
 class ResponseCode {
-public:
+  public:
     constexpr ResponseCode() = default;
     constexpr explicit ResponseCode(std::uint16_t raw) noexcept : raw_(raw) {}
 
@@ -69,7 +69,7 @@ public:
     static constexpr std::uint16_t fatal_cpu_error_bit = 0x0080;
     static constexpr std::uint16_t non_fatal_cpu_error_bit = 0x0040;
 
-private:
+  private:
     std::uint16_t raw_ = 0;
 };
 
@@ -81,16 +81,16 @@ struct RelayErrorSource {
 };
 
 enum class ClientError : int {
-    timeout = 1,           // no response within the timeout after every retry
-    malformed_response,    // response too short, wrong length for the request, bad header
-    unexpected_response,   // command code or addresses do not match the request
-    connection_closed,     // transport closed or failed while the request was in flight
-    too_many_in_flight,    // all 256 service IDs are in use
-    request_too_long,      // encoded command longer than the 2,012-byte frame limit
-    not_connected,         // transport not open
-    canceled,              // client destroyed or request canceled
-    handshake_failed,      // FINS/TCP node-address exchange did not complete
-    invalid_argument,      // caller passed a value the command cannot carry
+    timeout = 1,          // no response within the timeout after every retry
+    malformed_response,   // response too short, wrong length for the request, bad header
+    unexpected_response,  // command code or addresses do not match the request
+    connection_closed,    // transport closed or failed while the request was in flight
+    too_many_in_flight,   // all 256 service IDs are in use
+    request_too_long,     // encoded command longer than the 2,012-byte frame limit
+    not_connected,        // transport not open
+    canceled,             // client destroyed or request canceled
+    handshake_failed,     // FINS/TCP node-address exchange did not complete
+    invalid_argument,     // caller passed a value the command cannot carry
 };
 const std::error_category& client_category() noexcept;
 std::error_code make_error_code(ClientError e) noexcept;
