@@ -29,23 +29,13 @@
 #include "fins/commands/status.hpp"
 #include "process.hpp"
 #include "server_fixture.hpp"
+#include "tshark_support.hpp"
 
 namespace fins::test {
 namespace {
 
-constexpr const char* tshark = "/usr/bin/tshark";
-constexpr long severity_warning = 0x00600000;  // PI_WARN
-
-std::vector<std::string> split(const std::string& s, char sep) {
-    std::vector<std::string> out(1);
-    for (char c : s) {
-        if (c == sep)
-            out.emplace_back();
-        else
-            out.back() += c;
-    }
-    return out;
-}
+using tshark::severity_warning;
+using tshark::split;
 
 struct Row {
     std::string command, end_code, mode, model, units, parameter, average, year, malformed,
@@ -56,27 +46,6 @@ const std::vector<std::string> fields{
     "omron.command",   "omron.response.code", "omron.mode_code",      "omron.controller.model",
     "omron.unit_nums", "omron.parameter",     "omron.avg_cycle_time", "omron.year",
     "_ws.malformed",   "_ws.expert.severity", "_ws.expert.message"};
-
-RunResult decode(const std::string& capture, const std::string& port) {
-    std::vector<std::string> argv{tshark,
-                                  "-r",
-                                  capture,
-                                  "-d",
-                                  "udp.port==" + port + ",omron",
-                                  "-d",
-                                  "tcp.port==" + port + ",omron",
-                                  "-Y",
-                                  "omron",
-                                  "-T",
-                                  "fields",
-                                  "-E",
-                                  "separator=|"};
-    for (const auto& f : fields) {
-        argv.push_back("-e");
-        argv.push_back(f);
-    }
-    return run(argv);
-}
 
 std::vector<Row> parse_rows(const std::string& out) {
     std::vector<Row> rows;
@@ -99,17 +68,10 @@ void exchange(Client& c, const C& command, const char* what) {
 }
 
 TEST(TsharkControl, DissectorReadsModeConfigurationCycleTimeAndClockTraffic) {
-    if (!std::filesystem::exists(tshark)) GTEST_SKIP() << "tshark is not installed";
     ServerThread server;
-    const auto dir = std::filesystem::temp_directory_path() /
-                     ("fins-tshark-control-" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir);
-    const auto capture = (dir / "capture.pcapng").string();
-    const std::string port = std::to_string(server.port());
-
-    Child dump({tshark, "-i", "lo", "-f", "port " + port, "-w", capture});
-    if (!dump.wait_for_stderr("Capture started"))
-        GTEST_SKIP() << "cannot capture on lo (needs root or the wireshark group)";
+    tshark::Capture capture(server.port(), "control");
+    if (!capture.ready())
+        GTEST_SKIP() << "tshark missing, or no permission to capture on lo (root or wireshark)";
 
     for (bool tcp : {false, true}) {
         auto c = server.client(tcp);
@@ -147,18 +109,9 @@ TEST(TsharkControl, DissectorReadsModeConfigurationCycleTimeAndClockTraffic) {
         EXPECT_TRUE(c->send_raw({0x0F, 0x01}, {}).has_value());
     }
     // Read the growing capture (bounded) until the 4 marker frames are in it.
-    RunResult decoded;
-    std::vector<Row> rows;
-    for (int attempt = 0; attempt < 60; ++attempt) {
-        decoded = decode(capture, port);
-        rows = parse_rows(decoded.out);
-        int markers = 0;
-        for (const auto& r : rows)
-            markers += r.command == "0x0f01" ? 1 : 0;
-        if (markers == 4) break;
-    }
-    dump.terminate(SIGINT);
-    dump.wait();
+    const RunResult decoded = capture.read_until(
+        fields, [](const RunResult& d) { return tshark::count_rows(d, 0, "0x0f01") == 4; });
+    const std::vector<Row> rows = parse_rows(decoded.out);
     ASSERT_EQ(decoded.exit_code, 0) << decoded.err;
     SCOPED_TRACE("tshark fields:\n" + decoded.out + decoded.err);
 
@@ -212,7 +165,6 @@ TEST(TsharkControl, DissectorReadsModeConfigurationCycleTimeAndClockTraffic) {
     EXPECT_EQ(unit_counts, 2 * 1 + 2 * 2);  // the requests with a count + every response
     EXPECT_EQ(averages, 2);
     EXPECT_EQ(years, 2 * 2 + 1);
-    std::filesystem::remove_all(dir);
 }
 
 }  // namespace

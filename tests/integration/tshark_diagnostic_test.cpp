@@ -18,12 +18,13 @@
 
 #include "process.hpp"
 #include "server_fixture.hpp"
+#include "tshark_support.hpp"
 
 namespace fins::test {
 namespace {
 
-constexpr const char* tshark = "/usr/bin/tshark";
-constexpr long severity_warning = 0x00600000;  // epan/proto.h PI_WARN
+using tshark::severity_warning;
+using tshark::split;
 
 // Fields, in output order.
 const std::vector<std::string> fields = {"omron.command",
@@ -41,38 +42,10 @@ const std::vector<std::string> fields = {"omron.command",
                                          "omron.program_number",
                                          "omron.message"};
 
-std::vector<std::string> split(const std::string& s, char sep) {
-    std::vector<std::string> out(1);
-    for (char c : s) {
-        if (c == sep)
-            out.emplace_back();
-        else
-            out.back() += c;
-    }
-    return out;
-}
-
 using Row = std::map<std::string, std::string>;
 
-std::vector<Row> decode(const std::string& capture, const std::string& port, RunResult& result) {
-    std::vector<std::string> argv{tshark,
-                                  "-r",
-                                  capture,
-                                  "-d",
-                                  "udp.port==" + port + ",omron",
-                                  "-d",
-                                  "tcp.port==" + port + ",omron",
-                                  "-Y",
-                                  "omron",
-                                  "-T",
-                                  "fields",
-                                  "-E",
-                                  "separator=|"};
-    for (const auto& f : fields) {
-        argv.push_back("-e");
-        argv.push_back(f);
-    }
-    result = run(argv);
+// One map of field -> value per frame.
+std::vector<Row> parse_rows(const RunResult& result) {
     std::vector<Row> rows;
     std::istringstream lines(result.out);
     for (std::string line; std::getline(lines, line);) {
@@ -113,17 +86,10 @@ const std::vector<Exchange> traffic = {
 };
 
 TEST(TsharkDiagnostic, DissectorReadsOurDiagnosticTrafficWithoutComplaint) {
-    if (!std::filesystem::exists(tshark)) GTEST_SKIP() << "tshark is not installed";
     ServerThread server;
-    const auto dir =
-        std::filesystem::temp_directory_path() / ("fins-tshark-diag-" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir);
-    const auto capture = (dir / "capture.pcapng").string();
-    const std::string port = std::to_string(server.port());
-
-    Child dump({tshark, "-i", "lo", "-f", "port " + port, "-w", capture});
-    if (!dump.wait_for_stderr("Capture started"))
-        GTEST_SKIP() << "cannot capture on lo (needs root or the wireshark group)";
+    tshark::Capture capture(server.port(), "diagnostic");
+    if (!capture.ready())
+        GTEST_SKIP() << "tshark missing, or no permission to capture on lo (root or wireshark)";
 
     for (bool tcp : {false, true}) {
         auto c = server.client(tcp);
@@ -135,17 +101,9 @@ TEST(TsharkDiagnostic, DissectorReadsOurDiagnosticTrafficWithoutComplaint) {
         ASSERT_TRUE(c->send_raw({0x0F, 0x01}, {}).has_value());  // end marker
     }
     // Read the growing capture (bounded) until both end markers are in it.
-    RunResult decoded;
-    std::vector<Row> rows;
-    for (int attempt = 0; attempt < 60; ++attempt) {
-        rows = decode(capture, port, decoded);
-        int markers = 0;
-        for (const auto& r : rows)
-            markers += r.at("omron.command") == "0x0f01" ? 1 : 0;
-        if (markers == 4) break;
-    }
-    dump.terminate(SIGINT);
-    dump.wait();
+    const RunResult decoded = capture.read_until(
+        fields, [](const RunResult& d) { return tshark::count_rows(d, 0, "0x0f01") == 4; });
+    const std::vector<Row> rows = parse_rows(decoded);
     ASSERT_EQ(decoded.exit_code, 0) << decoded.err;
     SCOPED_TRACE("tshark fields:\n" + decoded.out + decoded.err);
 
@@ -187,7 +145,6 @@ TEST(TsharkDiagnostic, DissectorReadsOurDiagnosticTrafficWithoutComplaint) {
     EXPECT_EQ(seen["0x2301 omron.bit_flag=2573"], 2);  // 00 0A 0D: CIO 10 bit 13
     EXPECT_EQ(seen["0x2301 omron.response.code=0x0000"], 2);
     EXPECT_EQ(seen["0x2302 omron.response.code=0x0000"], 2);
-    std::filesystem::remove_all(dir);
 }
 
 }  // namespace

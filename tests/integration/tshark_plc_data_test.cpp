@@ -23,12 +23,13 @@
 #include "plc/plc.hpp"
 #include "process.hpp"
 #include "server/server.hpp"
+#include "tshark_support.hpp"
 
 namespace fins::test {
 namespace {
 
-constexpr const char* tshark = "/usr/bin/tshark";
-constexpr long severity_warning = 0x00600000;  // epan/proto.h PI_WARN
+using tshark::severity_warning;
+using tshark::split;
 
 // finsd in this process, in PROGRAM mode (03 07 and 03 08 refuse RUN).
 class ProgramModeServer {
@@ -67,42 +68,10 @@ class ProgramModeServer {
     std::thread thread_;
 };
 
-std::vector<std::string> split(const std::string& s, char sep) {
-    std::vector<std::string> out(1);
-    for (char c : s) {
-        if (c == sep)
-            out.emplace_back();
-        else
-            out.back() += c;
-    }
-    return out;
-}
-
 const std::vector<std::string> fields = {
     "omron.command",        "omron.parameter_area_code", "omron.word",      "omron.numwords",
     "omron.program_number", "omron.word.begin",          "omron.clearcode", "omron.response.code",
     "_ws.malformed",        "_ws.expert.severity"};
-
-RunResult decode(const std::string& capture, const std::string& port) {
-    std::vector<std::string> argv{tshark,
-                                  "-r",
-                                  capture,
-                                  "-d",
-                                  "udp.port==" + port + ",omron",
-                                  "-d",
-                                  "tcp.port==" + port + ",omron",
-                                  "-Y",
-                                  "omron",
-                                  "-T",
-                                  "fields",
-                                  "-E",
-                                  "separator=|"};
-    for (const auto& f : fields) {
-        argv.push_back("-e");
-        argv.push_back(f);
-    }
-    return run(argv);
-}
 
 std::vector<std::vector<std::string>> parse_rows(const std::string& out) {
     std::vector<std::vector<std::string>> rows;
@@ -118,16 +87,10 @@ std::vector<std::vector<std::string>> parse_rows(const std::string& out) {
 }
 
 TEST(TsharkPlcData, DissectorReadsParameterAndProgramAreaTrafficWithoutComplaint) {
-    if (!std::filesystem::exists(tshark)) GTEST_SKIP() << "tshark is not installed";
     ProgramModeServer server;
-    const auto dir = std::filesystem::temp_directory_path() /
-                     ("fins-tshark-plc-data-" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir);
-    const auto capture = (dir / "capture.pcapng").string();
-    const std::string port = std::to_string(server.port());
-    Child dump({tshark, "-i", "lo", "-f", "port " + port, "-w", capture});
-    if (!dump.wait_for_stderr("Capture started"))
-        GTEST_SKIP() << "cannot capture on lo (needs root or the wireshark group)";
+    tshark::Capture capture(server.port(), "plc-data");
+    if (!capture.ready())
+        GTEST_SKIP() << "tshark missing, or no permission to capture on lo (root or wireshark)";
 
     const std::vector<std::uint8_t> two_words{0x0A, 0x0B, 0x0C, 0x0D};
     const std::vector<std::uint8_t> program(8, 0x5A);
@@ -145,18 +108,9 @@ TEST(TsharkPlcData, DissectorReadsParameterAndProgramAreaTrafficWithoutComplaint
     }
     // Read the growing capture (bounded) until the last exchange (03 08 over both
     // transports: 4 frames) is in it, then stop the capture.
-    RunResult decoded;
-    std::vector<std::vector<std::string>> rows;
-    for (int attempt = 0; attempt < 60; ++attempt) {
-        decoded = decode(capture, port);
-        rows = parse_rows(decoded.out);
-        int clears = 0;
-        for (const auto& r : rows)
-            clears += r[0] == "0x0308" ? 1 : 0;
-        if (clears == 4) break;
-    }
-    dump.terminate(SIGINT);
-    dump.wait();
+    const RunResult decoded = capture.read_until(
+        fields, [](const RunResult& d) { return tshark::count_rows(d, 0, "0x0308") == 4; });
+    const auto rows = parse_rows(decoded.out);
     ASSERT_EQ(decoded.exit_code, 0) << decoded.err;
     SCOPED_TRACE("tshark fields:\n" + decoded.out + decoded.err);
     std::map<std::string, int> commands;
@@ -200,7 +154,6 @@ TEST(TsharkPlcData, DissectorReadsParameterAndProgramAreaTrafficWithoutComplaint
     for (const char* c : {"0x0202", "0x0203", "0x0306", "0x0307", "0x0308"})
         EXPECT_EQ(end_codes[std::string(c) + " 0x0000"], 2) << c;
     EXPECT_EQ(end_codes["0x0201 0x0000"], 2 * 2);
-    std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -13,66 +13,23 @@
 
 #include <gtest/gtest.h>
 
-#include "process.hpp"
 #include "server_fixture.hpp"
+#include "tshark_support.hpp"
 
 namespace fins::test {
 namespace {
 
-constexpr const char* tshark = "/usr/bin/tshark";
-// Expert-info severities as tshark prints them (epan/proto.h PI_WARN, PI_ERROR).
-constexpr long severity_warning = 0x00600000;
-
-std::vector<std::string> split(const std::string& s, char sep) {
-    std::vector<std::string> out;
-    std::string cur;
-    for (char c : s) {
-        if (c == sep) {
-            out.push_back(cur);
-            cur.clear();
-        } else {
-            cur += c;
-        }
-    }
-    out.push_back(cur);
-    return out;
-}
+using tshark::severity_warning;
+using tshark::split;
 
 struct Row {
     std::string tcp_command, command, area, address, count, end_code, malformed, severity;
 };
 
-RunResult decode(const std::string& capture, const std::string& port) {
-    return run({tshark,
-                "-r",
-                capture,
-                "-d",
-                "udp.port==" + port + ",omron",
-                "-d",
-                "tcp.port==" + port + ",omron",
-                "-Y",
-                "omron",
-                "-T",
-                "fields",
-                "-E",
-                "separator=|",
-                "-e",
-                "omron.tcp.command",
-                "-e",
-                "omron.command",
-                "-e",
-                "omron.memory.area.read",
-                "-e",
-                "omron.memory.address",
-                "-e",
-                "omron.memory.numitems",
-                "-e",
-                "omron.response.code",
-                "-e",
-                "_ws.malformed",
-                "-e",
-                "_ws.expert.severity"});
-}
+const std::vector<std::string> fields{"omron.tcp.command",      "omron.command",
+                                      "omron.memory.area.read", "omron.memory.address",
+                                      "omron.memory.numitems",  "omron.response.code",
+                                      "_ws.malformed",          "_ws.expert.severity"};
 
 std::vector<Row> parse_rows(const std::string& out) {
     std::vector<Row> rows;
@@ -89,17 +46,10 @@ std::vector<Row> parse_rows(const std::string& out) {
 }
 
 TEST(Tshark, DissectorReadsOurUdpAndTcpTrafficWithoutComplaint) {
-    if (!std::filesystem::exists(tshark)) GTEST_SKIP() << "tshark is not installed";
     ServerThread server;
-    const auto dir =
-        std::filesystem::temp_directory_path() / ("fins-tshark-" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir);
-    const auto capture = (dir / "capture.pcapng").string();
-    const std::string port = std::to_string(server.port());
-
-    Child dump({tshark, "-i", "lo", "-f", "port " + port, "-w", capture});
-    if (!dump.wait_for_stderr("Capture started"))
-        GTEST_SKIP() << "cannot capture on lo (needs root or the wireshark group)";
+    tshark::Capture capture(server.port(), "memory");
+    if (!capture.ready())
+        GTEST_SKIP() << "tshark missing, or no permission to capture on lo (root or wireshark)";
 
     // Traffic: every 01 xx command over both transports, plus end-code answers.
     for (bool tcp : {false, true}) {
@@ -117,22 +67,11 @@ TEST(Tshark, DissectorReadsOurUdpAndTcpTrafficWithoutComplaint) {
         EXPECT_FALSE(c->send(MemoryAreaRead{{0x82, 0x8000, 0}, 1}).has_value());  // 1103
         EXPECT_TRUE(c->send_raw({0x0F, 0x01}, {}).has_value());                   // 0401
     }
-    // The kernel hands captured packets to dumpcap in blocks and dumpcap drops the
-    // unfinished block when stopped, so read the growing file (bounded) until the last
-    // exchange (0F 01 over both transports, 4 frames) is in it, then stop the capture.
-    RunResult decoded;
-    std::vector<Row> rows;
-    for (int attempt = 0; attempt < 60; ++attempt) {
-        decoded = decode(capture, port);
-        rows = parse_rows(decoded.out);
-        int undefined = 0;
-        for (const auto& r : rows)
-            undefined += r.command == "0x0f01" ? 1 : 0;
-        if (undefined == 4) break;
-    }
-    dump.terminate(SIGINT);
-    dump.wait();
+    // The last exchange, 0F 01 over both transports, is 4 frames.
+    const RunResult decoded = capture.read_until(
+        fields, [](const RunResult& d) { return tshark::count_rows(d, 1, "0x0f01") == 4; });
     ASSERT_EQ(decoded.exit_code, 0) << decoded.err;
+    const std::vector<Row> rows = parse_rows(decoded.out);
     SCOPED_TRACE("tshark fields:\n" + decoded.out + decoded.err);
     std::map<std::string, int> commands;
     std::map<std::string, int> end_codes;
@@ -172,7 +111,6 @@ TEST(Tshark, DissectorReadsOurUdpAndTcpTrafficWithoutComplaint) {
     for (const auto& r : rows)
         if (r.tcp_command == "0x00000000" || r.tcp_command == "0x00000001") ++handshake;
     EXPECT_EQ(handshake, 2);
-    std::filesystem::remove_all(dir);
 }
 
 }  // namespace
