@@ -21,7 +21,8 @@
 //              registered but not readable (seed 001: "excluding the sequence commands
 //              (ITEM011 onwards) in the Step Ladder Program block (Block Model 301)")
 //
-// Values are read-only (02 41 ITEM write is not implemented), so nothing is stored.
+// Values are read-only: finsd answers only 02 40 ITEM read (02 41 ITEM write is undefined,
+// 0401), so nothing is stored.
 #pragma once
 
 #include <array>

@@ -3,7 +3,6 @@
 // write protection, ...). A Unix-domain stream socket; one JSON request per line, one
 // JSON answer per line. Runs on the server's io_context, so it touches the Plc on the
 // same thread as the FINS sessions.
-// (Interface fixed by the lead; implemented by the issue-3 owner of errors/messages.)
 #pragma once
 
 #include <filesystem>
