@@ -11,25 +11,10 @@ namespace fins {
 namespace {
 
 using test::encode;
+using test::expect_longer_fails;
+using test::expect_shorter_prefixes_fail;
 using test::hex;
 using test::prefix;
-
-template <class C>
-void expect_shorter_prefixes_fail(const std::vector<std::uint8_t>& params) {
-    for (std::size_t n = 0; n < params.size(); ++n) {
-        auto r = C::decode(prefix(params, n));
-        ASSERT_FALSE(r) << C::name << " prefix " << n;
-        EXPECT_EQ(r.error(), EndCode::command_too_short) << C::name << " prefix " << n;
-    }
-}
-
-template <class C>
-void expect_longer_fails(std::vector<std::uint8_t> params) {
-    params.push_back(0x00);
-    auto r = C::decode(params);
-    ASSERT_FALSE(r) << C::name;
-    EXPECT_EQ(r.error(), EndCode::command_too_long) << C::name;
-}
 
 TEST(ProgramAreaRead, RoundTrip) {
     const ProgramAreaRead c{0xFFFF, 0x000003E0, 992, false};

@@ -10,7 +10,10 @@
 #include <string_view>
 #include <vector>
 
+#include <gtest/gtest.h>
+
 #include "fins/byte_io.hpp"
+#include "fins/error.hpp"
 
 namespace fins::test {
 
@@ -74,6 +77,25 @@ std::vector<std::uint8_t> encode(const T& value, std::size_t capacity = 4096) {
 
 inline Bytes prefix(const std::vector<std::uint8_t>& v, std::size_t n) {
     return Bytes(v.data(), n);
+}
+
+// Every shorter prefix of a fixed-layout command's parameters decodes to 1002.
+template <class C>
+void expect_shorter_prefixes_fail(const std::vector<std::uint8_t>& params) {
+    for (std::size_t n = 0; n < params.size(); ++n) {
+        auto r = C::decode(prefix(params, n));
+        ASSERT_FALSE(r) << C::name << " prefix " << n;
+        EXPECT_EQ(r.error(), EndCode::command_too_short) << C::name << " prefix " << n;
+    }
+}
+
+// One byte more than a fixed-length command takes decodes to 1001.
+template <class C>
+void expect_longer_fails(std::vector<std::uint8_t> params) {
+    params.push_back(0x00);
+    auto r = C::decode(params);
+    ASSERT_FALSE(r) << C::name;
+    EXPECT_EQ(r.error(), EndCode::command_too_long) << C::name;
 }
 
 }  // namespace fins::test
