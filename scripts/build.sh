@@ -14,6 +14,8 @@ case "$kind" in
   fuzz) dir=build-fuzz; args=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DFINS_FUZZ=ON -DFINS_TESTS=OFF -DCMAKE_CXX_COMPILER=clang++-14) ;;
   *) echo "usage: $0 [release|asan|fuzz]" >&2; exit 2 ;;
 esac
+# ccache (optional, not a dependency) makes rebuilds in several work trees cheap.
+if command -v ccache >/dev/null; then args+=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
 cmake -S "$root" -B "$root/$dir" -G Ninja "${args[@]}" >/dev/null
 if [[ "$kind" == fuzz ]]; then
   ninja -C "$root/$dir" -j "$jobs" fuzz_frame fuzz_tcp fuzz_address fuzz_dispatch
