@@ -10,8 +10,9 @@ using codec::malformed;
 
 namespace {
 
-// libfins' 05 01 layout has a 1-byte remote I/O field (frames 10, item 1).
-constexpr std::size_t short_remote_io_size = 1;
+// The CV-series 05 01 layout (Wireshark's dissector) has a 2-byte remote I/O field,
+// "always 00" then the master count; clients accept it too.
+constexpr std::size_t cv_remote_io_size = 2;
 constexpr std::size_t connection_entry_size = 1 + connection_model_size;
 constexpr std::size_t system_use_reserved = cpu_system_use_size - 2;
 constexpr std::size_t bus_unit_reserved = cpu_bus_unit_block_size - 2 * cpu_bus_unit_slots;
@@ -62,12 +63,13 @@ void read_model_and_area(ByteReader& r, CpuUnitDataReadResponse& out) {
     out.area = read_area(r);
 }
 
-// `remote_io` is 2 (W342 diagram) or 1 (libfins); CPU information is the last byte.
+// `remote_io` is 1 (W342 5-3-15, CS/CJ/CP) or 2 (CV series); CPU information is the
+// last byte either way.
 void read_units_and_info(ByteReader& r, CpuUnitDataReadResponse& out, std::size_t remote_io) {
     for (auto& unit : out.bus_units)
         unit = r.u16();
     r.skip(bus_unit_reserved);
-    if (remote_io == cpu_remote_io_size) r.skip(1);  // "always 00"
+    if (remote_io == cv_remote_io_size) r.skip(1);  // CV: "always 00"
     out.sysmac_bus_masters = r.u8();
     out.racks = static_cast<std::uint8_t>(r.u8() & racks_mask);
 }
@@ -87,8 +89,7 @@ void CpuUnitDataReadResponse::encode(ByteWriter& w) const noexcept {
         for (auto unit : bus_units)
             w.u16(unit);
         zeros(w, bus_unit_reserved);
-        w.u8(0x00);  // remote I/O data, first byte: always 00
-        w.u8(sysmac_bus_masters);
+        w.u8(sysmac_bus_masters);  // remote I/O data: one byte (W342 5-3-15)
         w.u8(static_cast<std::uint8_t>(racks & racks_mask));
     }
 }
@@ -116,8 +117,8 @@ Result<CpuUnitDataRead::Response> CpuUnitDataRead::decode_response(Bytes data) c
     if (out.has_units_and_info()) {
         const std::size_t expected =
             (out.has_model_and_area() ? cpu_model_and_area_size : 0) + cpu_units_and_info_size;
-        if (data.size() == expected - 1)
-            remote_io = short_remote_io_size;
+        if (data.size() == expected + 1)
+            remote_io = cv_remote_io_size;
         else if (data.size() != expected)
             return malformed();
     } else if (data.size() != cpu_model_and_area_size) {

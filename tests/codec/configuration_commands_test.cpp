@@ -25,7 +25,7 @@ CpuUnitDataReadResponse sample(std::optional<CpuUnitDataSection> section) {
         r.system_version = "02.00";
         r.dip_switch = 0x01;
         r.largest_em_bank = 0x18;
-        r.area = {250, 23, 32768, 8, 25, 0x04, 0x0800};
+        r.area = {500, 23, 32768, 8, 25, 0x04, 0x0800};
     }
     if (r.has_units_and_info()) {
         r.bus_units[0] = 0x8123;
@@ -46,10 +46,12 @@ TEST(CpuUnitDataRead, CommandVariants) {
     EXPECT_EQ(CpuUnitDataRead::decode(hex("02")).error(), EndCode::parameter_error);
 }
 
-TEST(CpuUnitDataRead, W342_5_3_15_FullResponseIs159DataBytes161WithTheEndCode) {
+// W342 5-3-15: the SYSMAC BUS master count "is returned in a single byte", so the
+// full answer is 158 data bytes (160 with the end code), as real CS/CJ/CP units send.
+TEST(CpuUnitDataRead, W342_5_3_15_FullResponseIs158DataBytesRemoteIoInASingleByte) {
     const auto r = sample(std::nullopt);
     const auto data = encode(r);
-    ASSERT_EQ(data.size(), 159U);  // + the 2-byte end code = the diagram's 161
+    ASSERT_EQ(data.size(), 158U);
     // Model: 20 bytes space padded; version: 20 bytes NUL padded.
     EXPECT_EQ(text(data, 0, 20), "CJ2H-CPU68-EIP      ");
     EXPECT_EQ(data[20], '0');
@@ -61,53 +63,57 @@ TEST(CpuUnitDataRead, W342_5_3_15_FullResponseIs159DataBytes161WithTheEndCode) {
     EXPECT_EQ(data[41], 0x18);
     // Area data at 80: program size, IOM, DM words, T/C, EM, 2 unused, card type, size.
     EXPECT_EQ(std::vector<std::uint8_t>(data.begin() + 80, data.begin() + 92),
-              hex("00FA 17 8000 08 19 0000 04 0800"));
-    // CPU Bus Unit words at 92, unit 15 at 122; 32 reserved bytes; remote I/O 00 nn;
-    // CPU information (racks) last.
+              hex("01F4 17 8000 08 19 0000 04 0800"));
+    // CPU Bus Unit words at 92, unit 15 at 122; 32 reserved bytes; remote I/O (one
+    // byte: the master count); CPU information (racks) last.
     EXPECT_EQ(data[92], 0x81);
     EXPECT_EQ(data[93], 0x23);
     EXPECT_EQ(data[122], 0x80);
     EXPECT_EQ(data[123], 0x01);
-    EXPECT_EQ(data[156], 0x00);
-    EXPECT_EQ(data[157], 0x01);
-    EXPECT_EQ(data[158], 0x03);
+    EXPECT_EQ(data[156], 0x01);
+    EXPECT_EQ(data[157], 0x03);
 
     const CpuUnitDataRead command;
     const auto d = command.decode_response(data);
     ASSERT_TRUE(d);
     EXPECT_EQ(*d, r);
     for (std::size_t n = 0; n < data.size(); ++n)
-        if (n != 158) {  // 158 is libfins' layout, accepted below
-            EXPECT_FALSE(command.decode_response(prefix(data, n))) << n;
-        }
+        EXPECT_FALSE(command.decode_response(prefix(data, n))) << n;
     auto longer = data;
-    longer.push_back(0);
+    longer.insert(longer.begin() + 156, 0x00);
+    longer.push_back(0);  // 160: neither layout
     EXPECT_FALSE(command.decode_response(longer));
 }
 
-TEST(CpuUnitDataRead, ClientAcceptsLibfinsOneByteRemoteIoLayout) {
+// The client also reads the CV-series layout (a 2-byte remote I/O field "always 00"
+// then the count, 159 data bytes, Wireshark's dissector), CPU information last.
+TEST(CpuUnitDataRead, ClientAcceptsTheCvSeriesTwoByteRemoteIoLayout) {
     auto data = encode(sample(std::nullopt));
-    data.erase(data.begin() + 156);  // the "always 00" byte
+    data.insert(data.begin() + 156, 0x00);  // the CV "always 00" byte
+    ASSERT_EQ(data.size(), 159U);
     const auto d = CpuUnitDataRead{}.decode_response(data);
     ASSERT_TRUE(d);
     EXPECT_EQ(d->sysmac_bus_masters, 1);
     EXPECT_EQ(d->racks, 3);
+    EXPECT_EQ(*d, sample(std::nullopt));
+    auto units = encode(sample(CpuUnitDataSection::units_and_info));
+    units.insert(units.begin() + 64, 0x00);
+    const CpuUnitDataRead selector01{CpuUnitDataSection::units_and_info};
+    ASSERT_TRUE(selector01.decode_response(units));
+    EXPECT_EQ(selector01.decode_response(units)->racks, 3);
 }
 
 TEST(CpuUnitDataRead, W342_5_3_15_SelectorsReturnTheirParts) {
     for (auto section : {CpuUnitDataSection::model_and_area, CpuUnitDataSection::units_and_info}) {
         const auto r = sample(section);
         const auto data = encode(r);
-        EXPECT_EQ(data.size(), section == CpuUnitDataSection::model_and_area ? 92U : 67U);
+        EXPECT_EQ(data.size(), section == CpuUnitDataSection::model_and_area ? 92U : 66U);
         const CpuUnitDataRead command{section};
         const auto d = command.decode_response(data);
         ASSERT_TRUE(d);
         EXPECT_EQ(*d, r);
-        const std::size_t libfins = section == CpuUnitDataSection::units_and_info ? 66 : 0;
         for (std::size_t n = 0; n < data.size(); ++n)
-            if (n != libfins) {
-                EXPECT_FALSE(command.decode_response(prefix(data, n))) << n;
-            }
+            EXPECT_FALSE(command.decode_response(prefix(data, n))) << n;
     }
 }
 

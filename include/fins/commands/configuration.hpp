@@ -4,12 +4,14 @@
 //
 // 05 01 response data (after the end code), by data selector:
 //   none (all)  model 20 | version 20 | system use 40 | area data 12 |
-//               CPU Bus Units 64 | remote I/O 2 | CPU information 1     = 159 bytes
+//               CPU Bus Units 64 | remote I/O 1 | CPU information 1     = 158 bytes
 //   00          model 20 | version 20 | system use 40 | area data 12     =  92 bytes
-//   01          CPU Bus Units 64 | remote I/O 2 | CPU information 1      =  67 bytes
-// With MRC SRC and the end code, the full answer is the 161 bytes of the W342 diagram
-// (and of Wireshark's dissector). libfins reads a 1-byte remote I/O field instead, so
-// decode_response() also accepts 158 / 66 bytes and reads CPU information last.
+//   01          CPU Bus Units 64 | remote I/O 1 | CPU information 1      =  66 bytes
+// W342 5-3-15: the number of SYSMAC BUS masters "is returned in a single byte"; real
+// CS/CJ/CP CPU Units answer 158 bytes and libfins refuses any other length
+// (fins-frames.md 0501, resolved discrepancy). The 2-byte remote I/O field of the
+// CV-series diagram (Wireshark's dissector, 161 bytes with MRC SRC and end code) is
+// still accepted by decode_response(), which reads CPU information last.
 #pragma once
 
 #include <array>
@@ -39,11 +41,11 @@ inline constexpr std::size_t cpu_system_use_size = 40;  // DIP switch, largest E
 inline constexpr std::size_t cpu_area_data_size = 12;
 inline constexpr std::size_t cpu_bus_unit_slots = 16;       // unit numbers 0-15
 inline constexpr std::size_t cpu_bus_unit_block_size = 64;  // 16 x 2 bytes + 32 reserved
-inline constexpr std::size_t cpu_remote_io_size = 2;
+inline constexpr std::size_t cpu_remote_io_size = 1;      // W342 5-3-15 "a single byte"
 inline constexpr std::size_t cpu_model_and_area_size =
     cpu_model_size + cpu_version_size + cpu_system_use_size + cpu_area_data_size;  // 92
 inline constexpr std::size_t cpu_units_and_info_size =
-    cpu_bus_unit_block_size + cpu_remote_io_size + 1;  // 67
+    cpu_bus_unit_block_size + cpu_remote_io_size + 1;  // 66
 // CPU Bus Unit configuration word: bit 15 = unit mounted, bits 0-14 = model ID.
 inline constexpr std::uint16_t cpu_bus_unit_present = 0x8000;
 
@@ -54,8 +56,8 @@ struct CpuUnitAreaData {
     std::uint16_t dm_words = 0;             // "always 32,768"
     std::uint8_t timer_counter_kwords = 0;  // x 1,024 ("always 8")
     std::uint8_t em_non_file_banks = 0;     // EM banks without file memory
-    std::uint8_t memory_card_type = 0;      // 00 none, 04 flash
-    std::uint16_t memory_card_kbytes = 0;   // 0000 without a card
+    std::uint8_t memory_card_type = 0;      // 00 no memory card, 04 flash memory
+    std::uint16_t memory_card_kbytes = 0;   // "0000 if there is no memory card"
     friend bool operator==(const CpuUnitAreaData&, const CpuUnitAreaData&) = default;
 };
 
