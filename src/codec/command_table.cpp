@@ -1,7 +1,9 @@
 // The command list of W342 5-1-1 with the execution conditions of 5-1-2.
 //
 // Where 5-1-2 disagrees with a command's own "Execution Conditions" table in 5-3, this
-// table follows 5-1-2 and says so next to the row, so a handler can decide knowingly.
+// table follows 5-1-2 and says so next to the row, so a handler can decide knowingly;
+// rows marked "Page decides" follow the command's own page(s) instead (tests/server/
+// execution_matrix_test.cpp lists them).
 #include "fins/command_table.hpp"
 
 #include <algorithm>
@@ -49,11 +51,13 @@ constexpr std::array commands{
     // 5-1-2 leaves the network column blank; 5-3-20 says "No" and W596 2-6 lists CLOCK
     // WRITE as refused under write protection.
     CommandInfo{{0x07, 0x02}, "CLOCK WRITE", "5-3-20", guarded_write},
-    // 5-1-2: access right "Disabled (MESSAGE CLEAR only)". One row serves READ, CLEAR
-    // and FAL/FALS READ (5-3-21..23), so it is marked accepted here and the 09 20
-    // handler itself refuses the clear variant while another device holds the access
-    // right. 5-3-22 gives "OK" for network write protection where 5-1-2 says Disabled.
-    CommandInfo{{0x09, 0x20}, "MESSAGE READ/CLEAR", "5-3-21", when(OK, OK, OK, OK, OK, OK, NO)},
+    // Page decides: 5-1-2 gives one row for the three variants, access right "Disabled
+    // (MESSAGE CLEAR only)" and network write protection "Disabled". 5-3-21 MESSAGE READ
+    // and 5-3-23 FAL/FALS READ say OK under both: they are reads. So the row accepts
+    // both and the 09 20 handler refuses MESSAGE CLEAR itself (2102 under network write
+    // protection, as 5-1-2 says; 3001 while another node holds the access right, 5-3-22)
+    // and marks it as a write for the FINS write access log.
+    CommandInfo{{0x09, 0x20}, "MESSAGE READ/CLEAR", "5-3-21", always},
     // 5-1-2 marks 0C 01 "Disabled" while another device holds the right; the handler
     // refuses it itself so that its 3001 answer can name the holder (5-3-24).
     CommandInfo{{0x0C, 0x01}, "ACCESS RIGHT ACQUIRE", "5-3-24", when(OK, OK, OK, OK, OK, OK, NO)},
@@ -62,8 +66,10 @@ constexpr std::array commands{
     // 5-3-27 gives "OK" for network write protection; 5-1-2 (and 5-1-1 note 1) Disabled.
     CommandInfo{{0x21, 0x01}, "ERROR CLEAR", "5-3-27", guarded_write},
     CommandInfo{{0x21, 0x02}, "ERROR LOG READ", "5-3-28", always},
-    // 5-3-29 and the 5-3-25 list give "No" for the access right; 5-1-2 says OK.
-    CommandInfo{{0x21, 0x03}, "ERROR LOG CLEAR", "5-3-29", memory_write},
+    // Page decides: 5-3-29 ("Access right at other device: No") and the lists of
+    // commands refused while another device holds the access right on the 0C 01 and
+    // 0C 02 pages (5-3-24, 5-3-25: "2103 ERROR LOG CLEAR") say 3001; only 5-1-2 says OK.
+    CommandInfo{{0x21, 0x03}, "ERROR LOG CLEAR", "5-3-29", guarded_write},
     CommandInfo{{0x21, 0x40}, "FINS WRITE ACCESS LOG READ", "5-3-30", always},
     CommandInfo{{0x21, 0x41}, "FINS WRITE ACCESS LOG CLEAR", "5-3-31", guarded_write},
     CommandInfo{{0x22, 0x01}, "FILE NAME READ", "5-3-32", always},

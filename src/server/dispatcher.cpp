@@ -94,7 +94,7 @@ std::size_t Dispatcher::handle(Bytes request, MutableBytes out, const RequestCon
     auto code = entry->function(handler_context, decoded->parameters, data);
     if (data.overflowed()) code = EndCode::response_too_long;
     // W342 5-3-30: the CPU Unit logs every FINS write command it receives.
-    if (!info->conditions.network_write_protected)
+    if (!info->conditions.network_write_protected || handler_context.write)
         plc_.write_access_log().record(header.source, command, code, context.now);
     if (code != EndCode::normal_completion && !handler_context.keep_data) return answer(code);
 

@@ -45,10 +45,11 @@ TEST(CommandTable, EveryCommandOf511AndTheLoopControlItemRead) {
     EXPECT_EQ(get(0x09, 0x20).section, "5-3-21");
 }
 
-// The write-protected-from-network column (5-1-2 note 5 / 5-1-1 note 1).
+// The write-protected-from-network column (5-1-2 note 5 / 5-1-1 note 1). 09 20 is
+// accepted: its reads are allowed (5-3-21, 5-3-23), its handler refuses MESSAGE CLEAR.
 TEST(CommandTable, NetworkWriteProtection) {
     const std::set<std::uint16_t> refused{0x0102, 0x0103, 0x0105, 0x0202, 0x0203, 0x0307, 0x0308,
-                                          0x0401, 0x0402, 0x0702, 0x0920, 0x0C01, 0x2101, 0x2103,
+                                          0x0401, 0x0402, 0x0702, 0x0C01, 0x2101, 0x2103,
                                           0x2141, 0x2203, 0x2204, 0x2205, 0x2207, 0x2208, 0x220A,
                                           0x220B, 0x220C, 0x2215, 0x2220, 0x2301, 0x2302};
     for (const auto& c : command_table())
@@ -57,10 +58,11 @@ TEST(CommandTable, NetworkWriteProtection) {
 }
 
 // 0C 01 is the one "Disabled" row the table leaves to its handler: its 3001 answer must
-// carry the holder's address (5-3-24), which the generic check cannot write.
+// carry the holder's address (5-3-24), which the generic check cannot write. 21 03 is
+// refused although 5-1-2 says OK: 5-3-29 and the 0C 01 / 0C 02 pages say No.
 TEST(CommandTable, AccessRightHeldElsewhere) {
     const std::set<std::uint16_t> refused{0x0202, 0x0203, 0x0307, 0x0308, 0x0401, 0x0402, 0x0702,
-                                          0x2101, 0x2141, 0x2203, 0x2204, 0x2205, 0x2207, 0x2208,
+                                          0x2101, 0x2103, 0x2141, 0x2203, 0x2204, 0x2205, 0x2207, 0x2208,
                                           0x220A, 0x220B, 0x220C, 0x2215, 0x2220};
     for (const auto& c : command_table())
         EXPECT_EQ(c.conditions.access_right_elsewhere, refused.count(c.code.value()) == 0)
@@ -85,10 +87,13 @@ TEST(CommandTable, ModesAndProtection) {
 TEST(CommandTable, ManualGapsPinned) {
     // 07 02: blank network column -> Disabled (5-3-20, W596 2-6).
     EXPECT_FALSE(get(0x07, 0x02).conditions.network_write_protected);
-    // 09 20: "Disabled (MESSAGE CLEAR only)" -> accepted here; the handler refuses CLEAR.
+    // 09 20: "Disabled (MESSAGE CLEAR only)" -> accepted here; the handler refuses CLEAR,
+    // under network write protection too (the reads are OK there: 5-3-21, 5-3-23).
     EXPECT_TRUE(get(0x09, 0x20).conditions.access_right_elsewhere);
-    // 21 03: 5-1-2 says OK for the access right even though 5-3-29 says No.
-    EXPECT_TRUE(get(0x21, 0x03).conditions.access_right_elsewhere);
+    EXPECT_TRUE(get(0x09, 0x20).conditions.network_write_protected);
+    // 21 03: 5-1-2 says OK for the access right, 5-3-29 and the 0C 01 / 0C 02 pages say
+    // No; the pages decide.
+    EXPECT_FALSE(get(0x21, 0x03).conditions.access_right_elsewhere);
     // 22 0B / 22 0C: "OK (note)" in RUN/MONITOR counts as accepted.
     EXPECT_TRUE(get(0x22, 0x0B).conditions.run);
     EXPECT_TRUE(get(0x22, 0x0C).conditions.monitor);

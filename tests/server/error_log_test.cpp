@@ -172,5 +172,19 @@ TEST(ErrorLogClear, W342_5_3_29_ClearsTheCountNotThePresentErrors) {
     EXPECT_EQ(h.send("2103 00").end_code(), 0x1001 | 0x0040);
 }
 
+// 5-3-29 ("Access right at other device: No") and the 0C 01 / 0C 02 pages' lists
+// (5-3-24, 5-3-25: 2103 "No") refuse it while another node holds the access right,
+// although the 5-1-2 matrix says OK; the holder itself may clear.
+TEST(ErrorLogClear, W342_5_3_29_RefusedWhileAnotherNodeHoldsTheAccessRight) {
+    Harness h;
+    h.plc.errors().raise(0x0201, t0);
+    h.plc.set_access_right_holder(NodeAddress{0x01, 0x63, 0x00});
+    EXPECT_EQ(h.send("2103").end_code(), 0x3001 | 0x0040);
+    EXPECT_EQ(h.plc.errors().log_size(), 1u);
+    h.plc.set_access_right_holder(client_node);
+    EXPECT_EQ(h.send("2103").end_code(), 0x0040);
+    EXPECT_EQ(h.plc.errors().log_size(), 0u);
+}
+
 }  // namespace
 }  // namespace fins::test

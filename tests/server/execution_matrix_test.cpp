@@ -119,6 +119,47 @@ TEST(ExecutionMatrix, W342_5_1_2_EveryCommandEveryModeEveryCondition) {
     EXPECT_EQ(checked, static_cast<int>(server::handlers::handler_table().size() * 7));
 }
 
+// Where a command's own page decides against the 5-1-2 matrix (command_table.cpp rows
+// marked "Page decides"): the row departs from 5-1-2 on that condition, and finsd
+// answers as the page says.
+struct PageDecides {
+    CommandCode code;
+    Condition condition;
+    bool matrix_says_ok;  // the 5-1-2 value the row departs from
+    const char* pages;
+};
+
+constexpr PageDecides page_decides[] = {
+    // 5-1-2: OK. 5-3-29 "No"; 5-3-24 / 5-3-25 lists: 2103 "No".
+    {{0x21, 0x03}, Condition::access_right, true, "5-3-29, 5-3-24, 5-3-25"},
+    // 5-1-2: Disabled for the whole row. 5-3-21 MESSAGE READ and 5-3-23 FAL/FALS READ:
+    // OK; MESSAGE CLEAR stays refused, by the 09 20 handler.
+    {{0x09, 0x20}, Condition::network_write, false, "5-3-21, 5-3-23"},
+};
+
+TEST(ExecutionMatrix, W342_5_1_2_PageDecidesExceptions) {
+    for (const auto& e : page_decides) {
+        const CommandInfo* info = find_command(e.code);
+        ASSERT_NE(info, nullptr);
+        SCOPED_TRACE(fmt::format("{:04X} {} ({})", e.code.value(), info->name, e.pages));
+        EXPECT_NE(accepted(info->conditions, e.condition), e.matrix_says_ok);
+    }
+    {  // 21 03 under another node's access right: 3001, the log is kept.
+        Harness h;
+        h.plc.errors().raise(0x0201, {});
+        set_up(h.plc, Condition::access_right, find_command({0x21, 0x03})->conditions);
+        EXPECT_EQ(h.send("2103").end_code() & 0x7F3F, 0x3001);
+        EXPECT_EQ(h.plc.errors().log_size(), 1u);
+    }
+    {  // 09 20 under network write protection: both reads answer, CLEAR is 2102.
+        Harness h;
+        set_up(h.plc, Condition::network_write, find_command({0x09, 0x20})->conditions);
+        EXPECT_EQ(h.send("0920 0001").end_code(), 0x0000);  // MESSAGE READ
+        EXPECT_EQ(h.send("0920 8001").end_code(), 0x0000);  // FAL/FALS READ
+        EXPECT_EQ(h.send("0920 4001").end_code(), 0x2102);  // MESSAGE CLEAR
+    }
+}
+
 // Every command of W342 section 5 outside file memory (22 xx) and the serial gateway
 // (28 xx) has a handler, and so went through the matrix above.
 TEST(ExecutionMatrix, W342_5_1_1_EveryNonFileCommandIsImplemented) {

@@ -1,5 +1,6 @@
 // 09 20 MESSAGE READ / MESSAGE CLEAR / FAL/FALS READ through full frames
-// (W342 5-3-21 .. 5-3-23, 5-1-2 "Disabled (MESSAGE CLEAR only)").
+// (W342 5-3-21 .. 5-3-23, 5-1-2 "Disabled (MESSAGE CLEAR only)"; the reads are
+// allowed under network write protection, 5-3-21 / 5-3-23).
 #include <gtest/gtest.h>
 
 #include <string>
@@ -74,11 +75,37 @@ TEST(MessageClear, W342_5_1_2_RefusedWhileAnotherNodeHoldsTheAccessRightReadIsNo
     EXPECT_EQ(h.plc.messages().present(), 0x00);
 }
 
-TEST(MessageClear, W342_5_1_2_NetworkWriteProtectionRefusesEveryVariant) {
+// 5-3-21 and 5-3-23: MESSAGE READ and FAL/FALS READ are "OK" under network write
+// protection; MESSAGE CLEAR stays refused (5-1-2 "Disabled") and nothing is cleared.
+TEST(MessageRead, W342_5_3_21_And_5_3_23_ReadsAreAllowedUnderNetworkWriteProtection) {
     Harness h;
+    h.plc.messages().set(0, "HELLO");
     h.plc.set_network_write_protection(true);
-    EXPECT_EQ(h.send("0920 0001").end_code(), 0x2102);
+    const auto read = h.send("0920 0001");
+    EXPECT_EQ(read.end_code(), 0x0000);
+    EXPECT_EQ(read.data_hex(), "00 01 " + text_hex("HELLO", 32));
+    EXPECT_EQ(h.send("0920 8001").end_code(), 0x0000);
     EXPECT_EQ(h.send("0920 4001").end_code(), 0x2102);
+    EXPECT_EQ(h.plc.messages().present(), 0x01);
+    // Network write protection comes first, as in the execution conditions.
+    h.plc.set_access_right_holder(NodeAddress{0x01, 0x63, 0x00});
+    EXPECT_EQ(h.send("0920 4001").end_code(), 0x2102);
+    // A local (in-process) request is not one "via networks" (5-1-2 note 5).
+    h.plc.set_access_right_holder(std::nullopt);
+    h.context.link = server::Link::local;
+    EXPECT_EQ(h.send("0920 4001").end_code(), 0x0000);
+    EXPECT_EQ(h.plc.messages().present(), 0x00);
+}
+
+// 5-3-30 logs FINS write commands: MESSAGE CLEAR is one, the two reads are not.
+TEST(MessageRead, W342_5_3_30_ReadsAreNotInTheWriteAccessLogClearIs) {
+    Harness h;
+    ASSERT_EQ(h.send("0920 0001").end_code(), 0x0000);
+    ASSERT_EQ(h.send("0920 8001").end_code(), 0x0000);
+    EXPECT_EQ(h.plc.write_access_log().size(), 0u);
+    ASSERT_EQ(h.send("0920 4001").end_code(), 0x0000);
+    ASSERT_EQ(h.plc.write_access_log().size(), 1u);
+    EXPECT_EQ(h.plc.write_access_log().at(0).command, (CommandCode{0x09, 0x20}));
 }
 
 TEST(FalFalsRead, W342_5_3_23_MessageOfThePresentError) {

@@ -32,6 +32,9 @@ struct HandlerContext {
     // Set by a handler whose data goes out with a non-zero end code: 02 01 past the
     // area end (data + 1104), 21 02 (records + 1104), 0C 01 (3001 + the holder).
     bool keep_data = false;
+    // Set by a handler whose variant is a FINS write although its command's row is not
+    // (09 20 MESSAGE CLEAR): the dispatcher logs it in the write access log (5-3-30).
+    bool write = false;
 };
 
 using HandlerFunction = EndCode (*)(HandlerContext& context, Bytes parameters, ByteWriter& out);

@@ -5,10 +5,15 @@
 // - READ: the answer echoes the requested bits, then 32 bytes per requested message in
 //   ascending order; an unregistered message reads as 32 spaces (5-3-21). No bits: the
 //   word 0000 alone.
-// - CLEAR: refused with 3001 while another device holds the access right. 5-1-2 marks
-//   09 20 "Disabled (MESSAGE CLEAR only)", so the command table accepts the code and
-//   this handler checks the clear variant itself. Clearing an unregistered message is
-//   a normal completion.
+// - READ and FAL/FALS READ are reads (5-3-21, 5-3-23: OK under network write protection
+//   and while another device holds the access right); they are not logged as writes.
+// - CLEAR: a write. The command table accepts 09 20 under every condition so that the
+//   reads pass; this handler refuses the clear variant itself, in the order of the
+//   execution conditions: network write protection 2102 (5-1-2 "Disabled"), then the
+//   access right held by another device 3001 (5-1-2 "Disabled (MESSAGE CLEAR only)",
+//   5-3-22). Like any write refused by its execution conditions it is then not logged;
+//   once past them it goes into the FINS write access log whatever its end code.
+//   Clearing an unregistered message is a normal completion.
 // - FAL/FALS READ: number 1-511 (FAL(006)/FALS(007) range); 0 or above 511 answers
 //   110C. The message of FALS n (else FAL n) while that error is present, 16 spaces
 //   otherwise (5-3-23 "no message has been registered").
@@ -29,8 +34,12 @@ EndCode read_messages(HandlerContext& context, const MessageRead& command, ByteW
 }
 
 EndCode clear_messages(HandlerContext& context, const MessageClear& command) {
-    if (context.plc.access_right_held_by_other(context.header.source))
-        return EndCode::no_access_right;
+    const auto& source = context.header.source;
+    // W342 5-1-2 note 5: only requests "via networks" (not in-process ones).
+    if (context.request.link != Link::local && context.plc.network_write_protected_from(source))
+        return EndCode::write_protected;
+    if (context.plc.access_right_held_by_other(source)) return EndCode::no_access_right;
+    context.write = true;
     context.plc.messages().clear(command.messages);
     return EndCode::normal_completion;
 }
