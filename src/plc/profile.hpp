@@ -28,6 +28,7 @@ struct UnitInfo {
     std::uint8_t unit_address = 0;  // 10-1F CPU Bus Unit, 20-7F Special I/O Unit, E1 Inner Board
     std::string model;              // up to 20 ASCII characters
     std::uint16_t bus_unit_id = 0;  // 05 01 CPU Bus Unit model ID (bits 0-14); 0: not published
+    std::string version = "V1.00";  // the unit's own 05 01 answer (W465 7-3-2 "Version")
 };
 
 // DIP switch pin 1 (UM write protection) in Profile::dip_switch: pin k is bit k-1.
@@ -37,16 +38,23 @@ struct Profile {
     // Registry key (lower case, e.g. "cj2h"); also the identity of a state file
     // (Storage::open), so two profiles with different memory layouts never share one.
     std::string name = "cj2h";
+    // The 05 01 model string as the unit answers it: CS1/CJ1/CP1 with an underscore
+    // ("CJ1M_CPU13"), CJ2 with hyphens ("CJ2H-CPU65-EIP"); see profile.cpp.
     std::string model = "CJ2H-CPU68-EIP";
-    std::string system_version = "02.00";  // 05 01 internal system version (20 ASCII)
+    std::string system_version = "01.90";  // 05 01 internal system version (20 ASCII)
 
     // 05 01 area data and CPU information (W342 5-3-15).
-    std::uint16_t program_kwords = 250;     // UM (program area) size in K words (catalogue steps)
+    // Program area size as 05 01 reports it, in K words: real units report twice the
+    // catalogue K steps (CJ2H-CPU68-EIP, 400K steps: 800 = 0320 hex). Also the UM size
+    // of 03 06..03 08 (program.hpp).
+    std::uint16_t program_kwords = 800;
     std::uint8_t iom_kbytes = 23;           // I/O memory size in K bytes ("always 23")
     std::uint8_t timer_counter_kwords = 8;  // timer/counter size (x 1024, "always 8")
     std::uint8_t dip_switch = 0;            // pin k -> bit k-1 (pin 1 = UM write protection)
-    std::uint8_t memory_card_type = 0x04;   // 00 none, 04 flash
-    std::uint16_t memory_card_kbytes = 0;   // 0 when no card is inserted
+    // The Memory Card: none when memory_card_kbytes is 0 (05 01 then answers type 00,
+    // size 0000, W342 5-3-15); otherwise its type (04 flash memory) and size in K bytes.
+    std::uint8_t memory_card_type = 0x00;
+    std::uint16_t memory_card_kbytes = 0;
     std::uint8_t racks = 1;                 // CPU Rack + expansion racks
     bool battery = true;                    // 06 01 status bit 2
     std::vector<UnitInfo> units;            // mounted units, ascending unit address
@@ -86,12 +94,19 @@ struct Profile {
     [[nodiscard]] bool accepts(const MemoryAreaSegment& segment) const noexcept;
     // True when this model answers `code` (else 0401 undefined command).
     [[nodiscard]] bool supports(CommandCode code) const noexcept;
+    // The mounted unit at `unit_address` (a unit 05 02 lists), or nullptr.
+    [[nodiscard]] const UnitInfo* unit(std::uint8_t unit_address) const noexcept;
+    // 05 01 memory card fields: type 00 and size 0000 without a card (W342 5-3-15).
+    [[nodiscard]] bool has_memory_card() const noexcept {
+        return memory_card_type != 0 && memory_card_kbytes != 0;
+    }
 };
 
 // Every profile finsd knows, CJ2H first (the default).
 std::span<const Profile> profiles() noexcept;
-// The profile whose name or model equals `name`, ignoring case ("cj2h",
-// "CJ2H-CPU68-EIP", "nx102-9000" ...); nullptr when there is none.
+// The profile whose name or model equals `name`, ignoring case and taking '-' and '_'
+// as the same ("cj2h", "CJ2H-CPU68-EIP", "CJ1M-CPU13" = "CJ1M_CPU13", "nx102-9000" ...);
+// nullptr when there is none.
 const Profile* find_profile(std::string_view name) noexcept;
 
 // CJ2H-CPU68-EIP: the default profile.

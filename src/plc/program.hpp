@@ -3,7 +3,7 @@
 //
 // Size: Profile::program_kwords K words of 1,024 words of 2 bytes (W342 5-3-15 gives
 // the program area size in K words, "1K words = 1,024 words"), so the CJ2H profile's
-// 250 K words are 512,000 bytes, addresses 00000000-0007CFFF. The program area is that
+// 800 K words are 1,638,400 bytes, addresses 00000000-0018FFFF. The program area is that
 // whole UM: its "last address" (bit 15 in a read response) is the last 4-byte unit of
 // the UM, so a reader that stops on bit 15 gets every byte. The bytes are opaque: the
 // virtual CPU does not execute them. A new UM is all zeros. The UM and the state below

@@ -15,8 +15,9 @@ namespace {
 constexpr std::size_t response_prefix_size = header_size + command_code_size + end_code_size;
 
 // Is the frame for this node? DNA 00 or ours; DA1 00 (local), ours or FF (broadcast,
-// answered like our own node); DA2 00 (the CPU Unit) or E1 when the profile has a Loop
-// Control Board (Inner Board). A wrong network or node answers 0201, any other unit 0202.
+// answered like our own node); DA2 00 (the CPU Unit), E1 when the profile has a Loop
+// Control Board (Inner Board), or any unit the profile mounts (the units 05 02 lists).
+// A wrong network or node answers 0201, a unit that is not there 0202.
 EndCode check_destination(const NodeAddress& destination, const NodeAddress& self,
                           const plc::Profile& profile) noexcept {
     if (destination.network != local_network && destination.network != self.network)
@@ -26,15 +27,21 @@ EndCode check_destination(const NodeAddress& destination, const NodeAddress& sel
         return EndCode::destination_node_not_in_network;
     if (destination.unit == inner_board_unit && profile.loop_control)
         return EndCode::normal_completion;
-    if (destination.unit != cpu_unit) return EndCode::unit_missing;
+    if (destination.unit != cpu_unit && profile.unit(destination.unit) == nullptr)
+        return EndCode::unit_missing;
     return EndCode::normal_completion;
 }
 
-// Which unit runs a command: 02 40 belongs to the Loop Control Board (seed 001), every
-// other command to the CPU Unit. A command sent to the wrong one is undefined there.
-bool served_by(std::uint8_t unit, CommandCode command) noexcept {
+// Which unit runs a command: 02 40 belongs to the Loop Control Board (seed 001); a CPU
+// Bus Unit (10-1F) answers its own 05 01 CONTROLLER DATA READ (handlers/configuration.cpp,
+// W465 7-3-2); every other command belongs to the CPU Unit. A command sent to a unit
+// that does not run it is undefined there (0401), as a present unit answers.
+bool served_by(const plc::Profile& profile, std::uint8_t unit, CommandCode command) noexcept {
     const bool board_command = command == CommandCode{0x02, 0x40};
-    return unit == inner_board_unit ? board_command : !board_command;
+    if (unit == cpu_unit) return !board_command;
+    if (unit == inner_board_unit && profile.loop_control) return board_command;
+    const bool bus_unit = unit >= 0x10 && unit <= 0x1F;
+    return bus_unit && command == CommandCode{0x05, 0x01};
 }
 
 }  // namespace
@@ -78,7 +85,7 @@ std::size_t Dispatcher::handle(Bytes request, MutableBytes out, const RequestCon
     const CommandInfo* info = find_command(command);
     const handlers::HandlerEntry* entry = handlers::find_handler(command);
     if (info == nullptr || entry == nullptr || !plc_.profile().supports(command) ||
-        !served_by(header.destination.unit, command))
+        !served_by(plc_.profile(), header.destination.unit, command))
         return answer(EndCode::undefined_command);
 
     if (const auto code = handlers::check_execution_conditions(info->conditions, plc_,

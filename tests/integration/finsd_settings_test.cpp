@@ -195,7 +195,7 @@ TEST(FinsdSettings, InitialMemoryIsCheckedAgainstTheModel) {
     const auto r = check_initial_memory(s.memory, cj1m.memory());
     ASSERT_FALSE(r);
     EXPECT_EQ(
-        r.error().rfind("t.toml:2:1: memory.\"E0_0\": cannot be written on the CJ1M-CPU13", 0), 0u)
+        r.error().rfind("t.toml:2:1: memory.\"E0_0\": cannot be written on the CJ1M_CPU13", 0), 0u)
         << r.error();
 }
 

@@ -39,6 +39,8 @@ TEST(Profiles, RegistryHoldsSixUniqueProfilesWithCj2hFirst) {
     EXPECT_EQ(Profile{}.model, cj2h().model);
 }
 
+// Names and models match ignoring case, '-' and '_' being the same: the catalogue
+// spelling ("CJ1M-CPU13") finds the model as the unit answers it ("CJ1M_CPU13").
 TEST(Profiles, NamesAndModelsMatchIgnoringCase) {
     const std::pair<const char*, const char*> cases[] = {
         {"cj2h", "cj2h"},           {"CJ2H", "cj2h"},         {"CJ2H-CPU68-EIP", "cj2h"},
@@ -67,11 +69,13 @@ struct Sizes {
 
 TEST(Profiles, SizesAndOptionsOfEveryProfile) {
     const Sizes table[] = {
-        {"cj2h", "CJ2H-CPU68-EIP", 25, 250, 512, 960, 4096, 4096, true, true, true, false, false},
-        {"cs1h", "CS1H-CPU67H", 13, 250, 512, 960, 4096, 4096, false, true, true, false, false},
-        {"cs1h-lcb", "CS1H-CPU67H", 13, 250, 512, 960, 4096, 4096, false, true, true, true, false},
-        {"cj1m", "CJ1M-CPU13", 0, 20, 512, 960, 4096, 4096, false, true, true, false, false},
-        {"cp1h", "CP1H-XA40DR-A", 0, 20, 512, 960, 4096, 4096, false, false, true, false, false},
+        // Program area = twice the catalogue K steps (profile.cpp [SCAN]): CJ2H-CPU68-EIP
+        // 400K steps, CS1H-CPU67H 250K, CJ1M-CPU13 and CP1H-XA40DR-A 20K [LF].
+        {"cj2h", "CJ2H-CPU68-EIP", 25, 800, 512, 960, 4096, 4096, true, true, true, false, false},
+        {"cs1h", "CS1H_CPU67H", 13, 500, 512, 960, 4096, 4096, false, true, true, false, false},
+        {"cs1h-lcb", "CS1H_CPU67H", 13, 500, 512, 960, 4096, 4096, false, true, true, true, false},
+        {"cj1m", "CJ1M_CPU13", 0, 40, 512, 960, 4096, 4096, false, true, true, false, false},
+        {"cp1h", "CP1H_XA40DR-A", 0, 40, 512, 960, 4096, 4096, false, false, true, false, false},
         {"nx102", "NX102-9000", 4, 0x14, 512, 0, 0, 0, false, false, false, false, true},
     };
     for (const auto& s : table) {
@@ -111,6 +115,33 @@ TEST(Profiles, MountedUnits) {
     EXPECT_FALSE(get("nx102").battery);
     EXPECT_EQ(get("cj1m").memory_card_type, 0x00);
     EXPECT_EQ(get("cs1h").memory_card_kbytes, 30720);
+    EXPECT_EQ(get("cj2h").unit(0x10), &get("cj2h").units[0]);
+    EXPECT_EQ(get("cj2h").unit(0x11), nullptr);
+}
+
+// W342 5-3-15: no memory card = type 00 and size 0000; a card = its type and size. Every
+// CS/CJ/CP profile agrees with itself (NX keeps W596 2-2's fixed type 04).
+TEST(Profiles, W342_5_3_15_MemoryCardTypeAndSizeAgree) {
+    for (const auto& p : profiles()) {
+        if (p.nx_fixed_values) continue;
+        SCOPED_TRACE(p.name);
+        EXPECT_EQ(p.memory_card_type == 0x00, p.memory_card_kbytes == 0);
+        EXPECT_EQ(p.has_memory_card(), p.memory_card_kbytes != 0);
+    }
+    EXPECT_FALSE(get("cj2h").has_memory_card());
+    EXPECT_TRUE(get("cs1h").has_memory_card());
+    EXPECT_FALSE(get("cp1h").has_memory_card());  // a Memory Cassette, not a card
+}
+
+// Model strings as the units answer 05 01 (profile.cpp [LF], [SCAN]): CS1/CJ1/CP1 with
+// an underscore, CJ2 with hyphens; CJ2 unit versions 1.x.
+TEST(Profiles, ModelStringsAndVersionsAsRealUnitsAnswer) {
+    EXPECT_EQ(get("cj2h").model, "CJ2H-CPU68-EIP");
+    EXPECT_EQ(get("cj2h").system_version, "01.90");
+    EXPECT_EQ(get("cs1h").model, "CS1H_CPU67H");
+    EXPECT_EQ(get("cj1m").model, "CJ1M_CPU13");
+    EXPECT_EQ(get("cj1m").system_version, "04.10");
+    EXPECT_EQ(get("cp1h").model, "CP1H_XA40DR-A");
 }
 
 // W596 2-2: exactly 0101-0105, 0501, 0601, 0701, 0702 on an NX CPU Unit.

@@ -1,5 +1,6 @@
 // CPU UNIT DATA READ 05 01 and CONNECTION DATA READ 05 02 through the dispatcher with
 // full frames (W342 5-3-15, 5-3-16; W596 2-2 NX fixed values).
+#include <fmt/core.h>
 #include <gtest/gtest.h>
 
 #include "fins/commands/configuration.hpp"
@@ -11,8 +12,8 @@ namespace {
 plc::Profile with_units() {
     plc::Profile p = plc::cj2h();
     p.model = "CJ2H-CPU68-EIP";
-    p.system_version = "02.00";
-    p.program_kwords = 250;
+    p.system_version = "01.90";
+    p.program_kwords = 800;
     p.em_banks = 25;
     p.memory_card_type = 0x04;
     p.memory_card_kbytes = 0x0800;
@@ -30,28 +31,30 @@ std::string ascii(const std::vector<std::uint8_t>& d, std::size_t offset, std::s
                        d.begin() + static_cast<std::ptrdiff_t>(offset + n));
 }
 
-TEST(CpuUnitDataReadHandler, W342_5_3_15_AllDataIs161BytesWithTheEndCode) {
+// W342 5-3-15: remote I/O data "is returned in a single byte": 158 data bytes after
+// the end code, as real CS/CJ/CP CPU Units answer (and libfins requires).
+TEST(CpuUnitDataReadHandler, W342_5_3_15_AllDataIs158BytesAfterTheEndCode) {
     Harness h(with_units());
     const auto r = h.send("0501");
     ASSERT_EQ(r.end_code(), 0x0000);
     const auto d = r.data();
-    ASSERT_EQ(d.size(), 159U);
-    EXPECT_EQ(r.frame.size(), header_size + 2 + 2 + 159);  // 2 + 159 = the diagram's 161
+    ASSERT_EQ(d.size(), 158U);
+    EXPECT_EQ(r.frame.size(), header_size + 2 + 2 + 158);
     EXPECT_EQ(ascii(d, 0, 20), "CJ2H-CPU68-EIP      ");
-    EXPECT_EQ(ascii(d, 20, 5), "02.00");
+    EXPECT_EQ(ascii(d, 20, 5), "01.90");
     EXPECT_EQ(d[25], 0x00);  // version padded with NULs
     EXPECT_EQ(d[40], 0x00);  // DIP switch
     EXPECT_EQ(d[41], 0x18);  // largest EM bank: 24
-    EXPECT_EQ(to_hex(Bytes(d).subspan(80, 12)), "00 FA 17 80 00 08 19 00 00 04 08 00");
+    EXPECT_EQ(to_hex(Bytes(d).subspan(80, 12)), "03 20 17 80 00 08 19 00 00 04 08 00");
     // CPU Bus Unit 0 (unit address 10) and 15 (1F); the Special I/O Unit is not one.
     EXPECT_EQ(to_hex(Bytes(d).subspan(92, 4)), "81 23 00 00");
     EXPECT_EQ(to_hex(Bytes(d).subspan(122, 2)), "80 45");
-    EXPECT_EQ(to_hex(Bytes(d).subspan(156, 3)), "00 00 02");  // remote I/O 00 00, 2 racks
+    EXPECT_EQ(to_hex(Bytes(d).subspan(156, 2)), "00 02");  // remote I/O 00, 2 racks
     // The client decodes what the server sent.
     const auto decoded = CpuUnitDataRead{}.decode_response(d);
     ASSERT_TRUE(decoded);
     EXPECT_EQ(decoded->model, "CJ2H-CPU68-EIP");
-    EXPECT_EQ(decoded->area.program_kwords, 250);
+    EXPECT_EQ(decoded->area.program_kwords, 800);
     EXPECT_EQ(decoded->racks, 2);
 }
 
@@ -102,18 +105,108 @@ TEST(CpuUnitDataReadHandler, W596_2_2_NxReturnsFixedValues) {
     p.memory_card_kbytes = 0x1234;  // a card is inserted
     Harness h(p);
     auto d = h.send("0501").data();
-    ASSERT_EQ(d.size(), 159U);
+    ASSERT_EQ(d.size(), 158U);
     EXPECT_EQ(ascii(d, 0, 10), "NX102-9000");
     EXPECT_EQ(d[40], 0x00);                                  // DIP switch: 0
     EXPECT_EQ(to_hex(Bytes(d).subspan(80, 2)), "00 14");     // program area: 14 hex
     EXPECT_EQ(d[85], 0x08);                                  // timer/counter: 08
     EXPECT_EQ(to_hex(Bytes(d).subspan(89, 3)), "04 FF FF");  // SD card, inserted
-    EXPECT_EQ(to_hex(Bytes(d).subspan(156, 2)), "00 00");    // remote I/O: 0
+    EXPECT_EQ(d[156], 0x00);                                 // remote I/O: 0
 
     p.memory_card_kbytes = 0;  // no card
     Harness without(p);
     d = without.send("0501").data();
     EXPECT_EQ(to_hex(Bytes(d).subspan(89, 3)), "04 00 00");
+}
+
+// W342 5-3-15 "Memory card type 00: No memory card", "Memory card size ... 0000 if
+// there is no memory card": type and size agree on every CS/CJ/CP profile.
+TEST(CpuUnitDataReadHandler, W342_5_3_15_NoCardIsType00Size0000ACardItsTypeAndSize) {
+    plc::Profile p = with_units();
+    p.memory_card_type = 0x04;
+    p.memory_card_kbytes = 0;  // a type but no size: no card
+    Harness without(p);
+    EXPECT_EQ(to_hex(Bytes(without.send("0501 00").data()).subspan(89, 3)), "00 00 00");
+    for (const auto& profile : plc::profiles()) {
+        if (profile.nx_fixed_values) continue;
+        SCOPED_TRACE(profile.name);
+        Harness h(profile);
+        const auto d = h.send("0501 00").data();
+        const bool card = d[89] != 0x00;
+        EXPECT_EQ(card, d[90] != 0x00 || d[91] != 0x00);
+        EXPECT_EQ(card, profile.memory_card_kbytes != 0);
+        if (card) {
+            EXPECT_EQ(d[89], 0x04);  // flash memory
+            EXPECT_EQ((d[90] << 8) | d[91], profile.memory_card_kbytes);
+        }
+    }
+    // The CS1H profile's 30 MB flash card.
+    Harness cs1h(*plc::find_profile("cs1h"));
+    EXPECT_EQ(to_hex(Bytes(cs1h.send("0501 00").data()).subspan(89, 3)), "04 78 00");
+}
+
+// 11a: program area size = twice the catalogue K steps, as real units report it;
+// model strings with an underscore on CS1/CJ1/CP1, hyphens on CJ2 (profile.cpp).
+TEST(CpuUnitDataReadHandler, RealUnitsProgramAreaSizeAndModelStrings) {
+    const struct {
+        const char* profile;
+        const char* model;
+        const char* version;
+        const char* program_area;
+    } expected[] = {
+        {"cj2h", "CJ2H-CPU68-EIP", "01.90", "03 20"},  // 400K steps
+        {"cs1h", "CS1H_CPU67H", "04.00", "01 F4"},     // 250K steps
+        {"cj1m", "CJ1M_CPU13", "04.10", "00 28"},      // 20K steps
+        {"cp1h", "CP1H_XA40DR-A", "01.00", "00 28"},   // 20K steps
+    };
+    for (const auto& e : expected) {
+        SCOPED_TRACE(e.profile);
+        Harness h(*plc::find_profile(e.profile));
+        const auto d = h.send("0501 00").data();
+        ASSERT_EQ(d.size(), 92U);
+        EXPECT_EQ(ascii(d, 0, 20), fmt::format("{:<20}", e.model));
+        EXPECT_EQ(ascii(d, 20, 5), e.version);
+        EXPECT_EQ(to_hex(Bytes(d).subspan(80, 2)), e.program_area);
+    }
+}
+
+// A unit 05 02 lists is present (not 0202). A CPU Bus Unit answers its own 05 01
+// CONTROLLER DATA READ (W465 7-3-2: model, version, IP address, subnet mask, FINS UDP
+// port, mode setting, Ethernet address) and 0401 to everything else; so do the other
+// listed units (Special I/O Units, Inner Boards other than the Loop Control Board).
+TEST(UnitPresence, ListedUnitsArePresentCpuBusUnitAnswersItsControllerData) {
+    Harness h(with_units());
+    FrameFields to;
+    to.destination.unit = 0x10;
+    const auto r = h.send("0501", to);
+    ASSERT_EQ(r.end_code() & 0x7F3F, 0x0000);
+    EXPECT_EQ(r.header().source.unit, 0x10);
+    const auto d = r.data();
+    ASSERT_EQ(d.size(), 58U);
+    EXPECT_EQ(ascii(d, 0, 20), "CJ1W-ETN21          ");
+    EXPECT_EQ(ascii(d, 20, 20), fmt::format("{:<20}", "V1.00"));
+    EXPECT_EQ(to_hex(Bytes(d).subspan(40, 18)),
+              "00 00 00 00 00 00 00 00 25 80 00 00 00 00 00 00 00 00");
+    EXPECT_EQ(h.send("0501 00", to).end_code(), 0x1001);
+    EXPECT_EQ(h.send("0101 82000000 0001", to).end_code(), 0x0401);
+    EXPECT_EQ(h.send("0502 00", to).end_code(), 0x0401);
+    for (std::uint8_t unit : {std::uint8_t{0x1F}, std::uint8_t{0x20}, std::uint8_t{0xE1}}) {
+        FrameFields other;
+        other.destination.unit = unit;
+        EXPECT_EQ(h.send("0101 82000000 0001", other).end_code(), 0x0401) << int{unit};
+        EXPECT_EQ(h.send("0501", other).end_code(), unit == 0x1F ? 0x0000 : 0x0401) << int{unit};
+    }
+    // Unlisted units are missing.
+    for (std::uint8_t unit : {std::uint8_t{0x11}, std::uint8_t{0x21}, std::uint8_t{0xFE}}) {
+        FrameFields missing;
+        missing.destination.unit = unit;
+        EXPECT_EQ(h.send("0501", missing).end_code(), 0x0202) << int{unit};
+    }
+    // The default profile's built-in EtherNet/IP port (unit 10).
+    Harness cj2h;
+    const auto port = cj2h.send("0501", to);
+    EXPECT_EQ(port.end_code() & 0x7F3F, 0x0000);
+    EXPECT_EQ(ascii(port.data(), 0, 10), "CJ2B-EIP21");
 }
 
 TEST(ConnectionDataReadHandler, W342_5_3_16_AllUnitsFromTheCpuUnit) {

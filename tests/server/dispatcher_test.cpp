@@ -63,10 +63,11 @@ TEST(Dispatcher, W342_5_1_3_WrongNetworkOrNodeIs0201) {
     EXPECT_EQ(h.send(read_d10, f).end_code(), 0x0201);
 }
 
-// Choice: only the CPU Unit (DA2 00) is served; any other unit, FE included, is 0202.
+// A unit the profile does not mount, FE included, is 0202 (the CJ2H's unit 10, its
+// built-in EtherNet/IP port, is present: tests/server/configuration_test.cpp).
 TEST(Dispatcher, W342_5_1_3_UnitOtherThanCpuIs0202) {
     Harness h;
-    for (std::uint8_t unit : std::array<std::uint8_t, 4>{0x01, 0x10, 0xE1, 0xFE}) {
+    for (std::uint8_t unit : std::array<std::uint8_t, 4>{0x01, 0x11, 0xE1, 0xFE}) {
         FrameFields f;
         f.destination.unit = unit;
         const auto reply = h.send(read_d10, f);

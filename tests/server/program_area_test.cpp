@@ -174,7 +174,8 @@ TEST(ProgramAreaRead, W342_5_3_10_ReadingTheWholeUmIn992ByteBlocksEndsOnBit15) {
     std::uint32_t address = 0;
     bool last = false;
     std::size_t blocks = 0;
-    for (; !last && blocks < 1000; ++blocks) {
+    // CJ2H: 800 K words = 1,638,400 bytes = 1,652 blocks of 992 bytes.
+    for (; !last && blocks < 2000; ++blocks) {
         const auto r = h.send(fmt::format("0306 FFFF {:08X} 03E0", address));
         ASSERT_TRUE(r.end_code() == 0x0000 || r.end_code() == 0x1104) << r.end_code();
         const auto d = r.data();

@@ -1,6 +1,14 @@
 // 05 xx machine configuration reading: CPU UNIT DATA READ 05 01, CONNECTION DATA READ
 // 05 02 (W342 5-3-15, 5-3-16). Everything comes from the Profile; both are accepted in
 // every mode and under every protection (5-1-2).
+//
+// 05 01 sent to a CPU Bus Unit the profile lists (unit address 10-1F, dispatcher.cpp)
+// is that unit's own CONTROLLER DATA READ (Ethernet Units, W465 7-3-2): model and
+// version (20 ASCII characters each, space padded), IP address, subnet mask, FINS UDP
+// port number, mode setting, Ethernet address = 58 bytes; any parameter is 1001.
+// finsd does not model the unit's network settings: IP address, subnet mask and
+// Ethernet address are 0, the port is the default 9600 and the mode setting 0000
+// ("default" port, automatic address generation).
 #include <optional>
 
 #include "fins/commands/configuration.hpp"
@@ -23,6 +31,11 @@ constexpr std::uint8_t nx_timer_counter_kwords = 0x08;
 constexpr std::uint8_t nx_memory_card_type = 0x04;  // SD Memory Card, present or not
 constexpr std::uint16_t nx_card_inserted_size = 0xFFFF;
 
+// W465 7-3-2: a CPU Bus Unit's CONTROLLER DATA READ answer after model and version.
+constexpr std::size_t unit_address_bytes = 4;  // IP address, then subnet mask
+constexpr std::uint16_t unit_fins_udp_port = 9600;
+constexpr std::size_t unit_ethernet_address_bytes = 6;
+
 CpuUnitDataReadResponse cpu_unit_data(const plc::Plc& plc,
                                       std::optional<CpuUnitDataSection> section) {
     const auto& p = plc.profile();
@@ -38,8 +51,9 @@ CpuUnitDataReadResponse cpu_unit_data(const plc::Plc& plc,
     r.area.dm_words = static_cast<std::uint16_t>(p.dm_words > 0xFFFF ? 0xFFFF : p.dm_words);
     r.area.timer_counter_kwords = p.timer_counter_kwords;
     r.area.em_non_file_banks = p.em_banks;  // no EM bank is formatted as file memory
-    r.area.memory_card_type = p.memory_card_type;
-    r.area.memory_card_kbytes = p.memory_card_kbytes;
+    // W342 5-3-15: no memory card = type 00 and size 0000.
+    r.area.memory_card_type = p.has_memory_card() ? p.memory_card_type : 0x00;
+    r.area.memory_card_kbytes = p.has_memory_card() ? p.memory_card_kbytes : 0;
     for (const auto& unit : p.units) {
         if (unit.unit_address < first_bus_unit || unit.unit_address > last_bus_unit) continue;
         r.bus_units[unit.unit_address - first_bus_unit] = static_cast<std::uint16_t>(
@@ -75,11 +89,31 @@ std::optional<Found> unit_at_or_after(const plc::Profile& p, unsigned from) {
     return best;
 }
 
+// W465 7-3-2 (see the top of this file).
+EndCode unit_controller_data(const plc::UnitInfo& unit, const CpuUnitDataRead& command,
+                             ByteWriter& out) {
+    if (command.section) return EndCode::command_too_long;
+    out.text(unit.model, cpu_model_size, 0x20);
+    out.text(unit.version, cpu_version_size, 0x20);
+    out.text({}, 2 * unit_address_bytes, 0x00);
+    out.u16(unit_fins_udp_port);
+    out.u16(0x0000);  // mode setting
+    out.text({}, unit_ethernet_address_bytes, 0x00);
+    return EndCode::normal_completion;
+}
+
 }  // namespace
 
 // W342 5-3-15. Selector 00: model .. area data; 01: CPU Bus Units .. CPU information;
-// none: all (159 data bytes, the 2-byte remote I/O field of the W342 diagram).
+// none: all (158 data bytes: the remote I/O data is "a single byte").
 EndCode execute(HandlerContext& context, const CpuUnitDataRead& command, ByteWriter& out) {
+    const auto unit = context.header.destination.unit;
+    if (unit != cpu_unit) {
+        const plc::UnitInfo* info = context.plc.profile().unit(unit);
+        // The dispatcher routes only listed CPU Bus Units here.
+        if (info == nullptr) return EndCode::unit_missing;
+        return unit_controller_data(*info, command, out);
+    }
     cpu_unit_data(context.plc, command.section).encode(out);
     return EndCode::normal_completion;
 }
