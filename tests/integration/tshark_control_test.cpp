@@ -10,9 +10,13 @@
 //   07 02 with 6 bytes                  -> "Unexpected Length" (it expects 5 or 7)
 // The `fins` CLI sends the variants the dissector knows wherever W342 offers a choice
 // (RUN with FFFF + mode, STOP without a program number, CLOCK WRITE with 7 bytes).
+// Its 05 01 responses follow the CV-series layout too (2-byte remote I/O data: 161 and
+// 69 bytes with the end code). finsd answers as W342 5-3-15 and real CS/CJ/CP units do,
+// remote I/O "in a single byte" (160 and 68 bytes), so the dissector flags the full and
+// the selector-01 answers "Unexpected Length" and decodes no field of them.
 // Also, the dissector types the 40-byte "for system use" block of 05 01 as a string:
 // DIP switch 00 followed by the largest EM bank (18 on a CJ2H) reads as "Trailing stray
-// characters", a warning on those responses only.
+// characters", a warning on the selector-00 responses only.
 //
 // Needs tshark and permission to capture on `lo`; skipped otherwise.
 #include <filesystem>
@@ -117,11 +121,15 @@ TEST(TsharkControl, DissectorReadsModeConfigurationCycleTimeAndClockTraffic) {
 
     std::map<std::string, int> commands, end_codes, modes, malformed;
     int stray = 0;
+    int one_byte_remote_io = 0;  // 05 01 answers the CV-series dissector finds short
     for (const auto& r : rows) {
         ++commands[r.command];
         if (!r.end_code.empty()) ++end_codes[r.end_code];
         if (!r.mode.empty()) ++modes[r.mode];
         if (!r.malformed.empty()) ++malformed[r.command];
+        // (It reads no end code from them either.)
+        if (r.command == "0x0501" && !r.malformed.empty() && r.message == "Unexpected Length")
+            ++one_byte_remote_io;
         if (r.command == "0x0f01" || !r.malformed.empty()) continue;
         if (r.message == "Trailing stray characters") {
             ++stray;
@@ -133,9 +141,11 @@ TEST(TsharkControl, DissectorReadsModeConfigurationCycleTimeAndClockTraffic) {
                 EXPECT_LT(std::stol(s), severity_warning) << r.command << r.message;
             }
     }
-    // Malformed: exactly the four dissector-limited requests, nothing else.
+    // Malformed: exactly the four dissector-limited requests and the three 05 01 answers
+    // with a one-byte remote I/O field (selector 01 on each transport, all over UDP).
     EXPECT_EQ(malformed, (std::map<std::string, int>{
-                             {"0x0401", 1}, {"0x0402", 1}, {"0x0501", 1}, {"0x0702", 1}}));
+                             {"0x0401", 1}, {"0x0402", 1}, {"0x0501", 1 + 3}, {"0x0702", 1}}));
+    EXPECT_EQ(one_byte_remote_io, 2 + 1);
     // Each exchange crossed as request + response.
     EXPECT_EQ(commands["0x0401"], 2 * 2 * 4 + 2);
     EXPECT_EQ(commands["0x0402"], 2 * 2 + 2);
@@ -148,7 +158,7 @@ TEST(TsharkControl, DissectorReadsModeConfigurationCycleTimeAndClockTraffic) {
     EXPECT_EQ(modes["0x04"], 2);  // RUN FFFF 04
     EXPECT_EQ(modes["0x03"], 2);  // the refused mode byte
     EXPECT_EQ(end_codes["0x110c"], 2 * 2);
-    // Model of the CPU Unit in the 05 01 responses (selector 00 and all): 2 + 1.
+    // Model of the CPU Unit in the 05 01 responses it decodes (selector 00): 2.
     int models = 0;
     int unit_counts = 0;
     int averages = 0;
@@ -160,7 +170,7 @@ TEST(TsharkControl, DissectorReadsModeConfigurationCycleTimeAndClockTraffic) {
         // CLOCK WRITE requests: BCD 30 for 2030, which the dissector prints as 48 (0x30).
         if (r.command == "0x0702" && r.end_code.empty() && r.year == "48") ++years;
     }
-    EXPECT_EQ(models, 2 + 1);
+    EXPECT_EQ(models, 2);
     EXPECT_EQ(stray, models);
     EXPECT_EQ(unit_counts, 2 * 1 + 2 * 2);  // the requests with a count + every response
     EXPECT_EQ(averages, 2);
