@@ -139,13 +139,14 @@ TEST(CliProgramArea, W342_5_3_11_WriteReadBackAndClear) {
     EXPECT_EQ(dump.exit_code, 0) << dump.err;
     EXPECT_EQ(dump.out.substr(0, 13), "00000010  73 ");  // 16 x 7 + 3
 
-    // Without BYTES the read runs to the last address (bit 15): 20K words = 40,960 bytes.
+    // Without BYTES the read runs to the last address (bit 15): the CJ1M-CPU13's program
+    // area of 40 K words (20K steps, as 05 01 reports it) = 81,920 bytes.
     auto whole = d.fins({"program-read", "--out", back.string(), "--json"});
     ASSERT_EQ(whole.exit_code, 0) << whole.err;
     auto doc = nlohmann::json::parse(whole.out);
-    EXPECT_EQ(doc["bytes"], 40960);
+    EXPECT_EQ(doc["bytes"], 81920);
     EXPECT_EQ(doc["last"], true);
-    EXPECT_EQ(std::filesystem::file_size(back), 40960u);
+    EXPECT_EQ(std::filesystem::file_size(back), 81920u);
 
     auto c = d.fins({"program-clear", "--with-interrupt-tasks"});
     EXPECT_EQ(c.exit_code, 0) << c.err;
