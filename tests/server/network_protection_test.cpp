@@ -97,6 +97,23 @@ TEST(NetworkWriteProtection, AllExceptListedLetsOnlyTheListedNodesWrite) {
     EXPECT_EQ(h.send(write_d0, from(1, 20)).end_code(), 0x2102);
 }
 
+// 09 20 under protection for listed nodes: the reads pass for everyone (5-3-21,
+// 5-3-23); MESSAGE CLEAR is refused for a listed node only, and only it is logged.
+TEST(NetworkWriteProtection, W342_5_3_21_MessageReadsPassMessageClearFollowsTheSource) {
+    Harness h;
+    h.plc.messages().set(0, "A");
+    protect(h, NetworkWriteProtection::listed, {NodeAddress{1, 20, 0}});
+    EXPECT_EQ(h.send("0920 0001", from(1, 20)).end_code(), 0x0000);
+    EXPECT_EQ(h.send("0920 8001", from(1, 20)).end_code(), 0x0000);
+    EXPECT_EQ(h.send("0920 4001", from(1, 20)).end_code(), 0x2102);
+    EXPECT_EQ(h.plc.messages().present(), 0x01);
+    EXPECT_EQ(h.plc.write_access_log().size(), 0u);
+    EXPECT_EQ(h.send("0920 4001", from(1, 21)).end_code(), 0x0000);
+    EXPECT_EQ(h.plc.messages().present(), 0x00);
+    ASSERT_EQ(h.plc.write_access_log().size(), 1u);
+    EXPECT_EQ(h.plc.write_access_log().at(0).source, (NodeAddress{1, 21, 0}));
+}
+
 TEST(NetworkWriteProtection, AtMost32NodesAreKept) {
     Harness h;
     std::vector<NodeAddress> nodes;
