@@ -55,9 +55,9 @@ struct Profile {
     // size 0000, W342 5-3-15); otherwise its type (04 flash memory) and size in K bytes.
     std::uint8_t memory_card_type = 0x00;
     std::uint16_t memory_card_kbytes = 0;
-    std::uint8_t racks = 1;                 // CPU Rack + expansion racks
-    bool battery = true;                    // 06 01 status bit 2
-    std::vector<UnitInfo> units;            // mounted units, ascending unit address
+    std::uint8_t racks = 1;       // CPU Rack + expansion racks
+    bool battery = true;          // 06 01 status bit 2
+    std::vector<UnitInfo> units;  // mounted units, ascending unit address
 
     // The commands this model answers (MRC << 8 | SRC); empty = every command of the
     // W342 table. NX CPU Units answer only the W596 2-2 subset and 0401 for the rest.

@@ -49,9 +49,9 @@ TEST(CommandTable, EveryCommandOf511AndTheLoopControlItemRead) {
 // accepted: its reads are allowed (5-3-21, 5-3-23), its handler refuses MESSAGE CLEAR.
 TEST(CommandTable, NetworkWriteProtection) {
     const std::set<std::uint16_t> refused{0x0102, 0x0103, 0x0105, 0x0202, 0x0203, 0x0307, 0x0308,
-                                          0x0401, 0x0402, 0x0702, 0x0C01, 0x2101, 0x2103,
-                                          0x2141, 0x2203, 0x2204, 0x2205, 0x2207, 0x2208, 0x220A,
-                                          0x220B, 0x220C, 0x2215, 0x2220, 0x2301, 0x2302};
+                                          0x0401, 0x0402, 0x0702, 0x0C01, 0x2101, 0x2103, 0x2141,
+                                          0x2203, 0x2204, 0x2205, 0x2207, 0x2208, 0x220A, 0x220B,
+                                          0x220C, 0x2215, 0x2220, 0x2301, 0x2302};
     for (const auto& c : command_table())
         EXPECT_EQ(c.conditions.network_write_protected, refused.count(c.code.value()) == 0)
             << c.name;
@@ -62,8 +62,8 @@ TEST(CommandTable, NetworkWriteProtection) {
 // refused although 5-1-2 says OK: 5-3-29 and the 0C 01 / 0C 02 pages say No.
 TEST(CommandTable, AccessRightHeldElsewhere) {
     const std::set<std::uint16_t> refused{0x0202, 0x0203, 0x0307, 0x0308, 0x0401, 0x0402, 0x0702,
-                                          0x2101, 0x2103, 0x2141, 0x2203, 0x2204, 0x2205, 0x2207, 0x2208,
-                                          0x220A, 0x220B, 0x220C, 0x2215, 0x2220};
+                                          0x2101, 0x2103, 0x2141, 0x2203, 0x2204, 0x2205, 0x2207,
+                                          0x2208, 0x220A, 0x220B, 0x220C, 0x2215, 0x2220};
     for (const auto& c : command_table())
         EXPECT_EQ(c.conditions.access_right_elsewhere, refused.count(c.code.value()) == 0)
             << c.name;

@@ -41,7 +41,7 @@ inline constexpr std::size_t cpu_system_use_size = 40;  // DIP switch, largest E
 inline constexpr std::size_t cpu_area_data_size = 12;
 inline constexpr std::size_t cpu_bus_unit_slots = 16;       // unit numbers 0-15
 inline constexpr std::size_t cpu_bus_unit_block_size = 64;  // 16 x 2 bytes + 32 reserved
-inline constexpr std::size_t cpu_remote_io_size = 1;      // W342 5-3-15 "a single byte"
+inline constexpr std::size_t cpu_remote_io_size = 1;        // W342 5-3-15 "a single byte"
 inline constexpr std::size_t cpu_model_and_area_size =
     cpu_model_size + cpu_version_size + cpu_system_use_size + cpu_area_data_size;  // 92
 inline constexpr std::size_t cpu_units_and_info_size =
