@@ -20,7 +20,8 @@
 //            catalogue K steps, CJ2 model strings keep their hyphens (libfins' own
 //            "CJ2H_CPU68-EIP" spelling is not what the units send), and CJ2 versions are
 //            1.x (CJ2H) / 2.x (CJ2M).
-//   [W465]   CS1W-ETN21/CJ1W-ETN21 manual 7-3-2: a CPU Bus Unit's own 05 01 answer.
+//   [W421]   CS1W-ETN21/CJ1W-ETN21 Ethernet Units manual 7-3-2: a CPU Bus Unit's own
+//            05 01 answer (model, version "V1.20" in its example).
 // Figures no source above gives are choices, marked "choice" (README, PLC profiles).
 #include "plc/profile.hpp"
 

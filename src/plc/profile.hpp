@@ -28,7 +28,7 @@ struct UnitInfo {
     std::uint8_t unit_address = 0;  // 10-1F CPU Bus Unit, 20-7F Special I/O Unit, E1 Inner Board
     std::string model;              // up to 20 ASCII characters
     std::uint16_t bus_unit_id = 0;  // 05 01 CPU Bus Unit model ID (bits 0-14); 0: not published
-    std::string version = "V1.00";  // the unit's own 05 01 answer (W465 7-3-2 "Version")
+    std::string version = "V1.00";  // the unit's own 05 01 answer (W421 7-3-2 "Version")
 };
 
 // DIP switch pin 1 (UM write protection) in Profile::dip_switch: pin k is bit k-1.

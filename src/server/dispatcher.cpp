@@ -34,7 +34,7 @@ EndCode check_destination(const NodeAddress& destination, const NodeAddress& sel
 
 // Which unit runs a command: 02 40 belongs to the Loop Control Board (seed 001); a CPU
 // Bus Unit (10-1F) answers its own 05 01 CONTROLLER DATA READ (handlers/configuration.cpp,
-// W465 7-3-2); every other command belongs to the CPU Unit. A command sent to a unit
+// W421 7-3-2); every other command belongs to the CPU Unit. A command sent to a unit
 // that does not run it is undefined there (0401), as a present unit answers.
 bool served_by(const plc::Profile& profile, std::uint8_t unit, CommandCode command) noexcept {
     const bool board_command = command == CommandCode{0x02, 0x40};

@@ -171,7 +171,7 @@ TEST(CpuUnitDataReadHandler, RealUnitsProgramAreaSizeAndModelStrings) {
 }
 
 // A unit 05 02 lists is present (not 0202). A CPU Bus Unit answers its own 05 01
-// CONTROLLER DATA READ (W465 7-3-2: model, version, IP address, subnet mask, FINS UDP
+// CONTROLLER DATA READ (W421 7-3-2: model, version, IP address, subnet mask, FINS UDP
 // port, mode setting, Ethernet address) and 0401 to everything else; so do the other
 // listed units (Special I/O Units, Inner Boards other than the Loop Control Board).
 TEST(UnitPresence, ListedUnitsArePresentCpuBusUnitAnswersItsControllerData) {

@@ -3,7 +3,7 @@
 // every mode and under every protection (5-1-2).
 //
 // 05 01 sent to a CPU Bus Unit the profile lists (unit address 10-1F, dispatcher.cpp)
-// is that unit's own CONTROLLER DATA READ (Ethernet Units, W465 7-3-2): model and
+// is that unit's own CONTROLLER DATA READ (Ethernet Units, W421 7-3-2): model and
 // version (20 ASCII characters each, space padded), IP address, subnet mask, FINS UDP
 // port number, mode setting, Ethernet address = 58 bytes; any parameter is 1001.
 // finsd does not model the unit's network settings: IP address, subnet mask and
@@ -31,7 +31,7 @@ constexpr std::uint8_t nx_timer_counter_kwords = 0x08;
 constexpr std::uint8_t nx_memory_card_type = 0x04;  // SD Memory Card, present or not
 constexpr std::uint16_t nx_card_inserted_size = 0xFFFF;
 
-// W465 7-3-2: a CPU Bus Unit's CONTROLLER DATA READ answer after model and version.
+// W421 7-3-2: a CPU Bus Unit's CONTROLLER DATA READ answer after model and version.
 constexpr std::size_t unit_address_bytes = 4;  // IP address, then subnet mask
 constexpr std::uint16_t unit_fins_udp_port = 9600;
 constexpr std::size_t unit_ethernet_address_bytes = 6;
@@ -89,7 +89,7 @@ std::optional<Found> unit_at_or_after(const plc::Profile& p, unsigned from) {
     return best;
 }
 
-// W465 7-3-2 (see the top of this file).
+// W421 7-3-2 (see the top of this file).
 EndCode unit_controller_data(const plc::UnitInfo& unit, const CpuUnitDataRead& command,
                              ByteWriter& out) {
     if (command.section) return EndCode::command_too_long;
