@@ -94,6 +94,7 @@ class RawTcp {
         std::error_code ec;
         socket_.close(ec);
     }
+    [[nodiscard]] int native_handle() { return socket_.native_handle(); }
     // Why the last receive_packet() came back empty (eof = the peer's FIN).
     [[nodiscard]] std::error_code last_error() const { return last_error_; }
 

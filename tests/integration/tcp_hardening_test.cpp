@@ -3,6 +3,11 @@
 // handshake checks, closing after a refusal without a reset, and the deadlines and
 // cap that keep stalled sockets from locking other clients out. Every wait is a
 // blocking read bounded by SO_RCVTIMEO (raw_socket.hpp); no sleeps.
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <poll.h>
+#include <sys/socket.h>
+
 #include <cerrno>
 #include <functional>
 #include <memory>
@@ -84,6 +89,26 @@ std::uint8_t sid_of(const std::vector<std::uint8_t>& packet) {
 bool ends_with_fin(RawTcp& c) {
     auto rest = c.receive_packet();
     return rest.empty() && c.last_error() == asio::error::eof;
+}
+
+// After ends_with_fin(): our own shutdown must find the connection intact and end it
+// without an error. A reset from the server leaves it CLOSE (shutdown: ENOTCONN) or
+// with SO_ERROR set. Waits (bounded) until the kernel reports the connection closed.
+bool ends_without_reset(RawTcp& c) {
+    const int fd = c.native_handle();
+    if (::shutdown(fd, SHUT_WR) != 0) return false;
+    tcp_info info{};
+    for (int i = 0; i < 500; ++i) {
+        socklen_t size = sizeof info;
+        ::getsockopt(fd, IPPROTO_TCP, TCP_INFO, &info, &size);
+        if (info.tcpi_state == TCP_CLOSE) break;
+        pollfd p{fd, POLLERR, 0};
+        ::poll(&p, 1, 10);
+    }
+    int error = 0;
+    socklen_t size = sizeof error;
+    ::getsockopt(fd, SOL_SOCKET, SO_ERROR, &error, &size);
+    return info.tcpi_state == TCP_CLOSE && error == 0;
 }
 
 TEST(TcpIdentity, W421_7_4_FrameFromAnotherNodeIsNotExecuted) {
@@ -178,6 +203,7 @@ TEST(TcpHandshake, RefusalIsFollowedByFinNotResetWhenThePeerKeepsSending) {
         ASSERT_EQ(r.size(), 24u);
         EXPECT_EQ(be32(r, 12), 0x23u);
         EXPECT_TRUE(ends_with_fin(c));
+        EXPECT_TRUE(ends_without_reset(c));
     }
     auto c = finsd.connect();
     ASSERT_EQ(be32(c.handshake(), 12), 0u);
@@ -189,6 +215,7 @@ TEST(TcpHandshake, RefusalIsFollowedByFinNotResetWhenThePeerKeepsSending) {
     ASSERT_EQ(r.size(), 16u);
     EXPECT_EQ(be32(r, 8), 3u);
     EXPECT_TRUE(ends_with_fin(c));
+    EXPECT_TRUE(ends_without_reset(c));
 }
 
 TEST(TcpLimits, SilentSocketIsClosedAtTheHandshakeDeadline) {
