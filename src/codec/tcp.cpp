@@ -85,7 +85,8 @@ Result<std::uint8_t> decode_node_address_request(Bytes data) noexcept {
     // range as a whole, not its low byte.
     ByteReader r(data);
     const std::uint32_t node = r.u32();
-    if (node > max_client_node) return Unexpected(make_error_code(TcpError::client_node_out_of_range));
+    if (node > max_client_node)
+        return Unexpected(make_error_code(TcpError::client_node_out_of_range));
     return static_cast<std::uint8_t>(node);
 }
 

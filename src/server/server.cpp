@@ -4,6 +4,7 @@
 #include <array>
 #include <chrono>
 #include <list>
+#include <optional>
 
 #include <spdlog/spdlog.h>
 #include <asio/ip/tcp.hpp>
@@ -72,8 +73,11 @@ struct Server::Impl {
                 return;
             }
             if (accept_failures > 0) {
-                spdlog::warn("fins/tcp: accepting again after {} failed attempts", accept_failures);
+                if (accept_episode_logged)
+                    spdlog::warn("fins/tcp: accepting again after {} failed attempts",
+                                 accept_failures);
                 accept_failures = 0;
+                accept_episode_logged = false;
                 accept_delay = std::chrono::milliseconds(0);
             }
             sessions.remove_if([](const std::weak_ptr<TcpSession>& w) {
@@ -108,22 +112,29 @@ struct Server::Impl {
 
     // EMFILE/ENFILE and the like leave the connection queued, so an immediate retry
     // fails again at once (a busy loop writing a log line each time). Back off instead,
-    // doubling up to accept_retry_max, and log once per accept_log_interval; UDP and
-    // open connections are served meanwhile, and accepting resumes by itself.
+    // doubling up to accept_retry_max; UDP and open connections are served meanwhile,
+    // and accepting resumes by itself. At most one failure line per accept_log_interval
+    // (a failure that flaps with short recoveries included); the recovery of a logged
+    // failure is logged once.
     void accept_failed(std::error_code ec) {
         const auto now = std::chrono::steady_clock::now();
-        if (accept_failures++ == 0) {
-            spdlog::warn("fins/tcp: accept failed: {}; retrying with a back-off of up to {} ms", ec.message(),
-                         accept_retry_max.count());
+        const bool new_episode = accept_failures++ == 0;
+        ++accept_unreported;
+        if (!accept_logged || now - *accept_logged >= accept_log_interval) {
+            if (new_episode)
+                spdlog::warn("fins/tcp: accept failed: {}; retrying with a back-off of up to {} ms",
+                             ec.message(), accept_retry_max.count());
+            else
+                spdlog::warn(
+                    "fins/tcp: accept still failing: {} ({} failures since the last "
+                    "report)",
+                    ec.message(), accept_unreported);
             accept_logged = now;
-            accept_logged_failures = 0;
-        } else if (now - accept_logged >= accept_log_interval) {
-            spdlog::warn("fins/tcp: accept still failing: {} ({} failures since the last report)",
-                         ec.message(), accept_failures - accept_logged_failures);
-            accept_logged = now;
-            accept_logged_failures = accept_failures;
+            accept_unreported = 0;
+            accept_episode_logged = true;
         }
-        accept_delay = std::clamp(accept_delay * 2, std::chrono::milliseconds(10), accept_retry_max);
+        accept_delay =
+            std::clamp(accept_delay * 2, std::chrono::milliseconds(10), accept_retry_max);
         accept_timer.expires_after(accept_delay);
         accept_timer.async_wait([this](std::error_code timer_ec) {
             if (timer_ec || !acceptor.is_open()) return;
@@ -146,9 +157,10 @@ struct Server::Impl {
     std::chrono::milliseconds accept_log_interval;
     asio::steady_timer accept_timer;
     std::chrono::milliseconds accept_delay{0};
-    std::size_t accept_failures = 0;
-    std::size_t accept_logged_failures = 0;
-    std::chrono::steady_clock::time_point accept_logged{};
+    std::size_t accept_failures = 0;    // since the last successful accept
+    std::size_t accept_unreported = 0;  // failures not yet counted in a log line
+    bool accept_episode_logged = false;
+    std::optional<std::chrono::steady_clock::time_point> accept_logged;
 };
 
 Result<std::unique_ptr<Server>> Server::start(asio::io_context& io, plc::Plc& plc,

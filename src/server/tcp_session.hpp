@@ -98,10 +98,10 @@ class TcpSession : public std::enable_shared_from_this<TcpSession> {
     Clock::time_point timer_at_ = Clock::time_point::max();
     bool timer_armed_ = false;
     std::uint64_t timer_generation_ = 0;
-    bool writing_ = false;               // a response or notice is being written
-    bool confirming_ = false;            // command 6 is being written
-    bool confirm_wanted_ = false;        // command 6 waits for the current write
-    std::size_t deferred_size_ = 0;      // a response that waits for command 6
+    bool writing_ = false;           // a response or notice is being written
+    bool confirming_ = false;        // command 6 is being written
+    bool confirm_wanted_ = false;    // command 6 waits for the current write
+    std::size_t deferred_size_ = 0;  // a response that waits for command 6
     bool deferred_close_ = false;
     bool deferred_ = false;
     bool logged_foreign_source_ = false;  // one warning per connection

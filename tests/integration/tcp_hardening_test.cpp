@@ -29,8 +29,9 @@ using namespace std::chrono_literals;
 // The real Server on its own thread, its PLC prepared before the thread starts.
 class InProcessFinsd {
   public:
-    explicit InProcessFinsd(server::ServerOptions options,
-                   const std::function<void(plc::Plc&)>& setup = [](plc::Plc&) {}) {
+    explicit InProcessFinsd(
+        server::ServerOptions options,
+        const std::function<void(plc::Plc&)>& setup = [](plc::Plc&) {}) {
         options.port = 0;
         setup(plc_);
         auto s = server::Server::start(io_, plc_, options);
