@@ -200,11 +200,12 @@ Stats drive(int fd, bool tcp, const Frames& f, unsigned depth, double seconds) {
     return s;
 }
 
-// FINS/TCP handshake by hand: ask for node allocation, read the 24-byte answer.
+// FINS/TCP handshake by hand: ask for node 200, the source node of read_frame() (finsd
+// executes only frames from the node the connection got), read the 24-byte answer.
 bool tcp_handshake(int fd) {
     std::array<std::uint8_t, 24> buf{};
     fins::ByteWriter w{buf};
-    fins::write_node_address_request(w, 0);
+    fins::write_node_address_request(w, 200);
     if (::send(fd, buf.data(), w.size(), MSG_NOSIGNAL) <= 0) return false;
     return read_exact(fd, buf.data(), 24);
 }

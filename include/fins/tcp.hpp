@@ -53,7 +53,8 @@ void write_tcp_header(ByteWriter& w, TcpCommand command, std::size_t data_size,
 
 // Whole packets for the handshake and errors (sizes 20, 24 and 16 bytes).
 void write_node_address_request(ByteWriter& w, std::uint8_t client_node) noexcept;
-void write_node_address_response(ByteWriter& w, std::uint8_t client_node,
+// `client_node` is echoed whole in a refusal (e.g. 00000105 answered with 0x23).
+void write_node_address_response(ByteWriter& w, std::uint32_t client_node,
                                  std::uint8_t server_node, std::uint32_t error = 0) noexcept;
 void write_tcp_error(ByteWriter& w, TcpCommand command, TcpError error) noexcept;
 
@@ -61,7 +62,11 @@ struct NodeAddressResponse {
     std::uint8_t client_node = 0;
     std::uint8_t server_node = 0;
 };
-// Data of a node_address_request (4 bytes) -> client node (last byte significant).
+// W421 7-4 command 0: a client node is 00000000-000000FE (0 = allocate one).
+inline constexpr std::uint32_t max_client_node = 0xFE;
+// Data of a node_address_request (4 bytes) -> client node. A length other than 4 is
+// data_length_too_long; a value above FE (255, or 00000105: not its low byte) is
+// client_node_out_of_range.
 Result<std::uint8_t> decode_node_address_request(Bytes data) noexcept;
 // Data of a node_address_response (8 bytes).
 Result<NodeAddressResponse> decode_node_address_response(Bytes data) noexcept;

@@ -66,7 +66,7 @@ void write_node_address_request(ByteWriter& w, std::uint8_t client_node) noexcep
     w.u32(client_node);
 }
 
-void write_node_address_response(ByteWriter& w, std::uint8_t client_node, std::uint8_t server_node,
+void write_node_address_response(ByteWriter& w, std::uint32_t client_node, std::uint8_t server_node,
                                  std::uint32_t error) noexcept {
     write_tcp_header(w, TcpCommand::node_address_response, node_response_data, error);
     w.u32(client_node);
@@ -81,8 +81,13 @@ Result<std::uint8_t> decode_node_address_request(Bytes data) noexcept {
     // The envelope gave a length that does not fit command 0; FINS/TCP has no closer code.
     if (data.size() != node_request_data)
         return Unexpected(make_error_code(TcpError::data_length_too_long));
-    // Four bytes, but only the last is significant (frames 3.2).
-    return data[3];
+    // W421 7-4 command 0: 00000000-000000FE. A value above FE (e.g. 00000105) is out of
+    // range as a whole, not its low byte.
+    ByteReader r(data);
+    const std::uint32_t node = r.u32();
+    if (node > max_client_node)
+        return Unexpected(make_error_code(TcpError::client_node_out_of_range));
+    return static_cast<std::uint8_t>(node);
 }
 
 Result<NodeAddressResponse> decode_node_address_response(Bytes data) noexcept {

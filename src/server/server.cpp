@@ -1,11 +1,15 @@
 #include "server/server.hpp"
 
+#include <algorithm>
 #include <array>
+#include <chrono>
 #include <list>
+#include <optional>
 
 #include <spdlog/spdlog.h>
 #include <asio/ip/tcp.hpp>
 #include <asio/ip/udp.hpp>
+#include <asio/steady_timer.hpp>
 
 #include "server/dispatcher.hpp"
 #include "server/tcp_session.hpp"
@@ -23,11 +27,15 @@ std::uint8_t derive_node(const std::string& bind_address) noexcept {
 }
 
 struct Server::Impl {
-    Impl(asio::io_context& context, plc::Plc& plc, NodeAddress self, std::size_t max_connections)
+    Impl(asio::io_context& context, plc::Plc& plc, NodeAddress self, const ServerOptions& options)
         : dispatcher(plc, self),
           udp_socket(context),
           acceptor(context),
-          nodes(self.node, max_connections) {}
+          nodes(self.node, options.max_tcp_connections),
+          limits(options.tcp_limits),
+          accept_retry_max(options.accept_retry_max),
+          accept_log_interval(options.accept_log_interval),
+          accept_timer(context) {}
 
     void receive_udp() {
         udp_socket.async_receive_from(
@@ -55,17 +63,81 @@ struct Server::Impl {
     void accept_tcp() {
         acceptor.async_accept([this](std::error_code ec, asio::ip::tcp::socket socket) {
             if (ec == asio::error::operation_aborted || !acceptor.is_open()) return;
-            if (!ec) {
-                sessions.remove_if([](const std::weak_ptr<TcpSession>& w) {
-                    auto s = w.lock();
-                    return !s || !s->open();
-                });
-                auto session = std::make_shared<TcpSession>(std::move(socket), dispatcher, nodes);
-                sessions.push_back(session);
-                session->start();
-            } else {
-                spdlog::warn("fins/tcp: accept failed: {}", ec.message());
+            if (ec == asio::error::connection_aborted) {
+                // The peer gave up while queued: nothing is wrong with us.
+                accept_tcp();
+                return;
             }
+            if (ec) {
+                accept_failed(ec);
+                return;
+            }
+            if (accept_failures > 0) {
+                if (accept_episode_logged)
+                    spdlog::warn("fins/tcp: accepting again after {} failed attempts",
+                                 accept_failures);
+                accept_failures = 0;
+                accept_episode_logged = false;
+                accept_delay = std::chrono::milliseconds(0);
+            }
+            sessions.remove_if([](const std::weak_ptr<TcpSession>& w) {
+                auto s = w.lock();
+                return !s || !s->open();
+            });
+            evict_oldest_pending();
+            auto session =
+                std::make_shared<TcpSession>(std::move(socket), dispatcher, nodes, limits);
+            sessions.push_back(session);
+            session->start();
+            accept_tcp();
+        });
+    }
+
+    // At the cap of connections without a finished handshake, the oldest one goes: a
+    // real client finishes its handshake within a round trip, so the oldest is the one
+    // most likely stalled, and a flood of new sockets cannot keep every slot.
+    void evict_oldest_pending() {
+        std::size_t pending = 0;
+        for (const auto& weak : sessions)
+            if (auto s = weak.lock(); s && s->pending()) ++pending;
+        if (pending < limits.max_pending) return;
+        for (const auto& weak : sessions)
+            if (auto s = weak.lock(); s && s->pending()) {
+                spdlog::info("fins/tcp: {} connections without a handshake, closing the oldest",
+                             pending);
+                s->close();
+                return;
+            }
+    }
+
+    // EMFILE/ENFILE and the like leave the connection queued, so an immediate retry
+    // fails again at once (a busy loop writing a log line each time). Back off instead,
+    // doubling up to accept_retry_max; UDP and open connections are served meanwhile,
+    // and accepting resumes by itself. At most one failure line per accept_log_interval
+    // (a failure that flaps with short recoveries included); the recovery of a logged
+    // failure is logged once.
+    void accept_failed(std::error_code ec) {
+        const auto now = std::chrono::steady_clock::now();
+        const bool new_episode = accept_failures++ == 0;
+        ++accept_unreported;
+        if (!accept_logged || now - *accept_logged >= accept_log_interval) {
+            if (new_episode)
+                spdlog::warn("fins/tcp: accept failed: {}; retrying with a back-off of up to {} ms",
+                             ec.message(), accept_retry_max.count());
+            else
+                spdlog::warn(
+                    "fins/tcp: accept still failing: {} ({} failures since the last "
+                    "report)",
+                    ec.message(), accept_unreported);
+            accept_logged = now;
+            accept_unreported = 0;
+            accept_episode_logged = true;
+        }
+        accept_delay =
+            std::clamp(accept_delay * 2, std::chrono::milliseconds(10), accept_retry_max);
+        accept_timer.expires_after(accept_delay);
+        accept_timer.async_wait([this](std::error_code timer_ec) {
+            if (timer_ec || !acceptor.is_open()) return;
             accept_tcp();
         });
     }
@@ -79,7 +151,16 @@ struct Server::Impl {
     std::array<std::uint8_t, max_frame_size> udp_out{};
     asio::ip::tcp::acceptor acceptor;
     TcpNodeTable nodes;
-    std::list<std::weak_ptr<TcpSession>> sessions;
+    TcpLimits limits;
+    std::list<std::weak_ptr<TcpSession>> sessions;  // in accept order
+    std::chrono::milliseconds accept_retry_max;
+    std::chrono::milliseconds accept_log_interval;
+    asio::steady_timer accept_timer;
+    std::chrono::milliseconds accept_delay{0};
+    std::size_t accept_failures = 0;    // since the last successful accept
+    std::size_t accept_unreported = 0;  // failures not yet counted in a log line
+    bool accept_episode_logged = false;
+    std::optional<std::chrono::steady_clock::time_point> accept_logged;
 };
 
 Result<std::unique_ptr<Server>> Server::start(asio::io_context& io, plc::Plc& plc,
@@ -89,7 +170,7 @@ Result<std::unique_ptr<Server>> Server::start(asio::io_context& io, plc::Plc& pl
     if (ec) return Unexpected(ec);
     const std::uint8_t node = options.node != 0 ? options.node : derive_node(options.bind_address);
     const NodeAddress self{options.network, node, cpu_unit};
-    auto impl = std::make_unique<Impl>(io, plc, self, options.max_tcp_connections);
+    auto impl = std::make_unique<Impl>(io, plc, self, options);
 
     std::uint16_t port = options.port;
     if (options.tcp) {
@@ -141,6 +222,7 @@ void Server::stop() {
     std::error_code ignored;
     impl_->udp_socket.close(ignored);
     impl_->acceptor.close(ignored);
+    impl_->accept_timer.cancel();
     for (auto& weak : impl_->sessions)
         if (auto s = weak.lock()) s->close();
     impl_->sessions.clear();

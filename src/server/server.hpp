@@ -8,8 +8,12 @@
 // TCP: the FINS/TCP envelope (frames section 3): node-address handshake with
 //      auto-assignment, then FRAME SEND packets in both directions. Each response is
 //      sent with one write; TCP_NODELAY keeps request/response traffic off delayed ACKs.
+//      The handshake's node is the connection's identity (tcp_session.hpp); deadlines
+//      and a cap on unfinished handshakes keep stalled peers from holding slots; a
+//      failing accept (no descriptors left) backs off instead of spinning.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -18,6 +22,7 @@
 
 #include "fins/error.hpp"
 #include "fins/frame.hpp"
+#include "server/tcp_limits.hpp"
 
 namespace fins::plc {
 class Plc;
@@ -35,6 +40,12 @@ struct ServerOptions {
     std::uint8_t network = 0;  // this node's FINS network address (00 = local network)
     // W596 1-2: up to 16 FINS/TCP connections.
     std::size_t max_tcp_connections = 16;
+    // Deadlines, idle timeout, keep-alive, cap on unfinished handshakes (tcp_limits.hpp).
+    TcpLimits tcp_limits;
+    // Out of descriptors (or any other accept failure): retry after a back-off that
+    // doubles up to this, logging at most once per accept_log_interval.
+    std::chrono::milliseconds accept_retry_max{1'000};
+    std::chrono::milliseconds accept_log_interval{10'000};
 };
 
 // The node number finsd takes when none is given (see ServerOptions::node).

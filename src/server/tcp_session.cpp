@@ -1,5 +1,10 @@
 #include "server/tcp_session.hpp"
 
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <sys/socket.h>
+
+#include <algorithm>
 #include <cstring>
 
 #include <spdlog/spdlog.h>
@@ -11,62 +16,65 @@ namespace fins::server {
 
 namespace {
 
-// Auto-assigned client nodes: CS/CJ Ethernet units hand out 239-254 to FINS/TCP clients
-// by default (one per connection); we fall back to the rest of 1-254 when those are taken.
-constexpr std::uint8_t first_auto_node = 239;
+// A refused peer may keep sending; past this many bytes it is closed without waiting.
+constexpr std::size_t drain_limit = 256 * 1024;
+// FINS header offsets of the source network and node (W342 3-3-3: ICF RSV GCT DNA DA1
+// DA2 SNA SA1 SA2 SID).
+constexpr std::size_t source_network_offset = 6;
+constexpr std::size_t source_node_offset = 7;
 
 }  // namespace
 
-Result<std::uint8_t> TcpNodeTable::claim(std::uint8_t requested) noexcept {
-    if (full()) return Unexpected(make_error_code(TcpError::all_connections_in_use));
-    std::uint8_t node = requested;
-    if (requested == 0) {
-        auto free = [&](unsigned n) { return n != server_node_ && !used_[n]; };
-        node = 0;
-        for (unsigned n = first_auto_node; n <= 254 && node == 0; ++n)
-            if (free(n)) node = static_cast<std::uint8_t>(n);
-        for (unsigned n = 1; n < first_auto_node && node == 0; ++n)
-            if (free(n)) node = static_cast<std::uint8_t>(n);
-        if (node == 0) return Unexpected(make_error_code(TcpError::no_node_available));
-    } else if (requested == 255) {
-        return Unexpected(make_error_code(TcpError::client_node_out_of_range));
-    } else if (requested == server_node_) {
-        return Unexpected(make_error_code(TcpError::same_node_as_server));
-    } else if (used_[requested]) {
-        return Unexpected(make_error_code(TcpError::node_already_connected));
-    }
-    used_[node] = true;
-    ++count_;
-    return node;
+std::error_code set_keepalive(asio::ip::tcp::socket& socket, std::chrono::seconds idle) noexcept {
+    std::error_code ec;
+    socket.set_option(asio::socket_base::keep_alive(idle.count() > 0), ec);
+    if (ec || idle.count() <= 0) return ec;
+    const int fd = socket.native_handle();
+    const int idle_s = static_cast<int>(std::min<std::chrono::seconds::rep>(idle.count(), 32767));
+    const int interval_s = std::max(1, idle_s / 3);
+    const int probes = 3;
+    if (::setsockopt(fd, IPPROTO_TCP, TCP_KEEPIDLE, &idle_s, sizeof idle_s) != 0 ||
+        ::setsockopt(fd, IPPROTO_TCP, TCP_KEEPINTVL, &interval_s, sizeof interval_s) != 0 ||
+        ::setsockopt(fd, IPPROTO_TCP, TCP_KEEPCNT, &probes, sizeof probes) != 0)
+        return {errno, std::system_category()};
+    return {};
 }
 
-void TcpNodeTable::release(std::uint8_t node) noexcept {
-    if (node != 0 && used_[node]) {
-        used_[node] = false;
-        --count_;
-    }
+TcpSession::TcpSession(asio::ip::tcp::socket socket, Dispatcher& dispatcher, TcpNodeTable& nodes,
+                       const TcpLimits& limits)
+    : socket_(std::move(socket)),
+      dispatcher_(dispatcher),
+      nodes_(nodes),
+      limits_(limits),
+      timer_(socket_.get_executor()) {
+    std::error_code ignored;
+    peer_ = socket_.remote_endpoint(ignored).address();
 }
-
-TcpSession::TcpSession(asio::ip::tcp::socket socket, Dispatcher& dispatcher, TcpNodeTable& nodes)
-    : socket_(std::move(socket)), dispatcher_(dispatcher), nodes_(nodes) {}
 
 TcpSession::~TcpSession() {
-    nodes_.release(client_node_);
+    nodes_.release(client_node_, this);
 }
 
 void TcpSession::start() {
     std::error_code ignored;
     // Never let a response sit behind Nagle waiting for the client's delayed ACK.
     socket_.set_option(asio::ip::tcp::no_delay(true), ignored);
+    if (const auto ec = set_keepalive(socket_, limits_.keepalive))
+        spdlog::debug("fins/tcp: keep-alive: {}", ec.message());
+    set_deadline(Deadline::handshake, limits_.handshake_timeout);
     read_more();
 }
 
 void TcpSession::close() {
+    if (state_ == State::closed) return;
+    state_ = State::closed;
+    ++timer_generation_;
+    timer_.cancel();
+    nodes_.release(client_node_, this);
+    client_node_ = 0;
     std::error_code ignored;
     socket_.shutdown(asio::ip::tcp::socket::shutdown_both, ignored);
     socket_.close(ignored);
-    nodes_.release(client_node_);
-    client_node_ = 0;
 }
 
 void TcpSession::read_more() {
@@ -74,6 +82,7 @@ void TcpSession::read_more() {
     socket_.async_read_some(
         asio::buffer(in_.data() + in_size_, in_.size() - in_size_),
         [self](std::error_code ec, std::size_t n) {
+            if (!self->open()) return;
             if (ec) {
                 if (ec != asio::error::operation_aborted && ec != asio::error::eof)
                     spdlog::debug("fins/tcp: read failed: {}", ec.message());
@@ -86,18 +95,26 @@ void TcpSession::read_more() {
 }
 
 void TcpSession::process() {
-    if (!socket_.is_open()) return;
+    if (state_ != State::handshake && state_ != State::established) return;
     const Bytes available{in_.data(), in_size_};
     const TcpParse parsed = parse_tcp_frame(available);
     switch (parsed.status) {
         case TcpParse::Status::need_more:
+            // The handshake deadline runs from accept; afterwards a packet that has begun
+            // must end within frame_timeout, and silence is bounded by idle_timeout.
+            if (state_ == State::established) {
+                if (in_size_ == 0)
+                    set_deadline(Deadline::idle, limits_.idle_timeout);
+                else if (deadline_kind_ != Deadline::frame)
+                    set_deadline(Deadline::frame, limits_.frame_timeout);
+            }
             // Keep the partial packet at the front so the next read appends to it.
             read_more();
             return;
         case TcpParse::Status::error: {
             ByteWriter w{out_};
             write_tcp_error(w, TcpCommand::frame_error, parsed.error);
-            spdlog::warn("fins/tcp: envelope error {:#04x}, closing",
+            spdlog::warn("fins/tcp: {}: envelope error {:#04x}, closing", peer_.to_string(),
                          static_cast<int>(parsed.error));
             in_size_ = 0;
             send_and_continue(w.size(), true);
@@ -110,6 +127,8 @@ void TcpSession::process() {
     // The packet's data view points into in_; only now may it move.
     std::memmove(in_.data(), in_.data() + parsed.consumed, in_size_ - parsed.consumed);
     in_size_ -= parsed.consumed;
+    // A complete packet: what follows is a new packet with its own frame deadline.
+    if (state_ == State::established) deadline_kind_ = Deadline::idle;
     if (out_size_pending_ > 0 || !keep_open) {
         send_and_continue(out_size_pending_, !keep_open);
         return;
@@ -118,42 +137,31 @@ void TcpSession::process() {
 }
 
 bool TcpSession::handle_packet(const TcpPacket& packet) {
-    ByteWriter w{out_};
     out_size_pending_ = 0;
     const auto command = static_cast<TcpCommand>(packet.command);
-    if (client_node_ == 0) {
-        if (command != TcpCommand::node_address_request) {
-            write_tcp_error(w, TcpCommand::frame_error, TcpError::command_not_supported);
-            out_size_pending_ = w.size();
-            return false;
-        }
-        auto requested = decode_node_address_request(packet.data);
-        if (!requested) {
-            write_tcp_error(w, TcpCommand::frame_error, TcpError::data_length_too_long);
-            out_size_pending_ = w.size();
-            return false;
-        }
-        auto claimed = nodes_.claim(*requested);
-        if (!claimed) {
-            // W421 7-4: the error goes back in command 1, then the server closes.
-            write_node_address_response(w, *requested, dispatcher_.self().node,
-                                        static_cast<std::uint32_t>(claimed.error().value()));
-            out_size_pending_ = w.size();
-            spdlog::info("fins/tcp: refused client node {}: {}", *requested,
-                         claimed.error().message());
-            return false;
-        }
-        client_node_ = *claimed;
-        write_node_address_response(w, client_node_, dispatcher_.self().node);
+    if (state_ == State::handshake) {
+        if (command == TcpCommand::node_address_request) return handshake(packet);
+        ByteWriter w{out_};
+        write_tcp_error(w, TcpCommand::frame_error, TcpError::command_not_supported);
         out_size_pending_ = w.size();
-        spdlog::info("fins/tcp: client node {} connected", client_node_);
-        return true;
+        return false;
     }
+    ByteWriter w{out_};
     if (command != TcpCommand::frame) {
         // A second handshake or any other command on an open connection (frames 3.4 step 5).
         write_tcp_error(w, TcpCommand::frame_error, TcpError::command_not_supported);
         out_size_pending_ = w.size();
         return false;
+    }
+    if (!from_bound_node(packet.data)) {
+        // Not executed as another node and not answered: W421 sends a node's answers only
+        // on the connection paired with it. One warning per connection, no log flood.
+        const auto level = logged_foreign_source_ ? spdlog::level::debug : spdlog::level::warn;
+        logged_foreign_source_ = true;
+        spdlog::log(level, "fins/tcp: {}: dropped a frame from {}.{} on the connection of node {}",
+                    peer_.to_string(), packet.data[source_network_offset],
+                    packet.data[source_node_offset], client_node_);
+        return true;
     }
     // Reserve the envelope header, let the dispatcher write the FINS response after it.
     const MutableBytes frame_out{out_.data() + tcp_header_size, max_frame_size};
@@ -166,17 +174,183 @@ bool TcpSession::handle_packet(const TcpPacket& packet) {
     return true;
 }
 
+bool TcpSession::handshake(const TcpPacket& packet) {
+    ByteWriter w{out_};
+    const auto requested = decode_node_address_request(packet.data);
+    // The refusal echoes the requested value whole (00000105 stays 00000105).
+    ByteReader raw(packet.data);
+    const std::uint32_t echoed = packet.data.size() >= 4 ? raw.u32() : 0;
+    Result<std::uint8_t> claimed = requested;
+    if (requested) {
+        claimed = nodes_.claim(*requested, this);
+    } else if (requested.error() != TcpError::client_node_out_of_range) {
+        write_tcp_error(w, TcpCommand::frame_error, TcpError::data_length_too_long);
+        out_size_pending_ = w.size();
+        return false;
+    }
+    if (!claimed) {
+        // W421 7-4: a client with the same IP address and node as an open connection makes
+        // the server probe that connection with command 6; the newcomer is refused (0x21)
+        // whatever the probe shows.
+        if (claimed.error() == TcpError::node_already_connected)
+            if (TcpSession* holder = nodes_.owner(*requested);
+                holder != nullptr && holder->peer_address() == peer_)
+                holder->confirm_connection();
+        // W421 7-4: the error goes back in command 1, then the server closes.
+        write_node_address_response(w, echoed, dispatcher_.self().node,
+                                    static_cast<std::uint32_t>(claimed.error().value()));
+        out_size_pending_ = w.size();
+        spdlog::info("fins/tcp: {}: refused client node {:#010x}: {}", peer_.to_string(), echoed,
+                     claimed.error().message());
+        return false;
+    }
+    client_node_ = *claimed;
+    state_ = State::established;
+    write_node_address_response(w, client_node_, dispatcher_.self().node);
+    out_size_pending_ = w.size();
+    spdlog::info("fins/tcp: {}: client node {} connected", peer_.to_string(), client_node_);
+    return true;
+}
+
+bool TcpSession::from_bound_node(Bytes frame) const noexcept {
+    // Too short to name a source: the dispatcher drops it (there is no SID to answer).
+    if (frame.size() <= source_node_offset) return true;
+    const std::uint8_t network = frame[source_network_offset];
+    const bool local = network == local_network || network == dispatcher_.self().network;
+    return local && frame[source_node_offset] == client_node_;
+}
+
 void TcpSession::send_and_continue(std::size_t size, bool close_after) {
+    if (confirming_) {
+        // Command 6 is on its way; this packet follows it whole, never interleaved.
+        deferred_ = true;
+        deferred_size_ = size;
+        deferred_close_ = close_after;
+        return;
+    }
+    writing_ = true;
+    // The peer must take the response: a client that stops reading is a stalled frame.
+    if (state_ == State::established) set_deadline(Deadline::frame, limits_.frame_timeout);
     auto self = shared_from_this();
     // One write per response: clients that read one response per recv() depend on it.
     asio::async_write(socket_, asio::buffer(out_.data(), size),
                       [self, close_after](std::error_code ec, std::size_t) {
-                          if (ec || close_after) {
+                          self->writing_ = false;
+                          if (!self->open()) return;
+                          if (ec) {
                               self->close();
                               return;
                           }
+                          if (close_after) {
+                              self->close_after_notice();
+                              return;
+                          }
+                          if (self->confirm_wanted_) {
+                              self->confirm_wanted_ = false;
+                              self->send_confirmation();
+                          }
                           self->process();
                       });
+}
+
+void TcpSession::confirm_connection() {
+    if (state_ != State::established || confirming_) return;
+    if (writing_) {
+        confirm_wanted_ = true;
+        return;
+    }
+    send_confirmation();
+}
+
+void TcpSession::send_confirmation() {
+    confirming_ = true;
+    ByteWriter w{confirmation_};
+    write_tcp_header(w, TcpCommand::connection_confirmation, 0);
+    spdlog::info("fins/tcp: {}: node {} asked for again, confirming the connection",
+                 peer_.to_string(), client_node_);
+    auto self = shared_from_this();
+    asio::async_write(socket_, asio::buffer(confirmation_),
+                      [self](std::error_code ec, std::size_t) {
+                          self->confirming_ = false;
+                          if (!self->open()) return;
+                          if (ec) {
+                              self->close();
+                              return;
+                          }
+                          if (self->deferred_) {
+                              self->deferred_ = false;
+                              self->send_and_continue(self->deferred_size_, self->deferred_close_);
+                          }
+                      });
+}
+
+void TcpSession::close_after_notice() {
+    // The node is free at once; only the socket lingers while it drains.
+    nodes_.release(client_node_, this);
+    client_node_ = 0;
+    state_ = State::draining;
+    std::error_code ec;
+    socket_.shutdown(asio::ip::tcp::socket::shutdown_send, ec);
+    if (ec) {
+        close();
+        return;
+    }
+    set_deadline(Deadline::drain, limits_.drain_timeout);
+    drained_ = 0;
+    in_size_ = 0;
+    drain();
+}
+
+void TcpSession::drain() {
+    auto self = shared_from_this();
+    socket_.async_read_some(asio::buffer(in_), [self](std::error_code ec, std::size_t n) {
+        if (self->state_ != State::draining) return;
+        self->drained_ += n;
+        // End of the peer's data (it read our notice and closed), an error, or too much.
+        if (ec || self->drained_ > drain_limit) {
+            self->close();
+            return;
+        }
+        self->drain();
+    });
+}
+
+void TcpSession::set_deadline(Deadline kind, Clock::duration after) {
+    deadline_kind_ = kind;
+    if (after <= Clock::duration::zero()) {
+        deadline_ = Clock::time_point::max();  // idle_timeout 0: never
+        return;
+    }
+    deadline_ = Clock::now() + after;
+    if (!timer_armed_ || deadline_ < timer_at_) arm_timer(deadline_);
+}
+
+void TcpSession::arm_timer(Clock::time_point at) {
+    timer_at_ = at;
+    timer_armed_ = true;
+    const auto generation = ++timer_generation_;
+    timer_.expires_at(at);
+    auto self = shared_from_this();
+    timer_.async_wait([self, generation](std::error_code) {
+        // A newer arm or close() superseded this wait (its cancel may race the expiry).
+        if (generation != self->timer_generation_) return;
+        self->timer_armed_ = false;
+        self->on_timer();
+    });
+}
+
+void TcpSession::on_timer() {
+    if (!open() || deadline_ == Clock::time_point::max()) return;
+    if (Clock::now() < deadline_) {
+        arm_timer(deadline_);
+        return;
+    }
+    const char* what = deadline_kind_ == Deadline::handshake ? "handshake"
+                       : deadline_kind_ == Deadline::frame   ? "frame"
+                       : deadline_kind_ == Deadline::idle    ? "idle"
+                                                             : "drain";
+    spdlog::info("fins/tcp: {}: {} timeout, closing", peer_.to_string(), what);
+    close();
 }
 
 }  // namespace fins::server

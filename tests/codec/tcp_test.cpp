@@ -91,6 +91,14 @@ TEST(Tcp, HandshakeData) {
     }
     EXPECT_EQ(decode_node_address_request(hex("00 00 00 05 00")).error(),
               TcpError::data_length_too_long);
+    // W421 7-4: 00000000-000000FE. Above FE the whole value is out of range, not its
+    // low byte (00000105 is not node 5).
+    EXPECT_EQ(decode_node_address_request(hex("00 00 00 FF")).error(),
+              TcpError::client_node_out_of_range);
+    EXPECT_EQ(decode_node_address_request(hex("00 00 01 05")).error(),
+              TcpError::client_node_out_of_range);
+    EXPECT_EQ(decode_node_address_request(hex("80 00 00 01")).error(),
+              TcpError::client_node_out_of_range);
     const auto eight = hex("00 00 00 0A 00 00 00 01");
     for (std::size_t n = 0; n < eight.size(); ++n) {
         EXPECT_EQ(decode_node_address_response(prefix(eight, n)).error(),

@@ -61,7 +61,8 @@ class RawTcp {
     // Reads one whole FINS/TCP packet; empty on EOF, error or timeout.
     std::vector<std::uint8_t> receive_packet() {
         std::vector<std::uint8_t> head(tcp_header_size);
-        std::error_code ec;
+        std::error_code& ec = last_error_;
+        ec.clear();
         asio::read(socket_, asio::buffer(head), ec);
         if (ec) return {};
         const std::uint32_t length = (std::uint32_t{head[4]} << 24) |
@@ -93,9 +94,13 @@ class RawTcp {
         std::error_code ec;
         socket_.close(ec);
     }
+    [[nodiscard]] int native_handle() { return socket_.native_handle(); }
+    // Why the last receive_packet() came back empty (eof = the peer's FIN).
+    [[nodiscard]] std::error_code last_error() const { return last_error_; }
 
   private:
     asio::ip::tcp::socket socket_;
+    std::error_code last_error_;
 };
 
 inline std::uint32_t be32(const std::vector<std::uint8_t>& b, std::size_t at) {

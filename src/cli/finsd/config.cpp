@@ -153,6 +153,16 @@ class Loader {
         else if (k == "max_connections") {
             lo = 1;
             hi = 254;
+        } else if (k == "tcp_handshake_timeout" || k == "tcp_frame_timeout") {
+            lo = 1;
+            hi = 3600;
+        } else if (k == "tcp_idle_timeout")
+            hi = 86400;
+        else if (k == "tcp_keepalive")
+            hi = 7200;
+        else if (k == "tcp_max_pending") {
+            lo = 1;
+            hi = 1024;
         } else
             return fail(key, p, "unknown key");
         const auto v = integer(key, node, p, lo, hi);
@@ -161,6 +171,11 @@ class Loader {
         if (k == "network") s_.network = static_cast<std::uint8_t>(*v);
         if (k == "port") s_.port = static_cast<std::uint16_t>(*v);
         if (k == "max_connections") s_.max_connections = static_cast<std::size_t>(*v);
+        if (k == "tcp_handshake_timeout") s_.tcp_handshake_timeout = static_cast<unsigned>(*v);
+        if (k == "tcp_frame_timeout") s_.tcp_frame_timeout = static_cast<unsigned>(*v);
+        if (k == "tcp_idle_timeout") s_.tcp_idle_timeout = static_cast<unsigned>(*v);
+        if (k == "tcp_keepalive") s_.tcp_keepalive = static_cast<unsigned>(*v);
+        if (k == "tcp_max_pending") s_.tcp_max_pending = static_cast<std::size_t>(*v);
         return {};
     }
 

@@ -49,6 +49,12 @@ struct Settings {
     bool udp = true;
     bool tcp = true;
     std::size_t max_connections = 16;
+    // FINS/TCP limits in seconds (server/tcp_limits.hpp; idle and keep-alive 0 = off).
+    unsigned tcp_handshake_timeout = 10;
+    unsigned tcp_frame_timeout = 10;
+    unsigned tcp_idle_timeout = 300;
+    unsigned tcp_keepalive = 60;
+    std::size_t tcp_max_pending = 16;
 
     // [protection]
     plc::NetworkWriteProtectionSetting network_write_protection;
@@ -67,6 +73,9 @@ struct Overrides {
     std::optional<unsigned> node, network;
     std::optional<bool> udp, tcp;
     std::optional<std::size_t> max_connections;
+    std::optional<unsigned> tcp_handshake_timeout, tcp_frame_timeout, tcp_idle_timeout,
+        tcp_keepalive;
+    std::optional<std::size_t> tcp_max_pending;
     std::optional<std::string> network_write_protection;
     std::vector<std::string> protect_nodes;  // non-empty: replaces the file's list
     std::optional<bool> um_read_protection, dip_write_protection;

@@ -96,6 +96,11 @@ Expected<void> apply_overrides(const Overrides& o, Settings& s) {
     if (o.udp) s.udp = *o.udp;
     if (o.tcp) s.tcp = *o.tcp;
     if (o.max_connections) s.max_connections = *o.max_connections;
+    if (o.tcp_handshake_timeout) s.tcp_handshake_timeout = *o.tcp_handshake_timeout;
+    if (o.tcp_frame_timeout) s.tcp_frame_timeout = *o.tcp_frame_timeout;
+    if (o.tcp_idle_timeout) s.tcp_idle_timeout = *o.tcp_idle_timeout;
+    if (o.tcp_keepalive) s.tcp_keepalive = *o.tcp_keepalive;
+    if (o.tcp_max_pending) s.tcp_max_pending = *o.tcp_max_pending;
     if (o.network_write_protection) {
         const auto m = parse_protection(*o.network_write_protection);
         if (!m)

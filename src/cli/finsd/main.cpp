@@ -90,6 +90,29 @@ int configure(int argc, char** argv, Settings& settings) {
     auto* o_max = app.add_option("--max-connections", max_connections,
                                  "Maximum FINS/TCP connections (W596: 16)")
                       ->check(CLI::Range(1, 254));
+    unsigned tcp_handshake = 0, tcp_frame = 0, tcp_idle = 0, tcp_keepalive = 0;
+    std::size_t tcp_pending = 0;
+    auto* o_tcp_handshake =
+        app.add_option("--tcp-handshake-timeout", tcp_handshake,
+                       "Seconds from accept to the FINS/TCP handshake (default 10)")
+            ->check(CLI::Range(1, 3600));
+    auto* o_tcp_frame = app.add_option("--tcp-frame-timeout", tcp_frame,
+                                       "Seconds for a begun FINS/TCP packet to end (default 10)")
+                            ->check(CLI::Range(1, 3600));
+    auto* o_tcp_idle =
+        app.add_option("--tcp-idle-timeout", tcp_idle,
+                       "Seconds a FINS/TCP connection may stay silent (0 = no limit; default 300)")
+            ->check(CLI::Range(0, 86400));
+    auto* o_tcp_keepalive =
+        app.add_option("--tcp-keepalive", tcp_keepalive,
+                       "TCP keep-alive: seconds of silence before the first probe (0 = off; "
+                       "default 60)")
+            ->check(CLI::Range(0, 7200));
+    auto* o_tcp_pending =
+        app.add_option("--tcp-max-pending", tcp_pending,
+                       "Connections without a finished handshake (default 16; more close the "
+                       "oldest)")
+            ->check(CLI::Range(1, 1024));
     auto* o_udp = app.add_flag("--udp,!--no-udp", udp, "Serve FINS/UDP (default on)");
     auto* o_tcp = app.add_flag("--tcp,!--no-tcp", tcp, "Serve FINS/TCP (default on)");
     auto* o_log = app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off")
@@ -124,6 +147,11 @@ int configure(int argc, char** argv, Settings& settings) {
     take(o_node, node, o.node);
     take(o_network, network, o.network);
     take(o_max, max_connections, o.max_connections);
+    take(o_tcp_handshake, tcp_handshake, o.tcp_handshake_timeout);
+    take(o_tcp_frame, tcp_frame, o.tcp_frame_timeout);
+    take(o_tcp_idle, tcp_idle, o.tcp_idle_timeout);
+    take(o_tcp_keepalive, tcp_keepalive, o.tcp_keepalive);
+    take(o_tcp_pending, tcp_pending, o.tcp_max_pending);
     take(o_udp, udp, o.udp);
     take(o_tcp, tcp, o.tcp);
     take(o_protection, protection, o.network_write_protection);
@@ -174,6 +202,11 @@ int serve(const Settings& s) {
     options.node = s.node;
     options.network = s.network;
     options.max_tcp_connections = s.max_connections;
+    options.tcp_limits.handshake_timeout = std::chrono::seconds(s.tcp_handshake_timeout);
+    options.tcp_limits.frame_timeout = std::chrono::seconds(s.tcp_frame_timeout);
+    options.tcp_limits.idle_timeout = std::chrono::seconds(s.tcp_idle_timeout);
+    options.tcp_limits.keepalive = std::chrono::seconds(s.tcp_keepalive);
+    options.tcp_limits.max_pending = s.tcp_max_pending;
     asio::io_context io{1};
     auto server = fins::server::Server::start(io, plc, options);
     if (!server)
