@@ -60,8 +60,14 @@ class Finsd {
         log_path_ = path;
         int out[2];
         if (log_fd_ < 0 || ::pipe(out) != 0) return;
-        const std::vector<std::string> argv{o.finsd,          "--bind",  "127.0.0.1", "--port", "0",
-                                            "--log-level",    "warn",    "--max-connections",
+        const std::vector<std::string> argv{o.finsd,
+                                            "--bind",
+                                            "127.0.0.1",
+                                            "--port",
+                                            "0",
+                                            "--log-level",
+                                            "warn",
+                                            "--max-connections",
                                             std::to_string(max_connections)};
         pid_ = ::fork();
         if (pid_ == 0) {
@@ -122,7 +128,9 @@ class Finsd {
         if (WIFSIGNALED(status_)) return fmt::format("killed by signal {}", WTERMSIG(status_));
         return fmt::format("exit status {}", WEXITSTATUS(status_));
     }
-    [[nodiscard]] bool clean_exit() const { return exited_ && WIFEXITED(status_) && WEXITSTATUS(status_) == 0; }
+    [[nodiscard]] bool clean_exit() const {
+        return exited_ && WIFEXITED(status_) && WEXITSTATUS(status_) == 0;
+    }
     // SIGTERM, then up to 20 s for a clean exit.
     void terminate() {
         if (!running()) return;
@@ -180,9 +188,11 @@ int run(const Options& o) {
         finsd.print_log_tail();
         return 1;
     }
-    std::printf("soak: finsd (pid %d) listening on 127.0.0.1 port %u; %u TCP + %u UDP verifying "
-                "clients, %u churners, %u garbage senders, %.0f s\n",
-                static_cast<int>(finsd.pid()), target.port, o.tcp, o.udp, o.churners, o.garbage, duration.count());
+    std::printf(
+        "soak: finsd (pid %d) listening on 127.0.0.1 port %u; %u TCP + %u UDP verifying "
+        "clients, %u churners, %u garbage senders, %.0f s\n",
+        static_cast<int>(finsd.pid()), target.port, o.tcp, o.udp, o.churners, o.garbage,
+        duration.count());
     std::fflush(stdout);
 
     Stats stats;
@@ -193,22 +203,25 @@ int run(const Options& o) {
     const std::uint16_t block = 256;
     unsigned client = 0;
     for (unsigned i = 0; i < o.tcp; ++i, ++client)
-        threads.emplace_back(run_tcp_client, target, Range{static_cast<std::uint16_t>(client * block), block},
-                             o.seed * 1000 + client, std::ref(stats), std::ref(ready), std::cref(stop));
+        threads.emplace_back(
+            run_tcp_client, target, Range{static_cast<std::uint16_t>(client * block), block},
+            o.seed * 1000 + client, std::ref(stats), std::ref(ready), std::cref(stop));
     // The verifying TCP clients take their connections before the churn starts.
     const auto ready_deadline = Clock::now() + std::chrono::seconds(30);
-    while (ready < static_cast<int>(o.tcp) && stats.mismatches == 0 && Clock::now() < ready_deadline)
+    while (ready < static_cast<int>(o.tcp) && stats.mismatches == 0 &&
+           Clock::now() < ready_deadline)
         std::this_thread::sleep_for(std::chrono::milliseconds(10));
     for (unsigned i = 0; i < o.udp; ++i, ++client)
-        threads.emplace_back(run_udp_client, target, Range{static_cast<std::uint16_t>(client * block), block},
-                             static_cast<std::uint8_t>(2 + i), o.seed * 1000 + client, std::ref(stats),
-                             std::cref(stop));
+        threads.emplace_back(run_udp_client, target,
+                             Range{static_cast<std::uint16_t>(client * block), block},
+                             static_cast<std::uint8_t>(2 + i), o.seed * 1000 + client,
+                             std::ref(stats), std::cref(stop));
     for (unsigned i = 0; i < o.garbage; ++i)
         threads.emplace_back(run_garbage_sender, target, o.garbage_rate, o.seed * 7919 + i,
                              std::ref(stats), std::cref(stop));
     for (unsigned i = 0; i < o.churners; ++i)
-        threads.emplace_back(run_churner, target, o.churn_rate, o.seed * 104729 + i, std::ref(stats),
-                             std::cref(stop));
+        threads.emplace_back(run_churner, target, o.churn_rate, o.seed * 104729 + i,
+                             std::ref(stats), std::cref(stop));
 
     const auto start = Clock::now();
     const auto interval = std::chrono::duration<double>(o.interval);
@@ -222,7 +235,8 @@ int run(const Options& o) {
         const auto left = duration - (Clock::now() - start);
         if (left <= decltype(left)::zero()) break;
         next += std::chrono::duration_cast<Clock::duration>(interval);
-        std::this_thread::sleep_until(std::min(next, Clock::now() + std::chrono::duration_cast<Clock::duration>(left)));
+        std::this_thread::sleep_until(
+            std::min(next, Clock::now() + std::chrono::duration_cast<Clock::duration>(left)));
         if (!finsd.running()) {
             failures.push_back("finsd died: " + finsd.how_it_ended());
             break;
@@ -232,21 +246,23 @@ int run(const Options& o) {
         peak = std::max(peak, rss);
         const auto verified = stats.udp_verified + stats.tcp_verified;
         const double t = std::chrono::duration<double>(Clock::now() - start).count();
-        std::printf("t=%5.0fs verified %llu (UDP %llu, TCP %llu) mismatches %llu errors %llu "
-                    "garbage %llu (answered %llu) churn %llu (malformed %llu, resets %llu) RSS %.1f MiB\n",
-                    t, static_cast<unsigned long long>(verified),
-                    static_cast<unsigned long long>(stats.udp_verified.load()),
-                    static_cast<unsigned long long>(stats.tcp_verified.load()),
-                    static_cast<unsigned long long>(stats.mismatches.load()),
-                    static_cast<unsigned long long>(stats.errors.load()),
-                    static_cast<unsigned long long>(stats.garbage_datagrams.load()),
-                    static_cast<unsigned long long>(stats.garbage_answers.load()),
-                    static_cast<unsigned long long>(stats.connections.load()),
-                    static_cast<unsigned long long>(stats.malformed_streams.load()),
-                    static_cast<unsigned long long>(stats.resets.load()), mib(rss));
+        std::printf(
+            "t=%5.0fs verified %llu (UDP %llu, TCP %llu) mismatches %llu errors %llu "
+            "garbage %llu (answered %llu) churn %llu (malformed %llu, resets %llu) RSS %.1f MiB\n",
+            t, static_cast<unsigned long long>(verified),
+            static_cast<unsigned long long>(stats.udp_verified.load()),
+            static_cast<unsigned long long>(stats.tcp_verified.load()),
+            static_cast<unsigned long long>(stats.mismatches.load()),
+            static_cast<unsigned long long>(stats.errors.load()),
+            static_cast<unsigned long long>(stats.garbage_datagrams.load()),
+            static_cast<unsigned long long>(stats.garbage_answers.load()),
+            static_cast<unsigned long long>(stats.connections.load()),
+            static_cast<unsigned long long>(stats.malformed_streams.load()),
+            static_cast<unsigned long long>(stats.resets.load()), mib(rss));
         std::fflush(stdout);
         if (stats.mismatches > 0) failures.push_back("mismatches");
-        if (verified == last_verified) failures.push_back("stalled: no verified answer in an interval");
+        if (verified == last_verified)
+            failures.push_back("stalled: no verified answer in an interval");
         last_verified = verified;
     }
     stop = true;
@@ -267,16 +283,17 @@ int run(const Options& o) {
         failures.push_back("finsd did not shut down cleanly on SIGTERM: " + finsd.how_it_ended());
 
     const auto verified = stats.udp_verified + stats.tcp_verified;
-    std::printf("soak: %.0f s, %llu answers verified (%.0f/s), %llu mismatches, %llu errors, %llu garbage "
-                "datagrams, %llu connections churned (%llu malformed), finsd RSS %.1f -> %.1f MiB "
-                "(peak %.1f)\n",
-                elapsed, static_cast<unsigned long long>(verified), static_cast<double>(verified) / elapsed,
-                static_cast<unsigned long long>(stats.mismatches.load()),
-                static_cast<unsigned long long>(stats.errors.load()),
-                static_cast<unsigned long long>(stats.garbage_datagrams.load()),
-                static_cast<unsigned long long>(stats.connections.load()),
-                static_cast<unsigned long long>(stats.malformed_streams.load()), mib(baseline), mib(rss),
-                mib(peak));
+    std::printf(
+        "soak: %.0f s, %llu answers verified (%.0f/s), %llu mismatches, %llu errors, %llu garbage "
+        "datagrams, %llu connections churned (%llu malformed), finsd RSS %.1f -> %.1f MiB "
+        "(peak %.1f)\n",
+        elapsed, static_cast<unsigned long long>(verified), static_cast<double>(verified) / elapsed,
+        static_cast<unsigned long long>(stats.mismatches.load()),
+        static_cast<unsigned long long>(stats.errors.load()),
+        static_cast<unsigned long long>(stats.garbage_datagrams.load()),
+        static_cast<unsigned long long>(stats.connections.load()),
+        static_cast<unsigned long long>(stats.malformed_streams.load()), mib(baseline), mib(rss),
+        mib(peak));
     if (failures.empty()) return 0;
     for (const auto& f : failures)
         std::fprintf(stderr, "soak: FAILED: %s\n", f.c_str());
@@ -298,7 +315,8 @@ int main(int argc, char** argv) {
     app.add_option("--churn-rate", o.churn_rate, "Connections per second per churner");
     app.add_option("--garbage", o.garbage, "Threads sending garbage datagrams");
     app.add_option("--garbage-rate", o.garbage_rate, "Datagrams per second per garbage sender");
-    app.add_option("--interval", o.interval, "Seconds between reports")->check(CLI::Range(0.5, 3600.0));
+    app.add_option("--interval", o.interval, "Seconds between reports")
+        ->check(CLI::Range(0.5, 3600.0));
     app.add_option("--max-rss-growth-mib", o.max_rss_growth_mib,
                    "Fail when finsd's RSS grows more than this over the first report's");
     app.add_option("--seed", o.seed, "Seed of every client's random choices");

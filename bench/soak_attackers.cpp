@@ -41,9 +41,15 @@ std::vector<std::uint8_t> random_request(Rng& rng, std::uint8_t server_node, std
 std::vector<std::uint8_t> garbage(Rng& rng, std::uint8_t server_node) {
     std::vector<std::uint8_t> g;
     switch (rng() % 7) {
-        case 0: g = random_bytes(rng, rng() % 64); break;
-        case 1: g = random_bytes(rng, rng() % 2100); break;
-        case 2: g = random_request(rng, server_node, static_cast<std::uint8_t>(rng())); break;
+        case 0:
+            g = random_bytes(rng, rng() % 64);
+            break;
+        case 1:
+            g = random_bytes(rng, rng() % 2100);
+            break;
+        case 2:
+            g = random_request(rng, server_node, static_cast<std::uint8_t>(rng()));
+            break;
         case 3:  // a request with a few bytes flipped
             g = random_request(rng, server_node, static_cast<std::uint8_t>(rng()));
             for (auto i = rng() % 4 + 1; i > 0; --i)
@@ -94,7 +100,8 @@ bool read_until_close(int fd, int timeout_ms, Stats& stats, const char* what,
             return true;
         }
         if (r.status == Read::timeout) {
-            if (first_command >= 0) stats.mismatch(fmt::format("{}: not closed within {} ms", what, timeout_ms));
+            if (first_command >= 0)
+                stats.mismatch(fmt::format("{}: not closed within {} ms", what, timeout_ms));
             return false;
         }
         if (!r.well_formed()) {
@@ -103,7 +110,8 @@ bool read_until_close(int fd, int timeout_ms, Stats& stats, const char* what,
         }
         if (first && first_command >= 0 &&
             (r.command() != static_cast<std::uint32_t>(first_command) || r.error() == 0))
-            stats.mismatch(fmt::format("{}: answered command {} error {}", what, r.command(), r.error()));
+            stats.mismatch(
+                fmt::format("{}: answered command {} error {}", what, r.command(), r.error()));
     }
 }
 
@@ -149,9 +157,13 @@ void churn_once(const Target& t, Rng& rng, Stats& stats) {
         return tcp_packet(TcpCommand::frame, f);
     };
     switch (scenario) {
-        case 0: break;                                     // connect, close
-        case 1: c->fd.abort(); ++stats.resets; return;     // connect, reset
-        case 2: {                                          // a read, answered
+        case 0:
+            break;  // connect, close
+        case 1:
+            c->fd.abort();
+            ++stats.resets;
+            return;  // connect, reset
+        case 2: {    // a read, answered
             auto f = request(t.server_node, c->node, 7, {0x01, 0x01}, {0x82, 0, 0, 0, 0, 1});
             send_all(fd, tcp_packet(TcpCommand::frame, f));
             const auto r = receive_tcp_packet(fd);

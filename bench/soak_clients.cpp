@@ -49,7 +49,11 @@ void put16(std::vector<std::uint8_t>& v, std::uint16_t x) {
 class Verifier {
   public:
     Verifier(Range r, std::uint64_t seed, Stats& stats, std::string name)
-        : range_(r), value_(r.count), known_(r.count), rng_(seed), stats_(stats),
+        : range_(r),
+          value_(r.count),
+          known_(r.count),
+          rng_(seed),
+          stats_(stats),
           name_(std::move(name)) {}
 
     struct Op {
@@ -105,7 +109,8 @@ class Verifier {
             return true;
         }
         if (write) {
-            if (!data->empty()) return fail(op, fmt::format("{} data bytes after a write", data->size()));
+            if (!data->empty())
+                return fail(op, fmt::format("{} data bytes after a write", data->size()));
             for (std::size_t i = 0; i < op.offsets.size(); ++i) {
                 value_[op.offsets[i]] = op.values[i];
                 known_[op.offsets[i]] = true;
@@ -115,10 +120,12 @@ class Verifier {
         const bool multi = op.code == CommandCode{0x01, 0x04};
         const std::size_t item = multi ? 3 : 2;
         if (data->size() != op.offsets.size() * item)
-            return fail(op, fmt::format("{} data bytes for {} words", data->size(), op.offsets.size()));
+            return fail(op,
+                        fmt::format("{} data bytes for {} words", data->size(), op.offsets.size()));
         for (std::size_t i = 0; i < op.offsets.size(); ++i) {
             const auto* p = data->data() + i * item;
-            if (multi && p[0] != dm) return fail(op, fmt::format("item {} area code {:02X}", i, p[0]));
+            if (multi && p[0] != dm)
+                return fail(op, fmt::format("item {} area code {:02X}", i, p[0]));
             if (multi) ++p;
             const auto got = static_cast<std::uint16_t>((p[0] << 8) | p[1]);
             const auto o = op.offsets[i];

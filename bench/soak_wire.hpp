@@ -144,7 +144,8 @@ inline TcpReceived receive_tcp_packet(int fd) {
     return r;
 }
 
-inline std::vector<std::uint8_t> tcp_packet(TcpCommand command, const std::vector<std::uint8_t>& data,
+inline std::vector<std::uint8_t> tcp_packet(TcpCommand command,
+                                            const std::vector<std::uint8_t>& data,
                                             std::size_t declared) {
     std::vector<std::uint8_t> out(tcp_header_size + data.size());
     ByteWriter w{out};
@@ -153,7 +154,8 @@ inline std::vector<std::uint8_t> tcp_packet(TcpCommand command, const std::vecto
     return out;
 }
 
-inline std::vector<std::uint8_t> tcp_packet(TcpCommand command, const std::vector<std::uint8_t>& data) {
+inline std::vector<std::uint8_t> tcp_packet(TcpCommand command,
+                                            const std::vector<std::uint8_t>& data) {
     return tcp_packet(command, data, data.size());
 }
 
@@ -181,15 +183,15 @@ inline std::vector<std::uint8_t> request(std::uint8_t destination_node, std::uin
 // command table does not know (answered 0401). Garbage is made of these only, so it can
 // never write into a verifying client's words, take the access right or stop the CPU.
 inline constexpr std::array<CommandCode, 10> harmless_commands{{{0x01, 0x01},
-                                                               {0x01, 0x04},
-                                                               {0x02, 0x01},
-                                                               {0x03, 0x06},
-                                                               {0x05, 0x01},
-                                                               {0x05, 0x02},
-                                                               {0x06, 0x01},
-                                                               {0x07, 0x01},
-                                                               {0x21, 0x02},
-                                                               {0x21, 0x40}}};
+                                                                {0x01, 0x04},
+                                                                {0x02, 0x01},
+                                                                {0x03, 0x06},
+                                                                {0x05, 0x01},
+                                                                {0x05, 0x02},
+                                                                {0x06, 0x01},
+                                                                {0x07, 0x01},
+                                                                {0x21, 0x02},
+                                                                {0x21, 0x40}}};
 
 inline bool harmless(CommandCode code) {
     if (find_command(code) == nullptr) return true;

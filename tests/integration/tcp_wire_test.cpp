@@ -79,9 +79,10 @@ TEST_F(TcpWire, RequestSplitAtEveryBytePositionIsAnsweredOnce) {
     ASSERT_EQ(end_code_of(c.receive_packet(), tcp_header_size), 0x0000);
 
     const auto read_word = [&](std::uint16_t word, std::uint8_t sid) {
-        return tcp_packet(TcpCommand::frame,
-                          request_frame({0x01, 0x01}, {0x82, 0, static_cast<std::uint8_t>(word), 0, 0, 1},
-                                        sid, node));
+        return tcp_packet(
+            TcpCommand::frame,
+            request_frame({0x01, 0x01}, {0x82, 0, static_cast<std::uint8_t>(word), 0, 0, 1}, sid,
+                          node));
     };
     // The answer to read_word(word, sid): that SID and the word's value, nothing else.
     const auto expect_answer = [&](std::uint16_t word, std::uint8_t sid, std::size_t split) {
