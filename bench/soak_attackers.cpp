@@ -20,6 +20,10 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using Rng = std::mt19937_64;
 
+// How long finsd may take to answer or close: far beyond any scheduling delay on a
+// loaded machine, so only a stuck finsd hits it.
+constexpr int closing_ms = 10'000;
+
 std::vector<std::uint8_t> random_bytes(Rng& rng, std::size_t n) {
     std::vector<std::uint8_t> v(n);
     for (auto& b : v)
@@ -123,7 +127,7 @@ struct Connection {
 
 std::optional<Connection> open(const Target& t, bool handshake, Stats& stats) {
     Connection c;
-    c.fd = tcp_connect(t.port, 5000);
+    c.fd = tcp_connect(t.port, closing_ms);
     if (!c.fd.valid()) {
         stats.error("churn: connect failed");
         return std::nullopt;
@@ -181,24 +185,24 @@ void churn_once(const Target& t, Rng& rng, Stats& stats) {
             auto p = frame(c->node);
             p[rng() % 4] ^= 0x20;
             send_all(fd, p);
-            read_until_close(fd, 5000, stats, "bad magic", 3);
+            read_until_close(fd, closing_ms, stats, "bad magic", 3);
             break;
         }
         case 5:  // length beyond the largest frame
             send_all(fd, tcp_packet(TcpCommand::frame, {}, max_frame_size + 1 + rng() % 100));
-            read_until_close(fd, 5000, stats, "oversized length", 3);
+            read_until_close(fd, closing_ms, stats, "oversized length", 3);
             break;
         case 6:  // a second handshake
             send_all(fd, handshake_request(0));
-            read_until_close(fd, 5000, stats, "second handshake", 3);
+            read_until_close(fd, closing_ms, stats, "second handshake", 3);
             break;
         case 7:  // the server's own node: refused in the handshake
             send_all(fd, handshake_request(t.server_node));
-            read_until_close(fd, 5000, stats, "handshake as the server's node", 1);
+            read_until_close(fd, closing_ms, stats, "handshake as the server's node", 1);
             break;
         case 8:  // a frame before any handshake
             send_all(fd, frame(0xEF));
-            read_until_close(fd, 5000, stats, "frame before handshake", 3);
+            read_until_close(fd, closing_ms, stats, "frame before handshake", 3);
             break;
         case 9:  // harmless frames, some from a node that is not ours
             for (auto i = rng() % 4 + 1; i > 0; --i)

@@ -32,7 +32,7 @@ namespace {
 
 constexpr std::uint8_t dm = 0x82;
 constexpr int udp_timeout_ms = 1000;
-constexpr int tcp_timeout_ms = 5000;
+constexpr int tcp_timeout_ms = 10'000;  // only a stuck finsd takes this long
 
 std::vector<std::uint8_t> dm_address(std::uint16_t word) {
     return {dm, static_cast<std::uint8_t>(word >> 8), static_cast<std::uint8_t>(word), 0};
@@ -229,7 +229,7 @@ void run_tcp_client(Target t, Range r, std::uint64_t seed, Stats& stats, std::at
         if (!send_all(fd.get(), tcp_packet(TcpCommand::frame, frame)))
             return stats.mismatch(name + ": connection lost on send");
         const auto in = receive_tcp_packet(fd.get());
-        if (in.status == Read::timeout) return stats.mismatch(name + ": no answer within 5 s");
+        if (in.status == Read::timeout) return stats.mismatch(name + ": no answer within 10 s");
         if (!in.well_formed() || in.command() != 2)
             return stats.mismatch(name + ": connection lost or not a FRAME SEND");
         const Bytes got{in.packet.data() + tcp_header_size, in.packet.size() - tcp_header_size};
