@@ -16,6 +16,7 @@
 #include <asio/read.hpp>
 #include <asio/write.hpp>
 
+#include "../fuzz/corpus_dump.hpp"
 #include "fins/frame.hpp"
 #include "fins/tcp.hpp"
 
@@ -57,7 +58,13 @@ class RawTcp {
         socket_.set_option(asio::ip::tcp::no_delay(true));
         set_receive_timeout(socket_.native_handle(), 5);
     }
-    void send(const std::vector<std::uint8_t>& bytes) { asio::write(socket_, asio::buffer(bytes)); }
+    ~RawTcp() { fuzz::dump_test_bytes("tcp_stream", sent_); }  // FINS_FUZZ_DUMP
+    RawTcp(RawTcp&&) = default;
+    RawTcp& operator=(RawTcp&&) = default;
+    void send(const std::vector<std::uint8_t>& bytes) {
+        sent_.insert(sent_.end(), bytes.begin(), bytes.end());
+        asio::write(socket_, asio::buffer(bytes));
+    }
     // Reads one whole FINS/TCP packet; empty on EOF, error or timeout.
     std::vector<std::uint8_t> receive_packet() {
         std::vector<std::uint8_t> head(tcp_header_size);
@@ -101,6 +108,7 @@ class RawTcp {
   private:
     asio::ip::tcp::socket socket_;
     std::error_code last_error_;
+    std::vector<std::uint8_t> sent_;  // everything sent, for the fuzz corpus
 };
 
 inline std::uint32_t be32(const std::vector<std::uint8_t>& b, std::size_t at) {

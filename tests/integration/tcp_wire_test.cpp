@@ -60,21 +60,55 @@ TEST_F(TcpWire, HandshakeErrorsAreSentInCommandOneThenClosed) {
     EXPECT_EQ(be32(full.handshake(0), 12), 0x20u);  // max_tcp_connections = 3
 }
 
+// Every split request reads its own word (D<split>, holding 0x1000 + split) with its own
+// SID, so an answer can be told from every other one; a sentinel request at the end must
+// be answered next on the wire, so a request answered twice (or a stray byte) fails.
 TEST_F(TcpWire, RequestSplitAtEveryBytePositionIsAnsweredOnce) {
     auto c = connect();
-    ASSERT_EQ(be32(c.handshake(), 12), 0u);
-    const auto packet = tcp_packet(TcpCommand::frame, read_d0);
-    for (std::size_t split = 1; split < packet.size(); ++split) {
+    const auto handshake = c.handshake();
+    ASSERT_EQ(be32(handshake, 12), 0u);
+    const auto node = static_cast<std::uint8_t>(be32(handshake, 16));  // our SA1
+    constexpr std::uint16_t words = 64;
+    constexpr std::uint16_t base = 0x1000;
+    std::vector<std::uint8_t> write{0x82, 0, 0, 0, 0, words};
+    for (std::uint16_t i = 0; i < words; ++i) {
+        write.push_back(static_cast<std::uint8_t>((base + i) >> 8));
+        write.push_back(static_cast<std::uint8_t>(base + i));
+    }
+    c.send(tcp_packet(TcpCommand::frame, request_frame({0x01, 0x02}, write, 0xF0, node)));
+    ASSERT_EQ(end_code_of(c.receive_packet(), tcp_header_size), 0x0000);
+
+    const auto read_word = [&](std::uint16_t word, std::uint8_t sid) {
+        return tcp_packet(
+            TcpCommand::frame,
+            request_frame({0x01, 0x01}, {0x82, 0, static_cast<std::uint8_t>(word), 0, 0, 1}, sid,
+                          node));
+    };
+    // The answer to read_word(word, sid): that SID and the word's value, nothing else.
+    const auto expect_answer = [&](std::uint16_t word, std::uint8_t sid, std::size_t split) {
+        const auto r = c.receive_packet();
+        ASSERT_EQ(r.size(), tcp_header_size + 16) << "split at " << split;
+        EXPECT_EQ(r[tcp_header_size + 9], sid) << "split at " << split;
+        EXPECT_EQ(end_code_of(r, tcp_header_size), 0x0000) << "split at " << split;
+        EXPECT_EQ((r[tcp_header_size + 14] << 8) | r[tcp_header_size + 15], base + word)
+            << "split at " << split;
+    };
+    const std::size_t size = read_word(0, 0).size();
+    ASSERT_LT(size, words);
+    for (std::size_t split = 1; split < size; ++split) {
+        const auto word = static_cast<std::uint16_t>(split);
+        const auto packet = read_word(word, static_cast<std::uint8_t>(split));
         c.send({packet.begin(), packet.begin() + static_cast<std::ptrdiff_t>(split)});
         c.send({packet.begin() + static_cast<std::ptrdiff_t>(split), packet.end()});
-        auto r = c.receive_packet();
-        ASSERT_EQ(r.size(), tcp_header_size + 16) << "split at " << split;
-        EXPECT_EQ(end_code_of(r, tcp_header_size), 0x0000);
+        expect_answer(word, static_cast<std::uint8_t>(split), split);
     }
     // And one byte per write.
-    for (auto b : packet)
+    for (auto b : read_word(static_cast<std::uint16_t>(size), 0x77))
         c.send({b});
-    EXPECT_EQ(end_code_of(c.receive_packet(), tcp_header_size), 0x0000);
+    expect_answer(static_cast<std::uint16_t>(size), 0x77, 0);
+    // The sentinel: a whole request whose answer must be the very next packet.
+    c.send(read_word(words - 1, 0xAA));
+    expect_answer(words - 1, 0xAA, 0);
 }
 
 TEST_F(TcpWire, GluedRequestsGetOneWholeResponseEach) {

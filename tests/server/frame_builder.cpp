@@ -3,6 +3,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "../fuzz/corpus_dump.hpp"
+
 namespace fins::test {
 
 namespace {
@@ -84,7 +86,9 @@ std::vector<std::uint8_t> Reply::data() const {
 Harness::Harness(plc::Profile profile) : plc(std::move(profile)), dispatcher(plc, server_node) {}
 
 Reply Harness::send(Bytes frame) {
+    fuzz::dump_test_bytes("request", frame);  // FINS_FUZZ_DUMP: fuzz/make_corpus.sh
     const auto n = dispatcher.handle(frame, out_, context);
+    fuzz::dump_test_bytes("response", {out_.data(), n});
     return Reply{
         std::vector<std::uint8_t>(out_.begin(), out_.begin() + static_cast<std::ptrdiff_t>(n))};
 }
