@@ -58,6 +58,12 @@ std::optional<plc::NetworkWriteProtection> parse_protection(std::string_view tex
     return std::nullopt;
 }
 
+std::optional<plc::Durability> parse_durability(std::string_view text) noexcept {
+    if (text == "process") return plc::Durability::process;
+    if (text == "power") return plc::Durability::power;
+    return std::nullopt;
+}
+
 std::optional<NodeAddress> parse_node(std::string_view text) noexcept {
     const auto dot = text.find('.');
     if (dot == std::string_view::npos) return std::nullopt;
@@ -121,6 +127,12 @@ Expected<void> apply_overrides(const Overrides& o, Settings& s) {
     }
     if (o.um_read_protection) s.um_read_protection = *o.um_read_protection;
     if (o.dip_write_protection) s.dip_write_protection = *o.dip_write_protection;
+    if (o.durability) {
+        const auto d = parse_durability(*o.durability);
+        if (!d) return error(fmt::format("--durability: '{}' is not process or power", *o.durability));
+        s.durability = *d;
+    }
+    if (o.reset_state) s.reset_state = true;
     return {};
 }
 
