@@ -175,9 +175,12 @@ int open_plc(const Settings& s, const fins::plc::Profile& profile,
         const auto aside = Storage::set_aside(*s.data_dir);
         if (!aside) return fail(3, file + ": cannot move it aside: " +
                                        aside.error().message());
-        spdlog::warn("finsd: state file {} refused ({}); --reset-state moved it to {}: "
-                     "retained memory starts empty",
-                     file, error.message(), aside->string());
+        // Warnings about the operator's data go to stderr with the refusals, whatever
+        // the log level (stdout's first line stays "listening <port>" at warn).
+        std::fprintf(stderr,
+                     "finsd: warning: %s: %s; --reset-state moved it to %s: retained memory "
+                     "starts empty\n",
+                     file.c_str(), error.message().c_str(), aside->string().c_str());
         moved = true;
     }
 }
@@ -195,10 +198,11 @@ int serve(const Settings& s) {
     fins::plc::Plc& plc = *plc_owner;
     const bool restored = plc.storage().restored();
     if (s.data_dir && restored && !plc.storage().checksums_verified())
-        spdlog::warn("finsd: state file {} was not stopped cleanly (SIGKILL, crash or power "
-                     "loss): its header and section table are intact, section checksums "
-                     "cannot be checked",
-                     plc.storage().path().string());
+        std::fprintf(stderr,
+                     "finsd: warning: %s was not stopped cleanly (SIGKILL, crash or power "
+                     "loss): its header and section table are intact; its data has no valid "
+                     "checksums to check\n",
+                     plc.storage().path().c_str());
     if (s.data_dir)
         spdlog::info("finsd: {} state file {}", restored ? "restored" : "new",
                      plc.storage().path().string());
@@ -234,6 +238,8 @@ int serve(const Settings& s) {
                                started.error().message());
         control = std::move(*started);
     }
+    // Before "listening": a SIGTERM right after that line still stops finsd cleanly.
+    asio::signal_set signals{io, SIGINT, SIGTERM};
     const auto self = (*server)->address();
     const unsigned port =
         (*server)->tcp_port() != 0 ? (*server)->tcp_port() : (*server)->udp_port();
@@ -244,7 +250,6 @@ int serve(const Settings& s) {
     std::printf("listening %u\n", port);
     std::fflush(stdout);
 
-    asio::signal_set signals{io, SIGINT, SIGTERM};
     signals.async_wait([&](std::error_code, int signal) {
         spdlog::info("finsd: signal {}, shutting down", signal);
         (*server)->stop();
