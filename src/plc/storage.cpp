@@ -53,15 +53,6 @@ std::string_view entry_name(const sf::Entry& e) {
     return {e.name, ::strnlen(e.name, sf::name_size)};
 }
 
-// CRC-32C of `block` with its own checksum field `field` taken as 0.
-template <class Block>
-std::uint32_t crc_without(const Block& block, const std::uint32_t& field) {
-    const auto all = std::as_bytes(std::span(&block, 1));
-    const auto at = static_cast<std::size_t>(reinterpret_cast<const std::byte*>(&field) - all.data());
-    constexpr std::array<std::byte, sizeof field> zero{};
-    return crc32c(all.subspan(at + sizeof field), crc32c(zero, crc32c(all.first(at))));
-}
-
 Unexpected fail(std::error_code e) {
     return Unexpected(e);
 }
@@ -82,6 +73,7 @@ struct Storage::Impl {
     bool verified = false;
     bool sealed = false;
     bool closed = false;
+    bool upgraded = false;  // converted from a version 1 file
     std::error_code problem;
     std::filesystem::path path;
 
@@ -118,7 +110,7 @@ struct Storage::Impl {
                 seal.section_crc[i] = crc32c(sections[i]);
             seal.clean = sf::clean_mark;
         }
-        seal.crc = crc_without(seal, seal.crc);
+        seal.crc = sf::crc_without(seal, seal.crc);
     }
 
     Result<void> create(std::string_view profile_id);
@@ -165,9 +157,21 @@ Result<void> Storage::Impl::restore(std::string_view profile_id) {
     if (auto r = map_header(); !r) return r;
     const sf::Descriptor& d = header->descriptor;
     if (d.magic != sf::magic) return fail(make(Error::not_a_state_file));
+    if (d.version == 1 && !upgraded) {
+        // Converted into a new file (the old one kept as finsd.state.version1), then
+        // checked as any other.
+        auto converted = sf::convert_version1(dir_fd, fd, size);
+        if (!converted) return fail(converted.error());
+        ::munmap(header, page);
+        header = nullptr;
+        ::close(fd);
+        fd = *converted;
+        upgraded = true;
+        return restore(profile_id);
+    }
     if (d.version != sf::version) return fail(make(Error::unsupported_version));
     if (d.complete != sf::complete_mark) return fail(make(Error::incomplete));
-    if (d.crc != crc_without(d, d.crc)) return fail(make(Error::header_checksum));
+    if (d.crc != sf::crc_without(d, d.crc)) return fail(make(Error::header_checksum));
     if (std::string_view(d.profile, ::strnlen(d.profile, sf::profile_size)) != profile_id)
         return fail(make(Error::other_profile));
     if (d.file_size != size || d.count > sf::max_entries) return fail(make(Error::damaged));
@@ -183,7 +187,7 @@ Result<void> Storage::Impl::restore(std::string_view profile_id) {
     }
     if (end != size) return fail(make(Error::damaged));
     const sf::Seal& seal = header->seal;
-    if (seal.crc != crc_without(seal, seal.crc)) return fail(make(Error::header_checksum));
+    if (seal.crc != sf::crc_without(seal, seal.crc)) return fail(make(Error::header_checksum));
     if (seal.clean == sf::clean_mark) {
         if (auto r = verify_sections(size); !r) return r;
         verified = true;
@@ -332,7 +336,7 @@ Result<void> Storage::seal() {
     if (s.creating) {
         sf::Descriptor& d = s.header->descriptor;
         d.complete = sf::complete_mark;
-        d.crc = crc_without(d, d.crc);
+        d.crc = sf::crc_without(d, d.crc);
     }
     if (::fdatasync(s.fd) != 0) return fail(last_error());
     if (s.creating) {

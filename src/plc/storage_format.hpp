@@ -20,12 +20,17 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <system_error>
+
+#include "fins/error.hpp"
+#include "plc/crc32c.hpp"
 
 namespace fins::plc::state_file {
 
 inline constexpr std::array<char, 8> magic{'F', 'I', 'N', 'S', 'K', 'I', 'T', '\0'};
-// 1: no checksums, created in place (refused now: moving it aside keeps its data).
+// 1: no checksums, created in place; the same descriptor layout with 0 for its crc and
+// a zero seal block (convert_version1).
 inline constexpr std::uint32_t version = 2;
 inline constexpr std::size_t page = 4096;
 inline constexpr std::size_t seal_offset = 3584;
@@ -87,6 +92,24 @@ enum class Error : int {
 };
 
 std::error_code make_error(Error e) noexcept;
+
+// CRC-32C of `block` with its own checksum field `field` taken as 0.
+template <class Block>
+std::uint32_t crc_without(const Block& block, const std::uint32_t& field) {
+    const auto all = std::as_bytes(std::span(&block, 1));
+    const auto at =
+        static_cast<std::size_t>(reinterpret_cast<const std::byte*>(&field) - all.data());
+    constexpr std::array<std::byte, sizeof field> zero{};
+    return crc32c(all.subspan(at + sizeof field), crc32c(zero, crc32c(all.first(at))));
+}
+
+// A complete version 1 `finsd.state` (open as `fd`, `size` bytes, in the locked
+// directory `dir_fd`) copied to a version 2 file: built as finsd.state.new (reserved,
+// header given version 2, its checksum and a "not stopped cleanly" seal), synced, the
+// old file kept as finsd.state.version1 (a hard link), renamed into place, directory
+// synced. Returns the new file's descriptor. An incomplete version 1 file, or one with
+// more sections than version 2 holds, is refused (incomplete, unsupported_version).
+Result<int> convert_version1(int dir_fd, int fd, std::uint64_t size);
 // True for the errors about an existing file's content (Storage::is_refusal).
 bool is_refusal(const std::error_code& e) noexcept;
 

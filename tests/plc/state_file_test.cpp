@@ -273,6 +273,33 @@ TEST_F(StateFile, SparseExistingFileIsReservedAtStart) {
     EXPECT_GE(after.st_blocks * 512, static_cast<blkcnt_t>(bytes.size()));
 }
 
+// A version 1 file (earlier finsd: no checksums, the same section table) is converted
+// with its data, and kept as finsd.state.version1.
+TEST_F(StateFile, Version1FileIsConvertedAndKept) {
+    create();
+    const std::uint32_t v1 = 1;
+    const std::uint32_t zero = 0;
+    poke(8, &v1, sizeof v1);
+    poke(92, &zero, sizeof zero);  // version 1's reserved field, now the checksum
+    const std::string tail(4096 - 3552, '\0');
+    poke(3552, tail.data(), tail.size());
+    const std::string old = contents();
+    bool verified = true;
+    EXPECT_EQ(reopen_a(&verified)[99], 0xA099);
+    EXPECT_FALSE(verified);  // version 1 had no checksums to check
+    std::ifstream kept(dir_ / "finsd.state.version1", std::ios::binary);
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(kept), {}), old);
+    EXPECT_FALSE(fs::exists(dir_ / "finsd.state.new"));
+    EXPECT_EQ(reopen_a(&verified)[99], 0xA099);  // now a version 2 file, closed cleanly
+    EXPECT_TRUE(verified);
+
+    // An incomplete version 1 file (its creation never finished) is refused.
+    fs::remove(dir_ / "finsd.state.version1");
+    poke(8, &v1, sizeof v1);
+    poke(12, &zero, sizeof zero);
+    EXPECT_NE(message(Storage::open(dir_, "p1")).find("\"complete\" flag"), std::string::npos);
+}
+
 TEST_F(StateFile, PowerDurabilitySyncsOnEveryCommitProcessNever) {
     for (const auto durability : {Durability::process, Durability::power}) {
         auto s = Storage::open(dir_, "p1", {durability});

@@ -200,8 +200,8 @@ int serve(const Settings& s) {
     if (s.data_dir && restored && !plc.storage().checksums_verified())
         std::fprintf(stderr,
                      "finsd: warning: %s was not stopped cleanly (SIGKILL, crash or power "
-                     "loss): its header and section table are intact; its data has no valid "
-                     "checksums to check\n",
+                     "loss; or it was just converted from an earlier format): its header and "
+                     "section table are intact; its data has no valid checksums to check\n",
                      plc.storage().path().c_str());
     if (s.data_dir)
         spdlog::info("finsd: {} state file {}", restored ? "restored" : "new",
