@@ -157,6 +157,13 @@ TEST(FinsdStateFile, StorageKeysAndFlags) {
     EXPECT_TRUE(s.reset_state);
     Finsd flag({"--durability", "sometimes"});
     EXPECT_EQ(flag.result().exit_code, 2);
+    s.durability = plc::Durability::power;
+    const auto without_dir = cli::finsd::validate(s);
+    ASSERT_FALSE(without_dir);
+    EXPECT_EQ(without_dir.error(),
+              "storage.durability: \"power\" needs data_dir (without one nothing is kept)");
+    s.data_dir = "/tmp/d";
+    EXPECT_TRUE(cli::finsd::validate(s));
 }
 
 }  // namespace

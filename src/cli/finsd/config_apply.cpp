@@ -148,6 +148,8 @@ Expected<void> validate(const Settings& s) {
         s.network_write_protection.nodes.empty())
         return error("protection.nodes: empty, so network_write = \"listed\" protects nothing");
     if (const auto e = plc::validate(s.inject); !e.empty()) return error("inject." + e);
+    if (s.durability == plc::Durability::power && !s.data_dir)
+        return error("storage.durability: \"power\" needs data_dir (without one nothing is kept)");
     return {};
 }
 
