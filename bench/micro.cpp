@@ -55,8 +55,8 @@ BENCHMARK(BM_DispatchRead)->Arg(1)->Arg(999);
 // A 1-word MEMORY AREA WRITE to D100 on a state file in $TMPDIR (or /tmp):
 // arg 0 = [storage] durability "process", 1 = "power" (fdatasync before each answer).
 void BM_DispatchWriteStateFile(benchmark::State& state) {
-    const auto dir = std::filesystem::temp_directory_path() /
-                     ("finskit-bench-" + std::to_string(::getpid()));
+    const auto dir =
+        std::filesystem::temp_directory_path() / ("finskit-bench-" + std::to_string(::getpid()));
     std::filesystem::remove_all(dir);
     {
         const auto durability =
@@ -79,9 +79,9 @@ void BM_DispatchWriteStateFile(benchmark::State& state) {
         std::uint16_t value = 0;
         for (auto _ : state) {
             params[7] = static_cast<std::uint8_t>(++value);  // a change every time
-            const auto size = fins::encode_request(h, {0x01, 0x02},
-                                                   fins::Bytes{params.data(), 8}, frame)
-                                  .value_or(0);
+            const auto size =
+                fins::encode_request(h, {0x01, 0x02}, fins::Bytes{params.data(), 8}, frame)
+                    .value_or(0);
             auto n = dispatcher.handle(fins::Bytes{frame.data(), size}, out, context);
             benchmark::DoNotOptimize(n);
         }

@@ -306,8 +306,8 @@ std::span<std::byte> Storage::section(std::string_view name, std::size_t bytes, 
         }
     const std::uint64_t offset = d.file_size;
     const std::uint64_t length = round_up(bytes);
-    if (const int e = ::posix_fallocate(s.fd, static_cast<off_t>(offset),
-                                        static_cast<off_t>(length));
+    if (const int e =
+            ::posix_fallocate(s.fd, static_cast<off_t>(offset), static_cast<off_t>(length));
         e != 0) {
         if (!s.problem) s.problem = reserve_error(e);
         return s.on_heap(bytes);

@@ -143,7 +143,8 @@ TEST(FinsdStateFile, StorageKeysAndFlags) {
     EXPECT_EQ(s.durability, plc::Durability::process);
     ASSERT_TRUE(cli::finsd::load_config_text("[storage]\ndurability = \"power\"\n", "t.toml", s));
     EXPECT_EQ(s.durability, plc::Durability::power);
-    const auto bad = cli::finsd::load_config_text("[storage]\ndurability = \"disk\"\n", "t.toml", s);
+    const auto bad =
+        cli::finsd::load_config_text("[storage]\ndurability = \"disk\"\n", "t.toml", s);
     ASSERT_FALSE(bad);
     EXPECT_EQ(bad.error(), "t.toml:2:1: storage.durability: 'disk' is not process or power");
     const auto unknown = cli::finsd::load_config_text("[storage]\nreset = true\n", "t.toml", s);

@@ -6,8 +6,8 @@
 #include <array>
 #include <atomic>
 #include <cstring>
-#include <fstream>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <gtest/gtest.h>

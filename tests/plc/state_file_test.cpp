@@ -217,7 +217,7 @@ TEST_F(StateFile, FullFileSystemIsRefusedAtStartNotASigbus) {
         ASSERT_TRUE(s) << message(s);
         auto small = (*s)->array<std::uint16_t>("small", 100, R);
         auto big = (*s)->array<std::uint16_t>("big", 64 * 1024, R);  // 128 KiB
-        small[0] = 1;                                                  // reserved: fine
+        small[0] = 1;                                                // reserved: fine
         big[big.size() - 1] = 1;  // a heap stand-in, never a file page
         const auto sealed = (*s)->seal();
         ASSERT_FALSE(sealed);
@@ -225,7 +225,7 @@ TEST_F(StateFile, FullFileSystemIsRefusedAtStartNotASigbus) {
             << sealed.error().message();
         EXPECT_FALSE(Storage::is_refusal(sealed.error()));
     }
-    EXPECT_TRUE(fs::is_empty(dir_));  // the unfinished file is gone, its space free
+    EXPECT_TRUE(fs::is_empty(dir_));         // the unfinished file is gone, its space free
     auto again = Storage::open(dir_, "p1");  // and so at every restart
     ASSERT_TRUE(again);
     (*again)->array<std::uint16_t>("big", 64 * 1024, R);

@@ -129,7 +129,8 @@ Expected<void> apply_overrides(const Overrides& o, Settings& s) {
     if (o.dip_write_protection) s.dip_write_protection = *o.dip_write_protection;
     if (o.durability) {
         const auto d = parse_durability(*o.durability);
-        if (!d) return error(fmt::format("--durability: '{}' is not process or power", *o.durability));
+        if (!d)
+            return error(fmt::format("--durability: '{}' is not process or power", *o.durability));
         s.durability = *d;
     }
     if (o.reset_state) s.reset_state = true;

@@ -173,8 +173,7 @@ int open_plc(const Settings& s, const fins::plc::Profile& profile,
                                           "empty retained memory"
                                         : ""));
         const auto aside = Storage::set_aside(*s.data_dir);
-        if (!aside) return fail(3, file + ": cannot move it aside: " +
-                                       aside.error().message());
+        if (!aside) return fail(3, file + ": cannot move it aside: " + aside.error().message());
         // Warnings about the operator's data go to stderr with the refusals, whatever
         // the log level (stdout's first line stays "listening <port>" at warn).
         std::fprintf(stderr,
