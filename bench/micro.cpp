@@ -1,6 +1,10 @@
 // Google Benchmark micro-benchmarks of the hot path: decoding a request frame and
 // running it through the dispatcher into a response buffer (no sockets).
+#include <unistd.h>
+
 #include <array>
+#include <filesystem>
+#include <string>
 
 #include <benchmark/benchmark.h>
 
@@ -47,5 +51,43 @@ void BM_DispatchRead(benchmark::State& state) {
     }
 }
 BENCHMARK(BM_DispatchRead)->Arg(1)->Arg(999);
+
+// A 1-word MEMORY AREA WRITE to D100 on a state file in $TMPDIR (or /tmp):
+// arg 0 = [storage] durability "process", 1 = "power" (fdatasync before each answer).
+void BM_DispatchWriteStateFile(benchmark::State& state) {
+    const auto dir =
+        std::filesystem::temp_directory_path() / ("finskit-bench-" + std::to_string(::getpid()));
+    std::filesystem::remove_all(dir);
+    {
+        const auto durability =
+            state.range(0) == 0 ? fins::plc::Durability::process : fins::plc::Durability::power;
+        auto storage = fins::plc::Storage::open(dir, "cj2h", {durability});
+        if (!storage) {
+            state.SkipWithError(storage.error().message().c_str());
+            return;
+        }
+        fins::plc::Plc plc{fins::plc::cj2h(), std::move(*storage)};
+        if (!plc.storage().seal()) state.SkipWithError("seal failed");
+        fins::server::Dispatcher dispatcher{plc, {0, 1, 0}};
+        std::array<std::uint8_t, 16> params{0x82, 0x00, 0x64, 0x00, 0x00, 0x01, 0x00, 0x00};
+        fins::Header h;
+        h.destination = {0, 1, 0};
+        h.source = {0, 200, 0};
+        std::array<std::uint8_t, fins::max_frame_size> frame{};
+        std::array<std::uint8_t, fins::max_frame_size> out{};
+        const fins::server::RequestContext context{};
+        std::uint16_t value = 0;
+        for (auto _ : state) {
+            params[7] = static_cast<std::uint8_t>(++value);  // a change every time
+            const auto size =
+                fins::encode_request(h, {0x01, 0x02}, fins::Bytes{params.data(), 8}, frame)
+                    .value_or(0);
+            auto n = dispatcher.handle(fins::Bytes{frame.data(), size}, out, context);
+            benchmark::DoNotOptimize(n);
+        }
+    }
+    std::filesystem::remove_all(dir);
+}
+BENCHMARK(BM_DispatchWriteStateFile)->Arg(0)->Arg(1)->UseRealTime();
 
 }  // namespace

@@ -103,6 +103,11 @@ std::size_t Dispatcher::handle(Bytes request, MutableBytes out, const RequestCon
     // W342 5-3-30: the CPU Unit logs every FINS write command it receives.
     if (!info->conditions.network_write_protected || handler_context.write)
         plc_.write_access_log().record(header.source, command, code, context.now);
+    // [storage] durability = "power": what a write command changed is on disk before
+    // its answer; when that fails the answer says so.
+    if (!info->conditions.network_write_protected && !plc_.storage().commit() &&
+        code == EndCode::normal_completion)
+        code = EndCode::memory_error;
     if (code != EndCode::normal_completion && !handler_context.keep_data) return answer(code);
 
     const auto prefix = answer(code);

@@ -1,7 +1,8 @@
 // Retained memory survives SIGKILL: finsd with --data-dir acknowledges thousands of
 // writes to D, H, EM and counter words, is killed without a chance to flush, and a new
-// finsd on the same directory reads every acknowledged value back. CIO, W, timers and
-// the cleared Auxiliary Area words start at zero again.
+// finsd on the same directory reads every acknowledged value back (and warns that the
+// file was not stopped cleanly). CIO, W, timers and the cleared Auxiliary Area words
+// start at zero again.
 #include <signal.h>
 
 #include <functional>
@@ -114,6 +115,44 @@ TEST(Sigkill, AcknowledgedWritesSurviveAndClearedAreasStartAtZero) {
         EXPECT_EQ(words_of(*c, cleared, 100), std::vector<std::uint16_t>(100, 0)) << cleared;
     EXPECT_EQ(words_of(*c, "A448", 10), std::vector<std::uint16_t>(10, 0));
     EXPECT_EQ(words_of(*c, "A510", 11), std::vector<std::uint16_t>(11, 0x0510));
+
+    // The start after the kill said that the data's checksums could not be checked; a
+    // start after a clean stop (SIGTERM) checks them and says nothing.
+    const auto stopped = d.stop();
+    EXPECT_EQ(stopped.exit_code, 0);
+    EXPECT_NE(stopped.err.find("was not stopped cleanly"), std::string::npos) << stopped.err;
+    Finsd again({"--profile", "cj2h", "--data-dir", data});
+    ASSERT_TRUE(again.started()) << again.result().err;
+    const auto clean = again.stop();
+    EXPECT_EQ(clean.exit_code, 0);
+    EXPECT_EQ(clean.err.find("warning"), std::string::npos) << clean.err;
+}
+
+// --durability power: the same guarantee through the fdatasync path (what it adds, the
+// power-loss case, cannot be produced in a test; docs/benchmarks.md has its cost).
+TEST(Sigkill, PowerDurabilityAcknowledgedWritesSurvive) {
+    ScratchDir dir("sigkill");
+    const std::string data = (dir.path() / "data").string();
+    constexpr std::size_t total = 300;
+    {
+        Finsd d({"--profile", "cs1h", "--data-dir", data, "--durability", "power"});
+        ASSERT_TRUE(d.started()) << d.result().err;
+        auto c = d.client(false);
+        ASSERT_NE(c, nullptr);
+        for (std::size_t i = 0; i < total; ++i)
+            ASSERT_EQ(end_code(*c, memory_write,
+                               write_params(fmt::format("D{}", 20000 + i), value_of(i))),
+                      0u);
+        d.stop(SIGKILL);
+    }
+    Finsd d({"--profile", "cs1h", "--data-dir", data, "--durability", "power"});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    auto c = d.client(false);
+    ASSERT_NE(c, nullptr);
+    const auto got = words_of(*c, "D20000", total);
+    ASSERT_EQ(got.size(), total);
+    for (std::size_t i = 0; i < total; ++i)
+        EXPECT_EQ(got[i], value_of(i)) << i;
 }
 
 // SIGKILL while 32 writes are in flight: every write acknowledged before the kill is

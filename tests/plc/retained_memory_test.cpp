@@ -3,8 +3,11 @@
 // and through a whole Plc.
 #include <unistd.h>
 
+#include <array>
 #include <atomic>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -184,6 +187,47 @@ TEST_F(Retained, WholePlcRestoresIoMemoryAndRefusesAnotherProfile) {
     bigger.em_banks = 14;
     Plc plc(bigger, open(p));
     EXPECT_FALSE(plc.storage().seal());
+}
+
+// Issue 6 item 6: after a clean stop, a changed byte in the retained section of any
+// model (I/O memory, parameter areas, program, clock, logs, messages) is refused, and
+// the file is served again once the byte is back.
+TEST_F(Retained, WholePlcEverySectionIsUnderTheChecksums) {
+    const Profile p = *find_profile("cj1m");
+    {
+        Plc plc(p, open(p));
+        ASSERT_TRUE(plc.storage().seal());
+    }
+    const fs::path file = dir_ / "finsd.state";
+    std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+    std::array<char, 4096> header{};
+    f.read(header.data(), header.size());
+    std::uint32_t count = 0;
+    std::memcpy(&count, header.data() + 88, sizeof count);  // storage_format.hpp
+    EXPECT_GE(count, 8u);
+    for (std::uint32_t i = 0; i < count; ++i) {
+        const char* entry = header.data() + 96 + 64 * i;
+        std::uint64_t offset = 0;
+        std::uint64_t size = 0;
+        std::memcpy(&offset, entry + 40, sizeof offset);
+        std::memcpy(&size, entry + 48, sizeof size);
+        if (size == 0) continue;
+        const auto at = static_cast<std::streamoff>(offset + size - 1);  // its last byte
+        char byte = 0;
+        f.seekg(at);
+        f.get(byte);
+        f.seekp(at);
+        f.put(static_cast<char>(byte ^ 0x10));
+        f.flush();
+        const auto refused = Storage::open(dir_, p.name);
+        EXPECT_FALSE(refused) << entry;
+        f.seekp(at);
+        f.put(byte);
+        f.flush();
+    }
+    Plc plc(p, open(p));
+    EXPECT_TRUE(plc.storage().seal());
+    EXPECT_TRUE(plc.storage().checksums_verified());
 }
 
 TEST_F(Retained, EveryProfileRoundTripsItsLayout) {

@@ -1,6 +1,7 @@
 // plc::Storage: heap mode, and the state file of a data directory (restore after a
-// reopen, refusal of foreign, damaged or mismatching files, the lock, restarting an
-// unfinished creation).
+// reopen, refusal of foreign, damaged or mismatching files, the lock, creation that is
+// atomic at every step). Checksums, full disks and moving aside: state_file_test.cpp.
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -23,8 +24,9 @@ namespace fs = std::filesystem;
 constexpr auto R = Retention::retained;
 constexpr auto C = Retention::cleared;
 
-// Header offsets of the state file (storage.cpp): magic 0, version 8, complete 12,
-// profile 16, file_size 80, count 88, entries from 96 (64 bytes: name 40, offset, size).
+// Header offsets of the state file (storage_format.hpp): magic 0, version 8, complete
+// 12, profile 16, file_size 80, count 88, crc 92, entries from 96 (64 bytes: name 40,
+// offset, size).
 constexpr std::streamoff version_at = 8;
 constexpr std::streamoff first_entry_offset_at = 96 + 40;
 
@@ -151,13 +153,15 @@ TEST_F(StorageFile, CorruptedMagicVersionOrSectionTableIsRefused) {
     const std::uint32_t v = 99;
     poke(version_at, &v, sizeof v);
     EXPECT_NE(message(Storage::open(dir_, "p1")).find("unsupported"), std::string::npos);
-    const std::uint32_t one = 1;
-    poke(version_at, &one, sizeof one);
+    const std::uint32_t two = 2;
+    poke(version_at, &two, sizeof two);
     ASSERT_TRUE(Storage::open(dir_, "p1"));
 
+    // The header's own checksum catches a changed section table first.
     const std::uint64_t bad_offset = 4096 * 3;
     poke(first_entry_offset_at, &bad_offset, sizeof bad_offset);
-    EXPECT_NE(message(Storage::open(dir_, "p1")).find("damaged"), std::string::npos);
+    EXPECT_NE(message(Storage::open(dir_, "p1")).find("header fails its checksum"),
+              std::string::npos);
     const std::uint64_t huge = ~std::uint64_t{0};
     const std::uint64_t page = 4096;
     poke(first_entry_offset_at, &page, sizeof page);
@@ -224,21 +228,84 @@ TEST_F(StorageFile, SecondOpenWhileInUseIsRefused) {
     EXPECT_TRUE(Storage::open(dir_, "p1"));
 }
 
-TEST_F(StorageFile, UnfinishedCreationStartsOver) {
+TEST_F(StorageFile, UnsealedCreationLeavesNoStateFile) {
     {
         auto s = Storage::open(dir_, "p1");
         ASSERT_TRUE(s);
         auto a = (*s)->array<std::uint16_t>("a", 100, R);
         a[0] = 42;
-        // No seal(): as if the process died while the models were taking sections.
+        EXPECT_FALSE(fs::exists(state()));  // built under another name until seal()
+        // No seal(): the models never finished taking sections.
     }
-    auto s = Storage::open(dir_, "other");  // the unfinished file binds nothing
+    EXPECT_FALSE(fs::exists(state()));
+    EXPECT_FALSE(fs::exists(dir_ / "finsd.state.new"));
+    auto s = Storage::open(dir_, "other");
     ASSERT_TRUE(s) << message(s);
     EXPECT_FALSE((*s)->restored());
     auto x = (*s)->array<std::uint16_t>("x", 5, R);
     ASSERT_TRUE((*s)->seal());
     EXPECT_EQ(x[0], 0);
     EXPECT_EQ(fs::file_size(state()), 2u * 4096u);
+}
+
+// A child process builds a state file and ends itself (_exit: no destructor, no
+// flush, as SIGKILL would) at creation step `stop_at`; returns the steps it passed,
+// or -1 when it finished without reaching that step.
+int create_and_die_at(const fs::path& dir, int stop_at) {
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        static int target = 0;
+        static int seen = 0;
+        target = stop_at;
+        Storage::set_creation_probe([](const char*) {
+            if (seen++ == target) ::_exit(10 + target);
+        });
+        auto s = Storage::open(dir, "p1");
+        if (!s) ::_exit(2);
+        (*s)->array<std::uint16_t>("a", 100, R)[7] = 0x0A07;
+        (*s)->array<std::uint16_t>("b", 5000, R)[4999] = 0x0B99;
+        (*s)->object<std::uint32_t>("c", R) = 0xC;
+        if (!(*s)->seal()) ::_exit(3);
+        ::_exit(1);
+    }
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    if (!WIFEXITED(status)) return -2;
+    const int code = WEXITSTATUS(status);
+    return code == 1 ? -1 : code >= 10 ? code - 10 : -3;
+}
+
+// Issue 6 item 15: the creation of a state file is atomic. Ended at each step in turn,
+// the creation leaves either no state file (finsd starts a new one) or a complete one
+// (finsd restores it); never a file finsd refuses. A file sized before its header was
+// written (the zero-header window of an in-place creation) would fail here.
+TEST_F(StorageFile, CreationEndedAtAnyStepLeavesNoStateFileOrACompleteOne) {
+    int steps = 0;
+    for (int stop_at = 0; stop_at < 50; ++stop_at) {
+        fs::remove_all(dir_);
+        const int reached = create_and_die_at(dir_, stop_at);
+        ASSERT_GE(reached, -1) << "child failed at step " << stop_at;
+        if (reached == -1) break;  // finished: every step was tried
+        ++steps;
+        auto s = Storage::open(dir_, "p1");
+        ASSERT_TRUE(s) << "after step " << stop_at << ": " << message(s);
+        auto a = (*s)->array<std::uint16_t>("a", 100, R);
+        auto b = (*s)->array<std::uint16_t>("b", 5000, R);
+        (*s)->object<std::uint32_t>("c", R);
+        ASSERT_TRUE((*s)->seal()) << "after step " << stop_at;
+        if ((*s)->restored()) {
+            EXPECT_EQ(a[7], 0x0A07) << "after step " << stop_at;
+            EXPECT_EQ(b[4999], 0x0B99) << "after step " << stop_at;
+        } else {
+            EXPECT_EQ(a[7], 0) << "after step " << stop_at;
+        }
+        // The step names of storage.hpp, in order: the rename is step 7 (0-based 7 =
+        // "renamed"), so a file exists exactly when the child got past the rename.
+        EXPECT_EQ((*s)->restored(), stop_at >= 7) << "after step " << stop_at;
+    }
+    // locked, temporary file created, header written, 3 x section reserved, synced,
+    // renamed, directory synced.
+    EXPECT_EQ(steps, 9);
 }
 
 TEST_F(StorageFile, DuplicateSectionOnCreationFailsSeal) {

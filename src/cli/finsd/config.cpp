@@ -59,6 +59,8 @@ class Loader {
                 r = section(key, node, k, &Loader::protection);
             else if (k == "memory")
                 r = section(key, node, k, &Loader::memory);
+            else if (k == "storage")
+                r = section(key, node, k, &Loader::storage);
             else if (k == "inject")
                 r = section(key, node, k, &Loader::inject);
             else
@@ -219,6 +221,16 @@ class Loader {
                             "must be \"network.node\" (network 0-127, node 1-254 or *)");
             s_.network_write_protection.nodes.push_back(*n);
         }
+        return {};
+    }
+
+    Expected<void> storage(const toml::key& key, const toml::node& node, const std::string& p) {
+        if (key.str() != "durability") return fail(key, p, "unknown key");
+        std::string value;
+        if (auto r = text(key, node, p, value); !r) return r;
+        const auto d = parse_durability(value);
+        if (!d) return fail(key, p, fmt::format("'{}' is not process or power", value));
+        s_.durability = *d;
         return {};
     }
 

@@ -62,6 +62,10 @@ struct Settings {
     std::string um_password;            // [protection] password: releases UM read protection (ctl)
     bool dip_write_protection = false;  // DIP switch pin 1 ON
 
+    // [storage]
+    plc::Durability durability = plc::Durability::process;
+    bool reset_state = false;  // --reset-state only: a refused state file is moved aside
+
     std::vector<MemoryInit> memory;  // [memory]
     plc::Injections inject;          // [inject]
 };
@@ -79,6 +83,8 @@ struct Overrides {
     std::optional<std::string> network_write_protection;
     std::vector<std::string> protect_nodes;  // non-empty: replaces the file's list
     std::optional<bool> um_read_protection, dip_write_protection;
+    std::optional<std::string> durability;
+    bool reset_state = false;
 };
 
 using Error = std::string;
@@ -98,6 +104,8 @@ Expected<void> validate(const Settings& settings);
 std::optional<plc::OperatingMode> parse_mode(std::string_view text) noexcept;
 // "off" / "all" / "listed" / "all-except-listed".
 std::optional<plc::NetworkWriteProtection> parse_protection(std::string_view text) noexcept;
+// "process" / "power" ([storage] durability).
+std::optional<plc::Durability> parse_durability(std::string_view text) noexcept;
 // "N.M" or "N.*": network 0-127, node 1-254 or * (any node of the network).
 std::optional<NodeAddress> parse_node(std::string_view text) noexcept;
 

@@ -58,6 +58,12 @@ std::optional<plc::NetworkWriteProtection> parse_protection(std::string_view tex
     return std::nullopt;
 }
 
+std::optional<plc::Durability> parse_durability(std::string_view text) noexcept {
+    if (text == "process") return plc::Durability::process;
+    if (text == "power") return plc::Durability::power;
+    return std::nullopt;
+}
+
 std::optional<NodeAddress> parse_node(std::string_view text) noexcept {
     const auto dot = text.find('.');
     if (dot == std::string_view::npos) return std::nullopt;
@@ -126,6 +132,13 @@ Expected<void> apply_overrides(const Overrides& o, Settings& s) {
     }
     if (o.um_read_protection) s.um_read_protection = *o.um_read_protection;
     if (o.dip_write_protection) s.dip_write_protection = *o.dip_write_protection;
+    if (o.durability) {
+        const auto d = parse_durability(*o.durability);
+        if (!d)
+            return error(fmt::format("--durability: '{}' is not process or power", *o.durability));
+        s.durability = *d;
+    }
+    if (o.reset_state) s.reset_state = true;
     return {};
 }
 
@@ -141,6 +154,8 @@ Expected<void> validate(const Settings& s) {
         s.network_write_protection.nodes.empty())
         return error("protection.nodes: empty, so network_write = \"listed\" protects nothing");
     if (const auto e = plc::validate(s.inject); !e.empty()) return error("inject." + e);
+    if (s.durability == plc::Durability::power && !s.data_dir)
+        return error("storage.durability: \"power\" needs data_dir (without one nothing is kept)");
     return {};
 }
 

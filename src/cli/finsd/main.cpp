@@ -8,9 +8,9 @@
 // -> seal the storage -> [memory] initial values -> protections, mode, [inject] ->
 // Server -> control channel -> "listening <port>" on stdout.
 //
-// Exit codes: 0 clean shutdown (SIGINT/SIGTERM: the state file is flushed first),
-// 2 usage or configuration error, 3 start-up failure (cannot bind, state file damaged,
-// foreign or in use, control socket).
+// Exit codes: 0 clean shutdown (SIGINT/SIGTERM: the state file is closed cleanly, with
+// checksums), 2 usage or configuration error, 3 start-up failure (cannot bind, state
+// file refused, in use or without room on disk, control socket).
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -67,6 +67,7 @@ int configure(int argc, char** argv, Settings& settings) {
     std::uint16_t port = 0;
     unsigned node = 0, network = 0;
     std::size_t max_connections = 0;
+    std::string durability;
     bool udp = true, tcp = true, um_read = false, dip_write = false, list = false;
     app.add_option("--config", config, "TOML configuration file (keys: see README)");
     auto* o_profile = app.add_option("--profile", profile, "PLC profile (--list-profiles)");
@@ -125,6 +126,13 @@ int configure(int argc, char** argv, Settings& settings) {
     auto* o_um = app.add_flag("--um-read-protection", um_read, "UM read protection set");
     auto* o_dip = app.add_flag("--dip-write-protection", dip_write,
                                "DIP switch pin 1 ON (UM write-protected)");
+    auto* o_durability =
+        app.add_option("--durability", durability,
+                       "What an acknowledged write survives: process (SIGKILL) or power "
+                       "(fdatasync before each write's answer)")
+            ->check(CLI::IsMember({"process", "power"}));
+    app.add_flag("--reset-state", o.reset_state,
+                 "Move a refused state file aside (never deleted) and start with a new one");
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -157,29 +165,71 @@ int configure(int argc, char** argv, Settings& settings) {
     take(o_protection, protection, o.network_write_protection);
     if (o_um->count() > 0) o.um_read_protection = true;
     if (o_dip->count() > 0) o.dip_write_protection = true;
+    take(o_durability, durability, o.durability);
     if (auto r = apply_overrides(o, settings); !r) return fail(2, r.error());
     if (auto r = validate(settings); !r) return fail(2, r.error());
     return -1;
 }
 
+// The PLC on its state file (or the heap) into `plc`; -1, or the exit code. A state
+// file refused for its content stops finsd unless --reset-state moves it aside (once).
+int open_plc(const Settings& s, const fins::plc::Profile& profile,
+             std::unique_ptr<fins::plc::Plc>& plc) {
+    using fins::plc::Storage;
+    for (bool moved = false;;) {
+        std::error_code error;
+        std::unique_ptr<Storage> storage;
+        if (s.data_dir) {
+            auto opened = Storage::open(*s.data_dir, profile.name, {s.durability});
+            if (opened) storage = std::move(*opened);
+            if (!opened) error = opened.error();
+        }
+        if (!error) {
+            plc = std::make_unique<fins::plc::Plc>(profile, std::move(storage));
+            const auto sealed = plc->storage().seal();
+            if (sealed) return -1;
+            error = sealed.error();
+            plc.reset();  // unmaps and unlocks the refused file
+        }
+        const std::string file =
+            s.data_dir ? (*s.data_dir / "finsd.state").string() : std::string("(heap)");
+        const bool refused = Storage::is_refusal(error);
+        if (!refused || !s.reset_state || moved)
+            return fail(3, file + ": " + error.message() +
+                               (refused ? "; finsd never replaces it by itself: start with "
+                                          "--reset-state to move it aside and begin with "
+                                          "empty retained memory"
+                                        : ""));
+        const auto aside = Storage::set_aside(*s.data_dir);
+        if (!aside) return fail(3, file + ": cannot move it aside: " + aside.error().message());
+        // Warnings about the operator's data go to stderr with the refusals, whatever
+        // the log level (stdout's first line stays "listening <port>" at warn).
+        std::fprintf(stderr,
+                     "finsd: warning: %s: %s; --reset-state moved it to %s: retained memory "
+                     "starts empty\n",
+                     file.c_str(), error.message().c_str(), aside->string().c_str());
+        moved = true;
+    }
+}
+
 int serve(const Settings& s) {
     spdlog::set_level(spdlog::level::from_str(s.log_level));
+    // A file size limit (RLIMIT_FSIZE) then fails the state file's reservation with
+    // EFBIG, a clear exit 3, instead of killing finsd with SIGXFSZ.
+    std::signal(SIGXFSZ, SIG_IGN);
     fins::plc::Profile profile = *fins::plc::find_profile(s.profile);
     if (s.dip_write_protection) profile.dip_switch |= fins::plc::dip_pin1;
 
-    std::unique_ptr<fins::plc::Storage> storage;
-    if (s.data_dir) {
-        auto opened = fins::plc::Storage::open(*s.data_dir, profile.name);
-        if (!opened)
-            return fail(3,
-                        "data directory " + s.data_dir->string() + ": " + opened.error().message());
-        storage = std::move(*opened);
-    }
-    fins::plc::Plc plc{profile, std::move(storage)};
-    if (auto sealed = plc.storage().seal(); !sealed)
-        return fail(
-            3, "state file " + plc.storage().path().string() + ": " + sealed.error().message());
+    std::unique_ptr<fins::plc::Plc> plc_owner;
+    if (const int rc = open_plc(s, profile, plc_owner); rc >= 0) return rc;
+    fins::plc::Plc& plc = *plc_owner;
     const bool restored = plc.storage().restored();
+    if (s.data_dir && restored && !plc.storage().checksums_verified())
+        std::fprintf(stderr,
+                     "finsd: warning: %s was not stopped cleanly (SIGKILL, crash or power "
+                     "loss; or it was just converted from an earlier format): its header and "
+                     "section table are intact; its data has no valid checksums to check\n",
+                     plc.storage().path().c_str());
     if (s.data_dir)
         spdlog::info("finsd: {} state file {}", restored ? "restored" : "new",
                      plc.storage().path().string());
@@ -220,6 +270,8 @@ int serve(const Settings& s) {
                                started.error().message());
         control = std::move(*started);
     }
+    // Before "listening": a SIGTERM right after that line still stops finsd cleanly.
+    asio::signal_set signals{io, SIGINT, SIGTERM};
     const auto self = (*server)->address();
     const unsigned port =
         (*server)->tcp_port() != 0 ? (*server)->tcp_port() : (*server)->udp_port();
@@ -230,7 +282,6 @@ int serve(const Settings& s) {
     std::printf("listening %u\n", port);
     std::fflush(stdout);
 
-    asio::signal_set signals{io, SIGINT, SIGTERM};
     signals.async_wait([&](std::error_code, int signal) {
         spdlog::info("finsd: signal {}, shutting down", signal);
         (*server)->stop();
@@ -239,7 +290,7 @@ int serve(const Settings& s) {
         io.stop();
     });
     io.run();
-    plc.storage().flush();
+    plc.storage().close();  // sections on disk, then their checksums and "stopped cleanly"
     return 0;
 }
 
