@@ -100,13 +100,14 @@ std::size_t Dispatcher::handle(Bytes request, MutableBytes out, const RequestCon
     handlers::HandlerContext handler_context{plc_, header, context};
     auto code = entry->function(handler_context, decoded->parameters, data);
     if (data.overflowed()) code = EndCode::response_too_long;
+    // A write is a command whose row network write protection refuses, or a write
+    // variant of a shared code (09 20 MESSAGE CLEAR) its handler flagged.
+    const bool is_write = !info->conditions.network_write_protected || handler_context.write;
     // W342 5-3-30: the CPU Unit logs every FINS write command it receives.
-    if (!info->conditions.network_write_protected || handler_context.write)
-        plc_.write_access_log().record(header.source, command, code, context.now);
+    if (is_write) plc_.write_access_log().record(header.source, command, code, context.now);
     // [storage] durability = "power": what a write command changed is on disk before
     // its answer; when that fails the answer says so.
-    if (!info->conditions.network_write_protected && !plc_.storage().commit() &&
-        code == EndCode::normal_completion)
+    if (is_write && !plc_.storage().commit() && code == EndCode::normal_completion)
         code = EndCode::memory_error;
     if (code != EndCode::normal_completion && !handler_context.keep_data) return answer(code);
 

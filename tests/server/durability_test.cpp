@@ -63,6 +63,17 @@ TEST_F(Durable, PowerSyncsBeforeEachWriteAnswerNotForReads) {
     EXPECT_EQ(plc->storage().syncs(), 2u);
 }
 
+// 09 20's row is a read (5-3-21, 5-3-23); its MESSAGE CLEAR variant is a write and is
+// synced like every other write, its reads are not.
+TEST_F(Durable, W342_5_3_22_MessageClearIsSyncedMessageReadIsNot) {
+    auto plc = plc_on_file(plc::Durability::power);
+    server::Dispatcher d{*plc, server_node};
+    EXPECT_EQ(send(d, "0920 0083"), 0x0000);  // MESSAGE READ
+    EXPECT_EQ(plc->storage().syncs(), 0u);
+    EXPECT_EQ(send(d, "0920 4005"), 0x0000);  // MESSAGE CLEAR
+    EXPECT_EQ(plc->storage().syncs(), 1u);
+}
+
 TEST_F(Durable, ProcessNeverSyncs) {
     auto plc = plc_on_file(plc::Durability::process);
     server::Dispatcher d{*plc, server_node};
