@@ -285,7 +285,7 @@ int run_read_multi(const GlobalOptions& g, const ReadMultiArgs& a, Output& out) 
         items_json.push_back({{"address", name}, {"value", read[i]}});
         text += fmt::format("{}  {}\n", name, read[i]);
     }
-    out.print({{"values", items_json}}, text);
+    out.print({{"items", items_json}}, text);
     return exit_ok;
 }
 

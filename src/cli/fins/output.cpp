@@ -137,10 +137,13 @@ Progress::~Progress() {
 void Progress::update(std::size_t done) {
     // Only when the transfer takes more than one request: short ones finish before a
     // line could be read.
-    if (!active_ || done >= total_ || total_ == 0) return;
+    if (!active_ || (total_ != 0 && done >= total_)) return;
     shown_ = true;
-    std::fprintf(stderr, "\r%s: %zu/%zu %s (%zu%%)", what_.c_str(), done, total_, unit_.c_str(),
-                 done * 100 / total_);
+    if (total_ == 0)  // the end is not known in advance (program-read to bit 15)
+        std::fprintf(stderr, "\r%s: %zu %s", what_.c_str(), done, unit_.c_str());
+    else
+        std::fprintf(stderr, "\r%s: %zu/%zu %s (%zu%%)", what_.c_str(), done, total_,
+                     unit_.c_str(), done * 100 / total_);
     std::fflush(stderr);
 }
 

@@ -219,7 +219,7 @@ int run_messages(const GlobalOptions& g, Output& out, const DiagnosticArgs& a) {
     if (!mask) return out.usage("message numbers are 0-7");
     int rc = exit_ok;
     if (a.clear)
-        return run_simple(g, out, MessageClear{*mask}, {{"cleared", *mask}},
+        return run_simple(g, out, MessageClear{*mask}, {{"cleared", true}, {"mask", *mask}},
                           fmt::format("cleared messages (mask {:02X})\n", *mask));
     const auto r = send(g, out, rc, MessageRead{*mask});
     if (!r) return rc;
@@ -295,7 +295,7 @@ int run_error_clear(const GlobalOptions& g, Output& out, const std::string& code
     const std::string what = *code == clear_all_errors      ? "all errors"
                              : *code == clear_current_error ? "the current error"
                                                             : "error " + hex4(*code);
-    return run_simple(g, out, ErrorClear{*code}, {{"cleared", hex4(*code)}},
+    return run_simple(g, out, ErrorClear{*code}, {{"cleared", true}, {"code", hex4(*code)}},
                       fmt::format("cleared {} ({})\n", what, hex4(*code)));
 }
 
