@@ -90,8 +90,8 @@ TEST(CliNode, PlainUdpToAnotherNodeNamesTheDestToUse) {
         << plain.err;
     auto json = fins(d, {"--json", "read", "D0"});
     EXPECT_EQ(error_of(json)["end_code"], "0201");
-    EXPECT_EQ(error_of(json)["hint"],
-              "the PLC at 127.0.0.1:" + std::to_string(d.port()) + " is node 10: use --dest 0.10.0");
+    EXPECT_EQ(error_of(json)["hint"], "the PLC at 127.0.0.1:" + std::to_string(d.port()) +
+                                          " is node 10: use --dest 0.10.0");
 
     auto fixed = fins(d, {"--dest", "0.10.0", "read", "D0"});
     EXPECT_EQ(fixed.exit_code, 0) << fixed.err;
@@ -310,8 +310,8 @@ std::string run_on_terminal(const std::vector<std::string>& argv) {
 TEST(CliProgress, LongTransfersShowProgressOnATerminalOnly) {
     Finsd d({});
     ASSERT_TRUE(d.started()) << d.result().err;
-    const std::vector<std::string> argv{fins_bin, "--port", std::to_string(d.port()), "read",
-                                        "D0", "3000"};
+    const std::vector<std::string> argv{fins_bin, "--port", std::to_string(d.port()),
+                                        "read",   "D0",     "3000"};
     const auto shown = run_on_terminal(argv);
     EXPECT_NE(shown.find("read D0: 999/3000 words (33%)"), std::string::npos) << shown;
     EXPECT_NE(shown.find("\x1b[K"), std::string::npos) << "the line is erased at the end";

@@ -181,16 +181,15 @@ TEST(Readme, EverySampleSessionPrintsWhatTheReadmeShows) {
                 argv.insert(argv.end(), words.begin() + 1, words.end());
                 argv.erase(argv.begin() + 4);  // the second "ctl"
             }
-            ASSERT_FALSE(argv.empty()) << "README.md:" << step.line
-                                       << ": only fins and finsd ctl run in a session: "
-                                       << step.command;
+            ASSERT_FALSE(argv.empty())
+                << "README.md:" << step.line
+                << ": only fins and finsd ctl run in a session: " << step.command;
             if (words[0] == "fins") argv.insert(argv.end(), words.begin() + 1, words.end());
             const auto r = run(argv);
             const auto actual = lines_of(r.out + r.err);
             EXPECT_TRUE(lines_match(step.expected, 0, actual, 0))
                 << "README.md:" << step.line << ": $ " << step.command << "\nREADME shows:\n"
-                << joined(step.expected) << "the program printed (exit " << r.exit_code
-                << "):\n"
+                << joined(step.expected) << "the program printed (exit " << r.exit_code << "):\n"
                 << joined(actual);
         }
         std::filesystem::current_path(home);

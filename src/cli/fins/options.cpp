@@ -67,8 +67,8 @@ std::unique_ptr<Client> open_client(const GlobalOptions& g, Output& out, int& ex
     if (!g.dest.empty()) {
         auto d = parse_node_address(g.dest);
         if (!d) {
-            exit_code = out.usage(fmt::format(
-                "--dest '{}' is not NET.NODE.UNIT (e.g. 0.10.0, 0.10.E1)", g.dest));
+            exit_code = out.usage(
+                fmt::format("--dest '{}' is not NET.NODE.UNIT (e.g. 0.10.0, 0.10.E1)", g.dest));
             return nullptr;
         }
         o.destination = *d;
@@ -121,7 +121,8 @@ void describe_global_options(CLI::App& app) {
         text += fmt::format("  {:<22}{}\n", left, desc);
     }
     text += "Exit codes: 0 ok, 2 usage, 3 transport, 4 the PLC answered an end code.";
-    for (CLI::App* sub : app.get_subcommands({})) sub->footer(text);
+    for (CLI::App* sub : app.get_subcommands({}))
+        sub->footer(text);
     app.footer(
         "`fins VERB --help` describes a verb; `fins probe` shows the PLC's node.\n"
         "Exit codes: 0 ok, 2 usage, 3 transport, 4 the PLC answered an end code.");

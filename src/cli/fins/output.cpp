@@ -74,7 +74,8 @@ int Output::failure(std::error_code ec, const std::string& context) {
         hint = "no such unit at that node: the CPU Unit is unit 0 (--dest NET.NODE.0)";
     }
     if (json_) {
-        nlohmann::json e{{"kind", kind_name(kind)}, {"message", ec.message()}, {"context", context}};
+        nlohmann::json e{
+            {"kind", kind_name(kind)}, {"message", ec.message()}, {"context", context}};
         if (kind == ErrorKind::end_code) {
             e["end_code"] = fmt::format("{:04X}", ec.value());
             const auto* info = find_end_code(static_cast<std::uint16_t>(ec.value()));
@@ -121,13 +122,17 @@ void Output::print(const nlohmann::json& doc, const std::string& text) {
     // CPU Unit has an error someone should look at.
     if (fatal_ || non_fatal_) {
         std::fflush(stdout);
-        std::fprintf(stderr, "fins: note: the answer carried the %s CPU error flag (%s): see `fins status`\n",
-                     fatal_ ? "fatal" : "non-fatal", fatal_ ? "0080" : "0040");
+        std::fprintf(
+            stderr,
+            "fins: note: the answer carried the %s CPU error flag (%s): see `fins status`\n",
+            fatal_ ? "fatal" : "non-fatal", fatal_ ? "0080" : "0040");
     }
 }
 
 Progress::Progress(std::string what, std::size_t total, std::string unit)
-    : what_(std::move(what)), unit_(std::move(unit)), total_(total),
+    : what_(std::move(what)),
+      unit_(std::move(unit)),
+      total_(total),
       active_(::isatty(STDERR_FILENO) == 1) {}
 
 Progress::~Progress() {
@@ -142,8 +147,8 @@ void Progress::update(std::size_t done) {
     if (total_ == 0)  // the end is not known in advance (program-read to bit 15)
         std::fprintf(stderr, "\r%s: %zu %s", what_.c_str(), done, unit_.c_str());
     else
-        std::fprintf(stderr, "\r%s: %zu/%zu %s (%zu%%)", what_.c_str(), done, total_,
-                     unit_.c_str(), done * 100 / total_);
+        std::fprintf(stderr, "\r%s: %zu/%zu %s (%zu%%)", what_.c_str(), done, total_, unit_.c_str(),
+                     done * 100 / total_);
     std::fflush(stderr);
 }
 

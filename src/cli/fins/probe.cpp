@@ -92,7 +92,8 @@ std::optional<FoundNode> discover_udp(const GlobalOptions& g) {
             FoundNode node{r->header.source, {}};
             node.address.unit = 0;
             if (r->code.ok())
-                if (auto data = CpuUnitDataRead{}.decode_response(r->data)) node.model = data->model;
+                if (auto data = CpuUnitDataRead{}.decode_response(r->data))
+                    node.model = data->model;
             return node;
         }
     }
