@@ -232,7 +232,7 @@ int run_messages(const GlobalOptions& g, Output& out, const DiagnosticArgs& a) {
         list.push_back({{"number", n}, {"text", t}});
         text += t.empty() ? fmt::format("MSG {}\n", n) : fmt::format("MSG {}  {}\n", n, t);
     }
-    out.print({{"messages", list}}, text);
+    out.print({{"items", list}}, text);
     return exit_ok;
 }
 
@@ -241,7 +241,7 @@ int run_fal(const GlobalOptions& g, Output& out, unsigned number) {
     const auto r = send(g, out, rc, FalFalsRead{static_cast<std::uint16_t>(number)});
     if (!r) return rc;
     const std::string message = trim(r->message);
-    out.print({{"number", r->number}, {"message", message}},
+    out.print({{"number", r->number}, {"error_message", message}},
               fmt::format("FAL/FALS {}  \"{}\"\n", r->number, message));
     return exit_ok;
 }
