@@ -59,6 +59,14 @@ TEST(CliErrors, LocalDecodeAndRangeMistakesAreUsageErrorsWithTrueMessages) {
     EXPECT_EQ(task.exit_code, 0) << task.err;
     EXPECT_EQ(task.out, "TK2  0\n");
 
+    // Index registers are 32-bit: two registers are two values, not four words.
+    auto ir = fins(d, {"read", "IR0", "2", "--as", "hex"});
+    EXPECT_EQ(ir.exit_code, 0) << ir.err;
+    EXPECT_EQ(ir.out, "IR0  0x00000000\nIR1  0x00000000\n");
+    auto ir_write = fins(d, {"write", "IR0", "5"});
+    EXPECT_EQ(ir_write.exit_code, 2);
+    EXPECT_NE(ir_write.err.find("32-bit index register"), std::string::npos) << ir_write.err;
+
     for (const std::vector<std::string>& args :
          {std::vector<std::string>{"read", "D30000", "40000"},
           std::vector<std::string>{"fill", "D32000", "1000", "1"},

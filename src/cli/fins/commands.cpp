@@ -135,14 +135,22 @@ int run_read(const GlobalOptions& g, const ReadArgs& a, Format f, Output& out) {
         return out.usage(fmt::format("{} names a bit: use --as bits", a.address));
     if (f == Format::bits && !start->bit && !flag_area && !bit_only) {
         if (start->area == Area::index_register || start->area == Area::data_register)
-            return out.usage(fmt::format("{} has no bits to read: IR and DR are word access only",
-                                         a.address));
+            return out.usage(
+                fmt::format("{} has no bits to read: IR and DR are word access only", a.address));
         return out.usage(fmt::format(
-            "{} is a word: name a bit ({}.0) to read bits, or use --as hex for the word",
-            a.address, format_address(*start)));
+            "{} is a word: name a bit ({}.0) to read bits, or use --as hex for the word", a.address,
+            format_address(*start)));
     }
+    // Index registers are 32-bit elements (5-2-2, element size 4): one value each.
+    const bool wide = start->area == Area::index_register;
+    if (wide && f != Format::uint16 && f != Format::uint32 && f != Format::int32 &&
+        f != Format::hex)
+        return out.usage(
+            fmt::format("{} is a 32-bit index register: use --as uint32, int32 or hex", a.address));
     const std::size_t step = words_per_value(f);
-    const std::size_t elements = bits ? a.count : f == Format::string ? a.count : a.count * step;
+    const std::size_t elements = bits || wide          ? a.count
+                                 : f == Format::string ? a.count
+                                                       : a.count * step;
     if (auto problem = past_the_end(*start, elements, bits, "read")) return out.usage(*problem);
     auto mem = to_memory_address(*start, bits ? Access::bit : Access::word);
     if (!mem) return out.usage(fmt::format("{}: {}", a.address, mem.error().message()));
@@ -150,7 +158,8 @@ int run_read(const GlobalOptions& g, const ReadArgs& a, Format f, Output& out) {
     if (!client) return rc;
 
     const auto context = fmt::format("read {}", a.address);
-    auto data = read_elements(*client, *mem, elements, bits && start->bit.has_value(), out, context);
+    auto data =
+        read_elements(*client, *mem, elements, bits && start->bit.has_value(), out, context);
     if (!data) return out.failure(data.error(), context);
     nlohmann::json values = nlohmann::json::array();
     std::string text;
@@ -160,13 +169,30 @@ int run_read(const GlobalOptions& g, const ReadArgs& a, Format f, Output& out) {
             values.push_back(bit);
             text += fmt::format("{}  {}\n", format_address(advance(*start, i, true)), bit);
         }
+    } else if (wide) {
+        for (std::size_t i = 0; i + 3 < data->size(); i += 4) {
+            const std::uint32_t v = std::uint32_t{(*data)[i]} << 24 |
+                                    std::uint32_t{(*data)[i + 1]} << 16 |
+                                    std::uint32_t{(*data)[i + 2]} << 8 | (*data)[i + 3];
+            const std::string shown = f == Format::hex ? fmt::format("0x{:08X}", v)
+                                      : f == Format::int32
+                                          ? fmt::format("{}", static_cast<std::int32_t>(v))
+                                          : fmt::format("{}", v);
+            if (f == Format::hex)
+                values.push_back(shown);
+            else if (f == Format::int32)
+                values.push_back(static_cast<std::int32_t>(v));
+            else
+                values.push_back(v);
+            text += fmt::format("{}  {}\n", format_address(advance(*start, i / 4, false)), shown);
+        }
     } else {
         std::vector<std::uint16_t> words;
         for (std::size_t i = 0; i + 1 < data->size(); i += 2)
             words.push_back(static_cast<std::uint16_t>((*data)[i] << 8 | (*data)[i + 1]));
         auto printed = print_words(f, words);
-        if (!printed) return out.usage(f == Format::bcd ? not_bcd(*start, words)
-                                                        : printed.error().message());
+        if (!printed)
+            return out.usage(f == Format::bcd ? not_bcd(*start, words) : printed.error().message());
         for (std::size_t i = 0; i < printed->size(); ++i) {
             values.push_back((*printed)[i].json);
             text += fmt::format("{}  {}\n", format_address(advance(*start, i * step, false)),
@@ -191,6 +217,11 @@ int run_write(const GlobalOptions& g, const WriteArgs& a, Format f, Output& out)
     if (bits && !start->bit && !bit_only)
         return out.usage(fmt::format("{} is a word: name a bit ({}.0) to write bits", a.address,
                                      format_address(*start)));
+    if (start->area == Area::index_register)
+        return out.usage(
+            fmt::format("{} is a 32-bit index register: write takes word areas "
+                        "(`fins raw 0102 DC...` sends any MEMORY AREA WRITE)",
+                        a.address));
     auto parsed = parse_words(bits ? Format::bits : f, a.values);
     if (auto* e = std::get_if<ParseError>(&parsed)) return out.usage(e->message);
     const auto& words = std::get<std::vector<std::uint16_t>>(parsed);
