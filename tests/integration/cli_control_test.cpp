@@ -66,7 +66,7 @@ TEST_F(CliControl, CpuDataSections) {
     auto all = json({"cpu-data"});
     EXPECT_TRUE(all["model"].is_string());
     EXPECT_FALSE(all["model"].get<std::string>().empty());
-    EXPECT_EQ(all["area"]["iom_kbytes"], 23);
+    EXPECT_EQ(all["area_data"]["iom_kbytes"], 23);
     EXPECT_TRUE(all.contains("racks"));
     auto area = json({"cpu-data", "--section", "area"});
     EXPECT_EQ(area["model"], all["model"]);

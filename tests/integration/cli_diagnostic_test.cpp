@@ -121,12 +121,12 @@ TEST_F(CliDiagnostic, MessagesAndFalRead) {
     ASSERT_EQ(fins({"messages", "--clear", "1"}).exit_code, 0);
     EXPECT_EQ(fins({"messages", "1"}).out, "MSG 1\n");
     auto j = fins({"messages", "--json"});
-    EXPECT_EQ(Json::parse(j.out)["messages"].size(), 8u);
+    EXPECT_EQ(Json::parse(j.out)["items"].size(), 8u);
     EXPECT_EQ(fins({"messages", "8"}).exit_code, 2);
     auto f = fins({"fal", "9"});
     EXPECT_EQ(f.exit_code, 0) << f.err;
     EXPECT_EQ(f.out, "FAL/FALS 9  \"LOW OIL\"\n");
-    EXPECT_EQ(Json::parse(fins({"fal", "10", "--json"}).out)["message"], "");
+    EXPECT_EQ(Json::parse(fins({"fal", "10", "--json"}).out)["error_message"], "");
 }
 
 TEST_F(CliDiagnostic, AccessRightAcrossTwoSourceNodes) {

@@ -54,7 +54,7 @@ TEST(CliParameterArea, ReadWriteAndClearRoutingTables) {
     ASSERT_FALSE(d.port().empty());
     auto w = d.fins({"param-write", "routing", "510", "0x0A0B", "12"});
     EXPECT_EQ(w.exit_code, 0) << w.err;
-    EXPECT_EQ(w.out, "wrote 2 words at routing 01FE (2 words sent in 1 blocks)\n");
+    EXPECT_EQ(w.out, "wrote 2 words at routing 01FE (2 words sent in 1 block)\n");
     auto r = d.fins({"param-read", "routing", "508"});
     EXPECT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(r.out, "routing tables (8013) words 01FC-01FF\n01FC  0000 0000 0A0B 000C\n");

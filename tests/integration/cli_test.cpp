@@ -93,9 +93,9 @@ TEST_F(Cli, BitsFillTransferAndReadMulti) {
     auto m = fins({"read-multi", "H0", "CIO10.13", "T5", "--json"});
     ASSERT_EQ(m.exit_code, 0) << m.err;
     auto doc = nlohmann::json::parse(m.out);
-    EXPECT_EQ(doc["values"][0]["value"], 255);
-    EXPECT_EQ(doc["values"][1]["value"], 1);
-    EXPECT_EQ(doc["values"][2]["address"], "T5");
+    EXPECT_EQ(doc["items"][0]["value"], 255);
+    EXPECT_EQ(doc["items"][1]["value"], 1);
+    EXPECT_EQ(doc["items"][2]["address"], "T5");
 }
 
 TEST_F(Cli, RawPrintsTheDecodedAnswer) {

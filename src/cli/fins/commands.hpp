@@ -1,7 +1,10 @@
 // The verbs of the `fins` CLI. Each returns the process exit code.
 #pragma once
 
+#include <array>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <system_error>
 #include <vector>
 
@@ -57,20 +60,77 @@ struct RawArgs {
     bool no_response = false;
 };
 
+enum class ErrorKind { usage, end_code, transport };
+
+// "1 word", "3 words"; "1 entry"/"2 entries" with the plural given.
+std::string plural(std::size_t n, std::string_view one);
+std::string plural(std::size_t n, std::string_view one, std::string_view many);
+// NET.NODE.UNIT in decimal, as --dest takes it.
+std::string node_text(const NodeAddress& a);
+// "host:port" ("[::1]:9600" for IPv6).
+std::string endpoint(const GlobalOptions& g);
+
 // Prints results and errors in the chosen style and maps errors to exit codes.
 class Output {
   public:
     explicit Output(bool json) : json_(json) {}
     [[nodiscard]] bool json() const { return json_; }
-    // Usage errors: message on stderr (JSON: {"error": ...} on stdout), exit 2.
+    // Usage errors: "fins: MESSAGE" on stderr (JSON: {"error": {"kind": "usage", ...}} on
+    // stdout too), exit 2.
     int usage(const std::string& message);
-    // Any failure from the client: end codes exit 4, everything else 3.
+    // A failure from the client: end codes exit 4; address and argument errors found
+    // before sending exit 2; everything else (timeout, connection, malformed answer) 3.
+    // A 0201 answer asks the PLC which node it is and says what --dest to use.
     int failure(std::error_code ec, const std::string& context);
+    // The text, or the JSON document; with note_flags() called, the document gets
+    // "fatal_cpu_error" and "non_fatal_cpu_error" and a set flag is noted on stderr.
     void print(const nlohmann::json& doc, const std::string& text);
+    // Records the CPU error flags (bits 7 and 6, W342 5-1-3) of an answer.
+    void note_flags(ResponseCode code);
+    // The connection settings failures are explained against (set by open_client).
+    void set_target(const GlobalOptions& g) { target_ = &g; }
 
   private:
     bool json_;
+    const GlobalOptions* target_ = nullptr;
+    bool flags_tracked_ = false;
+    bool fatal_ = false;
+    bool non_fatal_ = false;
 };
+
+// "what: done/total unit (n%)" on stderr, redrawn in place, only when stderr is a
+// terminal; the line is erased when the Progress goes away.
+class Progress {
+  public:
+    Progress(std::string what, std::size_t total, std::string unit);
+    ~Progress();
+    Progress(const Progress&) = delete;
+    Progress& operator=(const Progress&) = delete;
+    void update(std::size_t done);
+
+  private:
+    std::string what_;
+    std::string unit_;
+    std::size_t total_;
+    bool active_;
+    bool shown_ = false;
+};
+
+// What answered a probe: its FINS address (the answer's source) and model (05 01).
+struct FoundNode {
+    NodeAddress address;
+    std::string model;
+};
+// Asks the PLC at g.host:g.port who it is: over UDP one 05 01 to node 00 ("the local
+// node", which the PLC answers with its own address), over TCP the node the FINS/TCP
+// handshake reports. Nothing on failure.
+std::optional<FoundNode> discover_node(const GlobalOptions& g);
+// NET.NODE.UNIT: each part decimal, or hex with 0x or with a letter A-F (E1 = 225).
+std::optional<NodeAddress> parse_node_address(const std::string& s);
+
+// Registers the global options on `app` and describes them in every verb's --help.
+void add_global_options(CLI::App& app, GlobalOptions& g);
+void describe_global_options(CLI::App& app);
 
 int run_read(const GlobalOptions& g, const ReadArgs& a, Format f, Output& out);
 int run_write(const GlobalOptions& g, const WriteArgs& a, Format f, Output& out);
@@ -78,6 +138,7 @@ int run_fill(const GlobalOptions& g, const FillArgs& a, Output& out);
 int run_transfer(const GlobalOptions& g, const TransferArgs& a, Output& out);
 int run_read_multi(const GlobalOptions& g, const ReadMultiArgs& a, Output& out);
 int run_raw(const GlobalOptions& g, const RawArgs& a, Output& out);
+int run_probe(const GlobalOptions& g, Output& out);
 
 // Verbs of the other command groups register themselves; a verb's callback runs after
 // the whole command line is parsed (global options may follow the verb) and stores the
@@ -86,6 +147,21 @@ void add_plc_data_verbs(CLI::App& app, const GlobalOptions& g, int& exit_code); 
 void add_control_verbs(CLI::App& app, const GlobalOptions& g, int& exit_code);   // 04-07 xx
 void add_diagnostic_verbs(CLI::App& app, const GlobalOptions& g,
                           int& exit_code);  // 06 01, 09, 0C, 21, 23
+
+// Sends `command` and decodes the answer like Client::send, noting the answer's CPU error
+// flags on `out` (Client::send drops them: 0040 is a normal completion).
+template <class C>
+Result<typename C::Response> send_noting_flags(Client& client, const C& command, Output& out) {
+    std::array<std::uint8_t, max_parameter_size> buffer{};
+    ByteWriter w(buffer);
+    command.encode(w);
+    if (w.overflowed()) return Unexpected(make_error_code(ClientError::request_too_long));
+    auto r = client.send_raw(C::code, w.written());
+    if (!r) return Unexpected(r.error());
+    out.note_flags(r->code);
+    if (!r->code.ok()) return Unexpected(make_error_code(r->code.end_code()));
+    return command.decode_response(r->data);
+}
 
 // Connects with the global options, or prints why not and sets `exit_code`.
 std::unique_ptr<Client> open_client(const GlobalOptions& g, Output& out, int& exit_code);

@@ -1,10 +1,12 @@
 // fins: read, write and probe an Omron PLC (or finsd) over FINS/UDP or FINS/TCP.
 //
-// Exit codes: 0 success; 2 usage error (bad option, address or value); 3 transport
-// failure (cannot connect, timeout, connection lost, malformed answer); 4 the PLC
-// answered with a non-zero end code (printed as hex and name).
+// Exit codes: 0 success; 2 usage error (bad option, address or value, a range past the
+// area's end, a value that does not decode as asked); 3 transport failure (cannot
+// connect, timeout, connection lost, malformed answer); 4 the PLC answered with a
+// non-zero end code (printed as hex and name).
 #include <cstdio>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <fmt/core.h>
@@ -19,19 +21,9 @@ int main(int argc, char** argv) {
     app.require_subcommand(1);
     // Global options may also follow the verb: `fins read D100 --json`.
     app.fallthrough(true);
+    app.set_version_flag("--version", std::string("fins ") + FINSKIT_VERSION);
     GlobalOptions g;
-    app.add_option("--host", g.host, "PLC host name or IP address")->capture_default_str();
-    app.add_option("--port", g.port, "FINS port")->capture_default_str();
-    app.add_flag("--tcp", g.tcp, "Use FINS/TCP instead of FINS/UDP");
-    app.add_option("--timeout", g.timeout_seconds, "Seconds to wait for each attempt")
-        ->capture_default_str()
-        ->check(CLI::Range(0.001, 3600.0));
-    app.add_option("--retries", g.retries, "Retransmissions after a timeout (0-15, W596)")
-        ->capture_default_str()
-        ->check(CLI::Range(0, 15));
-    app.add_option("--dest", g.dest, "Destination NET.NODE.UNIT (default: derived)");
-    app.add_option("--source", g.source, "Source NET.NODE.UNIT (default: derived)");
-    app.add_flag("--json", g.json, "Print JSON");
+    add_global_options(app, g);
 
     std::string as = "uint16";
     auto add_as = [&as](CLI::App* c) {
@@ -80,20 +72,31 @@ int main(int argc, char** argv) {
     c_raw->add_flag("--no-response", raw.no_response,
                     "Set the ICF no-response bit and do not wait");
 
+    app.add_subcommand("probe", "Show which FINS node answers at --host/--port (and the --dest to use)");
+
     int group_rc = -1;
     add_plc_data_verbs(app, g, group_rc);
     add_control_verbs(app, g, group_rc);
     add_diagnostic_verbs(app, g, group_rc);
 
+    describe_global_options(app);
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        const int rc = app.exit(e);
-        return rc == 0 ? 0 : exit_usage;
+        // --help and --version print and exit 0; every other parse error is a usage
+        // error like any other, with the prefix and, under --json, as JSON.
+        if (e.get_exit_code() == 0) return app.exit(e);
+        bool json = false;
+        for (int i = 1; i < argc; ++i)
+            json = json || std::string_view(argv[i]) == "--json";
+        Output out{json};
+        return out.usage(fmt::format("{} (see fins --help)", e.what()));
     }
     if (group_rc >= 0) return group_rc;
     Output out{g.json};
     if (c_raw->parsed()) return run_raw(g, raw, out);
+    if (app.got_subcommand("probe")) return run_probe(g, out);
     auto format = parse_format(as);
     if (!format) return out.usage(fmt::format("unknown --as format '{}'", as));
     if (c_read->parsed()) return run_read(g, read, *format, out);

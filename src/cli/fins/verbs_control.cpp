@@ -94,7 +94,7 @@ int run_cpu_data(const GlobalOptions& g, Output& out, const std::string& section
         doc["system_version"] = r->system_version;
         doc["dip_switch"] = r->dip_switch;
         doc["largest_em_bank"] = r->largest_em_bank;
-        doc["area"] = {{"program_kwords", a.program_kwords},
+        doc["area_data"] = {{"program_kwords", a.program_kwords},
                        {"iom_kbytes", a.iom_kbytes},
                        {"dm_words", a.dm_words},
                        {"timer_counter_kwords", a.timer_counter_kwords},

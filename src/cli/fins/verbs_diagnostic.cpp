@@ -219,7 +219,7 @@ int run_messages(const GlobalOptions& g, Output& out, const DiagnosticArgs& a) {
     if (!mask) return out.usage("message numbers are 0-7");
     int rc = exit_ok;
     if (a.clear)
-        return run_simple(g, out, MessageClear{*mask}, {{"cleared", *mask}},
+        return run_simple(g, out, MessageClear{*mask}, {{"cleared", true}, {"mask", *mask}},
                           fmt::format("cleared messages (mask {:02X})\n", *mask));
     const auto r = send(g, out, rc, MessageRead{*mask});
     if (!r) return rc;
@@ -232,7 +232,7 @@ int run_messages(const GlobalOptions& g, Output& out, const DiagnosticArgs& a) {
         list.push_back({{"number", n}, {"text", t}});
         text += t.empty() ? fmt::format("MSG {}\n", n) : fmt::format("MSG {}  {}\n", n, t);
     }
-    out.print({{"messages", list}}, text);
+    out.print({{"items", list}}, text);
     return exit_ok;
 }
 
@@ -241,7 +241,7 @@ int run_fal(const GlobalOptions& g, Output& out, unsigned number) {
     const auto r = send(g, out, rc, FalFalsRead{static_cast<std::uint16_t>(number)});
     if (!r) return rc;
     const std::string message = trim(r->message);
-    out.print({{"number", r->number}, {"message", message}},
+    out.print({{"number", r->number}, {"error_message", message}},
               fmt::format("FAL/FALS {}  \"{}\"\n", r->number, message));
     return exit_ok;
 }
@@ -295,7 +295,7 @@ int run_error_clear(const GlobalOptions& g, Output& out, const std::string& code
     const std::string what = *code == clear_all_errors      ? "all errors"
                              : *code == clear_current_error ? "the current error"
                                                             : "error " + hex4(*code);
-    return run_simple(g, out, ErrorClear{*code}, {{"cleared", hex4(*code)}},
+    return run_simple(g, out, ErrorClear{*code}, {{"cleared", true}, {"code", hex4(*code)}},
                       fmt::format("cleared {} ({})\n", what, hex4(*code)));
 }
 

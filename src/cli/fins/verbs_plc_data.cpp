@@ -73,6 +73,7 @@ Result<std::vector<std::uint16_t>> read_words(Client& client, const ParameterAre
                                               std::uint32_t start, std::uint32_t count) {
     std::vector<std::uint16_t> words;
     words.reserve(count);
+    Progress progress(fmt::format("param-read {}", area.id), count, "words");
     while (words.size() < count) {
         const auto n = std::min<std::size_t>(max_parameter_words, count - words.size());
         const ParameterAreaRead command{area.code, static_cast<std::uint16_t>(start + words.size()),
@@ -81,6 +82,7 @@ Result<std::vector<std::uint16_t>> read_words(Client& client, const ParameterAre
         if (!r) return Unexpected(r.error());
         if (r->count != n) return Unexpected(make_error_code(ClientError::malformed_response));
         words.insert(words.end(), r->words.begin(), r->words.end());
+        progress.update(words.size());
     }
     return words;
 }
@@ -91,6 +93,7 @@ Result<std::size_t> write_words(Client& client, const ParameterAreaInfo& area, s
     std::size_t done = 0;
     std::size_t blocks = 0;
     std::vector<std::uint8_t> bytes;
+    Progress progress(fmt::format("param-write {}", area.id), words.size(), "words");
     while (done < words.size()) {
         const auto n = std::min<std::size_t>(max_parameter_words, words.size() - done);
         bytes.clear();
@@ -105,6 +108,7 @@ Result<std::size_t> write_words(Client& client, const ParameterAreaInfo& area, s
         if (auto r = client.send(command); !r) return Unexpected(r.error());
         done += n;
         ++blocks;
+        progress.update(done);
     }
     return blocks;
 }
@@ -194,8 +198,8 @@ int run_param_write(const GlobalOptions& g, const ParamArgs& a, Output& out) {
                {"written", words.size()},
                {"transferred", transferred},
                {"blocks", *blocks}},
-              fmt::format("wrote {} words at {} {:04X} ({} words sent in {} blocks)\n",
-                          words.size(), area->id, start, transferred, *blocks));
+              fmt::format("wrote {} at {} {:04X} ({} sent in {})\n", plural(words.size(), "word"),
+                          area->id, start, plural(transferred, "word"), plural(*blocks, "block")));
     return exit_ok;
 }
 
@@ -208,7 +212,7 @@ int run_param_clear(const GlobalOptions& g, const ParamArgs& a, Output& out) {
     if (!client) return rc;
     if (auto r = client->send(ParameterAreaClear{area->code, 0, area->words, false, 0}); !r)
         return out.failure(r.error(), fmt::format("param-clear {}", area->id));
-    out.print({{"area", fmt::format("{:04X}", area->code)}, {"cleared", area->words}},
+    out.print({{"area", fmt::format("{:04X}", area->code)}, {"cleared", true}, {"count", area->words}},
               fmt::format("cleared {} ({:04X}), {} words\n", area->name, area->code, area->words));
     return exit_ok;
 }
@@ -255,6 +259,8 @@ int run_program_read(const GlobalOptions& g, const ProgramArgs& a, Output& out) 
     if (!client) return rc;
     std::vector<std::uint8_t> data;
     bool last = false;
+    // The UM's size is not known before bit 15: the default limit shows as "to the end".
+    Progress progress("program-read", a.bytes.empty() ? 0 : *limit, "bytes");
     // Until bit 15 (the UM's last address) or BYTES; the UM is finite, so is this loop.
     while (!last && data.size() < *limit) {
         const auto n = std::min<std::size_t>(max_program_read_bytes, *limit - data.size());
@@ -267,6 +273,7 @@ int run_program_read(const GlobalOptions& g, const ProgramArgs& a, Output& out) 
             return out.failure(make_error_code(ClientError::malformed_response), "program-read");
         data.insert(data.end(), r->data.begin(), r->data.end());
         last = r->last;
+        progress.update(data.size());
     }
     nlohmann::json doc{{"start", *start}, {"bytes", data.size()}, {"last", last}};
     if (!a.file.empty()) {
@@ -276,8 +283,8 @@ int run_program_read(const GlobalOptions& g, const ProgramArgs& a, Output& out) 
         if (!f.write(body.data(), static_cast<std::streamsize>(body.size())))
             return out.usage(fmt::format("cannot write '{}'", a.file));
         doc["file"] = a.file;
-        out.print(doc, fmt::format("read {} bytes from {:08X} into {}{}\n", data.size(), *start,
-                                   a.file, last ? " (to the last address)" : ""));
+        out.print(doc, fmt::format("read {} from {:08X} into {}{}\n", plural(data.size(), "byte"),
+                                   *start, a.file, last ? " (to the last address)" : ""));
         return exit_ok;
     }
     doc["data"] = hex_text(data);
@@ -323,6 +330,7 @@ int run_program_write(const GlobalOptions& g, const ProgramArgs& a, Output& out)
     if (!client) return rc;
     std::size_t done = 0;
     std::size_t blocks = 0;
+    Progress progress("program-write", data->size(), "bytes");
     while (done < data->size()) {
         const auto n = std::min<std::size_t>(max_program_write_bytes, data->size() - done);
         const ProgramAreaWrite command{
@@ -331,9 +339,11 @@ int run_program_write(const GlobalOptions& g, const ProgramArgs& a, Output& out)
         if (auto r = client->send(command); !r) return out.failure(r.error(), "program-write");
         done += n;
         ++blocks;
+        progress.update(done);
     }
     out.print({{"start", *start}, {"bytes", done}, {"blocks", blocks}},
-              fmt::format("wrote {} bytes at {:08X} in {} blocks\n", done, *start, blocks));
+              fmt::format("wrote {} at {:08X} in {}\n", plural(done, "byte"), *start,
+                          plural(blocks, "block")));
     return exit_ok;
 }
 

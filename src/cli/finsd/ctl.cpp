@@ -1,4 +1,4 @@
-// `finsd ctl --socket PATH VERB ...`: sends one request to a running finsd's control
+// `finsd ctl --socket PATH VERB ...` (options before or after the verb): sends one request to a running finsd's control
 // channel (server/control.hpp) and prints the answer line.
 //
 //   status                          the JSON snapshot
@@ -102,6 +102,8 @@ int run_ctl(int argc, char** argv) {
     CLI::App app{"finsd ctl: change a running finsd through its control socket"};
     app.name("finsd ctl");
     app.require_subcommand(1);
+    // Options may follow the verb, as with `fins`: `finsd ctl status --socket PATH`.
+    app.fallthrough(true);
     std::string socket;
     app.add_option("--socket", socket, "The control socket (finsd --control PATH)")->required();
 
@@ -176,8 +178,9 @@ int run_ctl(int argc, char** argv) {
         // argv[0] is "ctl": CLI11 skips it as the program name.
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        const int rc = app.exit(e);
-        return rc == 0 ? exit_ok : exit_usage;
+        if (e.get_exit_code() == 0) return app.exit(e);  // --help
+        std::fprintf(stderr, "finsd ctl: %s (see finsd ctl --help)\n", e.what());
+        return exit_usage;
     }
     const std::string line = c_send->parsed() ? raw : request.dump();
     if (line.find('\n') != std::string::npos) {

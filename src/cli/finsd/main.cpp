@@ -14,12 +14,16 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
 
+#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
+#include <fmt/format.h>
 #include <CLI/CLI.hpp>
 #include <asio/io_context.hpp>
 #include <asio/signal_set.hpp>
@@ -29,6 +33,7 @@
 #include "plc/plc.hpp"
 #include "plc/profile.hpp"
 #include "plc/storage.hpp"
+#include "plc/storage_format.hpp"
 #include "server/control.hpp"
 #include "server/server.hpp"
 
@@ -47,6 +52,20 @@ int fail(int code, const std::string& message) {
     return code;
 }
 
+// The profile a foreign state file was written for, to name it in the refusal: the
+// header holds the profile name NUL-terminated (plc/storage.cpp), so look for each known
+// name there rather than depend on the header's offsets.
+std::string state_file_profile(const std::filesystem::path& dir) {
+    std::ifstream f(dir / "finsd.state", std::ios::binary);
+    std::string head(4096, '\0');
+    f.read(head.data(), static_cast<std::streamsize>(head.size()));
+    head.resize(static_cast<std::size_t>(f.gcount()));
+    for (const auto& p : fins::plc::profiles())
+        if (head.find(std::string(1, '\0') + p.name + std::string(1, '\0')) != std::string::npos)
+            return p.name;
+    return "unknown";
+}
+
 void list_profiles() {
     std::printf("%-9s %-15s %5s %8s %s\n", "name", "model", "EM", "UM (K)", "notes");
     for (const auto& p : fins::plc::profiles())
@@ -61,6 +80,12 @@ void list_profiles() {
 // to go on.
 int configure(int argc, char** argv, Settings& settings) {
     CLI::App app{"finsd: a virtual Omron CPU Unit speaking FINS/UDP and FINS/TCP"};
+    app.set_version_flag("--version", std::string("finsd ") + FINSKIT_VERSION);
+    app.footer(
+        "finsd ctl --socket PATH VERB ...: change a running finsd through its control channel\n"
+        "(--control PATH); `finsd ctl --help` lists the verbs.\n"
+        "Logs go to stderr; stdout carries only \"listening <port>\" once serving.\n"
+        "Exit codes: 0 clean shutdown, 2 usage or configuration error, 3 start-up failure.");
     std::string config;
     Overrides o;
     std::string profile, mode, data_dir, control, log_level, bind, protection;
@@ -74,8 +99,9 @@ int configure(int argc, char** argv, Settings& settings) {
     app.add_flag("--list-profiles", list, "Print the known profiles and exit");
     auto* o_mode =
         app.add_option("--mode", mode, "Operating mode at start-up: program, monitor, run");
-    auto* o_data =
-        app.add_option("--data-dir", data_dir, "Keep retained memory in DIR/finsd.state");
+    auto* o_data = app.add_option(
+        "--data-dir", data_dir,
+        "Keep retained memory in DIR/finsd.state (DIR and its parents are created if missing)");
     auto* o_control = app.add_option("--control", control, "Control channel socket path");
     auto* o_bind =
         app.add_option("--bind", bind, "Address to listen on (IPv4 or IPv6; default 127.0.0.1)");
@@ -121,7 +147,7 @@ int configure(int argc, char** argv, Settings& settings) {
     auto* o_protection =
         app.add_option("--network-write-protection", protection,
                        "off, all, listed or all-except-listed (W342 5-1-2 note 5)");
-    app.add_option("--protect-node", o.protect_nodes,
+    auto* o_nodes = app.add_option("--protect-node", o.protect_nodes,
                    "A listed node, network.node (repeatable; node * = any)");
     auto* o_um = app.add_flag("--um-read-protection", um_read, "UM read protection set");
     auto* o_dip = app.add_flag("--dip-write-protection", dip_write,
@@ -136,8 +162,8 @@ int configure(int argc, char** argv, Settings& settings) {
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        const int rc = app.exit(e);
-        return rc == 0 ? 0 : 2;
+        if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+        return fail(2, std::string(e.what()) + " (see finsd --help)");
     }
     if (list) {
         list_profiles();
@@ -168,6 +194,20 @@ int configure(int argc, char** argv, Settings& settings) {
     take(o_durability, durability, o.durability);
     if (auto r = apply_overrides(o, settings); !r) return fail(2, r.error());
     if (auto r = validate(settings); !r) return fail(2, r.error());
+    // A node list protects nothing unless the mode reads it: refuse the flag rather than
+    // let someone believe those nodes are refused (or, under "all", the only ones).
+    const auto write_mode = settings.network_write_protection.mode;
+    using fins::plc::NetworkWriteProtection;
+    if (o_nodes->count() > 0 && (write_mode == NetworkWriteProtection::off ||
+                                 write_mode == NetworkWriteProtection::all))
+        return fail(2, fmt::format("--protect-node has no effect with network write protection "
+                                   "'{}': add --network-write-protection listed (refuse those "
+                                   "nodes) or all-except-listed (accept only those)",
+                                   write_mode == NetworkWriteProtection::off ? "off" : "all"));
+    if (!settings.network_write_protection.nodes.empty() &&
+        write_mode == NetworkWriteProtection::off)
+        spdlog::warn("finsd: protection.nodes is set but protection.network_write is \"off\": "
+                     "no node is refused");
     return -1;
 }
 
@@ -194,8 +234,12 @@ int open_plc(const Settings& s, const fins::plc::Profile& profile,
         const std::string file =
             s.data_dir ? (*s.data_dir / "finsd.state").string() : std::string("(heap)");
         const bool refused = Storage::is_refusal(error);
+        std::string why = error.message();
+        if (error == fins::plc::state_file::make_error(fins::plc::state_file::Error::other_profile))
+            why += fmt::format(": the file is for profile '{}', this finsd runs '{}'",
+                               state_file_profile(*s.data_dir), profile.name);
         if (!refused || !s.reset_state || moved)
-            return fail(3, file + ": " + error.message() +
+            return fail(3, file + ": " + why +
                                (refused ? "; finsd never replaces it by itself: start with "
                                           "--reset-state to move it aside and begin with "
                                           "empty retained memory"
@@ -297,6 +341,9 @@ int serve(const Settings& s) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    // Logs on stderr: stdout carries only "listening <port>" (and `finsd ctl` answers).
+    spdlog::set_default_logger(std::make_shared<spdlog::logger>(
+        "", std::make_shared<spdlog::sinks::stderr_color_sink_mt>()));
     if (argc > 1 && std::string_view(argv[1]) == "ctl")
         return fins::cli::run_ctl(argc - 1, argv + 1);
     Settings settings;

@@ -1,0 +1,131 @@
+// The global options of `fins` (where the PLC is, how to reach it, --json), node
+// addresses and the connection every verb opens with them.
+#include <charconv>
+#include <chrono>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include <fmt/core.h>
+#include <CLI/CLI.hpp>
+
+#include "cli/fins/commands.hpp"
+#include "fins/client.hpp"
+
+namespace fins::cli {
+
+namespace {
+
+// One part of NET.NODE.UNIT: decimal, 0x-prefixed hex, or hex when it has a letter A-F
+// (the README and the manuals write unit addresses such as E1 in hex).
+std::optional<unsigned> parse_node_part(std::string_view s) {
+    int base = 10;
+    if (s.size() > 2 && s[0] == '0' && (s[1] == 'x' || s[1] == 'X')) {
+        base = 16;
+        s.remove_prefix(2);
+    } else if (s.find_first_of("abcdefABCDEF") != std::string_view::npos) {
+        base = 16;
+    }
+    unsigned v = 0;
+    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v, base);
+    if (s.empty() || ec != std::errc{} || end != s.data() + s.size() || v > 255)
+        return std::nullopt;
+    return v;
+}
+
+}  // namespace
+
+std::optional<NodeAddress> parse_node_address(const std::string& s) {
+    unsigned parts[3] = {0, 0, 0};
+    std::string_view rest = s;
+    for (std::size_t i = 0; i < 3; ++i) {
+        const auto dot = rest.find('.');
+        if ((i < 2) != (dot != std::string_view::npos)) return std::nullopt;
+        const auto v = parse_node_part(rest.substr(0, dot));
+        if (!v) return std::nullopt;
+        parts[i] = *v;
+        rest = i < 2 ? rest.substr(dot + 1) : std::string_view{};
+    }
+    if (parts[0] > 127) return std::nullopt;
+    return NodeAddress{static_cast<std::uint8_t>(parts[0]), static_cast<std::uint8_t>(parts[1]),
+                       static_cast<std::uint8_t>(parts[2])};
+}
+
+std::string endpoint(const GlobalOptions& g) {
+    if (g.host.find(':') != std::string::npos) return fmt::format("[{}]:{}", g.host, g.port);
+    return fmt::format("{}:{}", g.host, g.port);
+}
+
+std::unique_ptr<Client> open_client(const GlobalOptions& g, Output& out, int& exit_code) {
+    out.set_target(g);
+    ClientOptions o;
+    o.host = g.host;
+    o.port = g.port;
+    o.protocol = g.tcp ? ClientOptions::Protocol::tcp : ClientOptions::Protocol::udp;
+    o.timeout = std::chrono::milliseconds(static_cast<long>(g.timeout_seconds * 1000.0 + 0.5));
+    o.retries = g.retries;
+    if (!g.dest.empty()) {
+        auto d = parse_node_address(g.dest);
+        if (!d) {
+            exit_code = out.usage(
+                fmt::format("--dest '{}' is not NET.NODE.UNIT (e.g. 0.10.0, 0.10.E1)", g.dest));
+            return nullptr;
+        }
+        o.destination = *d;
+    }
+    if (!g.source.empty()) {
+        auto s = parse_node_address(g.source);
+        if (!s) {
+            exit_code = out.usage(fmt::format("--source '{}' is not NET.NODE.UNIT", g.source));
+            return nullptr;
+        }
+        o.source = *s;
+    }
+    auto client = Client::connect(o);
+    if (!client) {
+        exit_code = out.failure(client.error(), fmt::format("cannot reach {}", endpoint(g)));
+        return nullptr;
+    }
+    return std::move(*client);
+}
+
+void add_global_options(CLI::App& app, GlobalOptions& g) {
+    app.add_option("--host", g.host, "PLC host name or IP address")->capture_default_str();
+    app.add_option("--port", g.port, "FINS port")->capture_default_str();
+    app.add_flag("--tcp", g.tcp, "Use FINS/TCP instead of FINS/UDP");
+    app.add_option("--timeout", g.timeout_seconds, "Seconds to wait for each attempt")
+        ->capture_default_str()
+        ->check(CLI::Range(0.001, 3600.0));
+    app.add_option("--retries", g.retries, "Retransmissions after a timeout (0-15, W596)")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 15));
+    app.add_option("--dest", g.dest,
+                   "Destination NET.NODE.UNIT, unit in hex allowed (0.10.E1); default: derived "
+                   "(`fins probe` finds the PLC's node)");
+    app.add_option("--source", g.source, "Source NET.NODE.UNIT (default: derived)");
+    app.add_flag("--json", g.json, "Print JSON");
+}
+
+void describe_global_options(CLI::App& app) {
+    std::string text = "Global options (before or after the verb):\n";
+    for (const CLI::Option* o : app.get_options()) {
+        const std::string name = o->get_name(false, true);
+        if (name.empty() || name == "-h,--help" || name == "--version") continue;
+        std::string left = name;
+        if (o->get_type_size() != 0) {
+            const std::string type = o->get_type_name();
+            left += " " + type.substr(0, type.find(':'));  // "FLOAT:FLOAT in [...]" -> FLOAT
+        }
+        std::string desc = o->get_description();
+        if (!o->get_default_str().empty()) desc += " [" + o->get_default_str() + "]";
+        text += fmt::format("  {:<22}{}\n", left, desc);
+    }
+    text += "Exit codes: 0 ok, 2 usage, 3 transport, 4 the PLC answered an end code.";
+    for (CLI::App* sub : app.get_subcommands({}))
+        sub->footer(text);
+    app.footer(
+        "`fins VERB --help` describes a verb; `fins probe` shows the PLC's node.\n"
+        "Exit codes: 0 ok, 2 usage, 3 transport, 4 the PLC answered an end code.");
+}
+
+}  // namespace fins::cli

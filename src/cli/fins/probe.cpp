@@ -1,0 +1,154 @@
+// `fins probe`: which FINS node answers at HOST:PORT, and the --dest that reaches it.
+//
+// Over UDP the client addresses node "host's last octet" (1 on loopback), so a PLC set to
+// another node answers 0201. A request to node 00 means "the local node" (W342 5-1-1
+// DA1), which a PLC answers with its own address in the response's source field: one
+// 05 01 CPU UNIT DATA READ sent that way tells the node and the model. Over TCP the
+// FINS/TCP handshake reports the server's node.
+#include <netdb.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <array>
+#include <chrono>
+#include <cstring>
+#include <memory>
+#include <string>
+
+#include <fmt/core.h>
+
+#include "cli/fins/commands.hpp"
+#include "fins/commands/configuration.hpp"
+#include "fins/frame.hpp"
+
+namespace fins::cli {
+
+namespace {
+
+constexpr std::uint8_t probe_service_id = 0x5A;
+// Node 254 unless the local address gives a better one: a PLC converting node numbers
+// to IP addresses (automatic generation) answers to its network's host SA1.
+constexpr std::uint8_t probe_source_node = 254;
+
+struct Fd {
+    int fd = -1;
+    ~Fd() {
+        if (fd >= 0) ::close(fd);
+    }
+};
+
+std::uint8_t local_node(int fd) {
+    sockaddr_storage local{};
+    socklen_t size = sizeof local;
+    if (::getsockname(fd, reinterpret_cast<sockaddr*>(&local), &size) != 0 ||
+        local.ss_family != AF_INET)
+        return probe_source_node;
+    const auto* in = reinterpret_cast<const sockaddr_in*>(&local);
+    const auto bytes = reinterpret_cast<const std::uint8_t*>(&in->sin_addr.s_addr);
+    if (bytes[0] == 127 || bytes[3] == 0 || bytes[3] == 255) return probe_source_node;
+    return bytes[3];
+}
+
+std::optional<FoundNode> discover_udp(const GlobalOptions& g) {
+    addrinfo hints{};
+    hints.ai_family = AF_UNSPEC;
+    hints.ai_socktype = SOCK_DGRAM;
+    addrinfo* found = nullptr;
+    const auto port = std::to_string(g.port);
+    if (::getaddrinfo(g.host.c_str(), port.c_str(), &hints, &found) != 0 || found == nullptr)
+        return std::nullopt;
+    std::unique_ptr<addrinfo, void (*)(addrinfo*)> list(found, ::freeaddrinfo);
+    Fd s{::socket(found->ai_family, SOCK_DGRAM | SOCK_CLOEXEC, 0)};
+    if (s.fd < 0 || ::connect(s.fd, found->ai_addr, found->ai_addrlen) != 0) return std::nullopt;
+
+    Header h;
+    h.destination = NodeAddress{0, 0, 0};
+    h.source = NodeAddress{0, local_node(s.fd), 0};
+    if (auto src = parse_node_address(g.source); src && !g.source.empty()) h.source = *src;
+    h.service_id = probe_service_id;
+    std::array<std::uint8_t, 64> frame{};
+    const auto size = encode_request(h, CpuUnitDataRead::code, Bytes{}, frame);
+    if (!size) return std::nullopt;
+
+    const auto wait = std::chrono::milliseconds(static_cast<long>(g.timeout_seconds * 1000.0));
+    for (unsigned attempt = 0; attempt <= g.retries; ++attempt) {
+        if (::send(s.fd, frame.data(), *size, 0) != static_cast<ssize_t>(*size))
+            return std::nullopt;
+        const auto deadline = std::chrono::steady_clock::now() + wait;
+        // Bounded: every turn either returns or moves towards the deadline.
+        while (true) {
+            const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+                deadline - std::chrono::steady_clock::now());
+            pollfd p{s.fd, POLLIN, 0};
+            if (left.count() <= 0 || ::poll(&p, 1, static_cast<int>(left.count())) <= 0) break;
+            std::array<std::uint8_t, 2048> in{};
+            const auto n = ::recv(s.fd, in.data(), in.size(), 0);
+            if (n <= 0) return std::nullopt;  // e.g. ICMP port unreachable
+            auto r = decode_response(Bytes(in.data(), static_cast<std::size_t>(n)));
+            if (!r || r->header.service_id != probe_service_id ||
+                r->command != CpuUnitDataRead::code)
+                continue;
+            FoundNode node{r->header.source, {}};
+            node.address.unit = 0;
+            if (r->code.ok())
+                if (auto data = CpuUnitDataRead{}.decode_response(r->data))
+                    node.model = data->model;
+            return node;
+        }
+    }
+    return std::nullopt;
+}
+
+std::optional<FoundNode> discover_tcp(const GlobalOptions& g) {
+    ClientOptions o;
+    o.host = g.host;
+    o.port = g.port;
+    o.protocol = ClientOptions::Protocol::tcp;
+    o.timeout = std::chrono::milliseconds(static_cast<long>(g.timeout_seconds * 1000.0 + 0.5));
+    auto client = Client::connect(o);
+    if (!client) return std::nullopt;
+    FoundNode node{(*client)->destination(), {}};
+    if (auto data = (*client)->send(CpuUnitDataRead{CpuUnitDataSection::model_and_area}))
+        node.model = data->model;
+    return node;
+}
+
+}  // namespace
+
+std::optional<FoundNode> discover_node(const GlobalOptions& g) {
+    return g.tcp ? discover_tcp(g) : discover_udp(g);
+}
+
+int run_probe(const GlobalOptions& g, Output& out) {
+    auto found = discover_node(g);
+    if (!found)
+        return out.failure(make_error_code(ClientError::timeout),
+                           fmt::format("probe {} over {}", endpoint(g), g.tcp ? "TCP" : "UDP"));
+    // The node a plain `fins` would address: the client's own derivation, no request sent.
+    GlobalOptions plain = g;
+    plain.dest.clear();
+    std::optional<NodeAddress> derived;
+    if (!g.tcp) {
+        int rc = 0;
+        Output quiet{false};
+        if (auto c = open_client(plain, quiet, rc)) derived = c->destination();
+    }
+    const bool needs_dest = derived && derived->node != found->address.node;
+    nlohmann::json doc{{"host", g.host},
+                       {"port", g.port},
+                       {"protocol", g.tcp ? "tcp" : "udp"},
+                       {"node", node_text(found->address)},
+                       {"model", found->model},
+                       {"needs_dest", needs_dest}};
+    std::string text =
+        fmt::format("{} over {}: FINS node {}{}\n", endpoint(g), g.tcp ? "TCP" : "UDP",
+                    node_text(found->address), found->model.empty() ? "" : ", " + found->model);
+    if (needs_dest)
+        text += fmt::format("fins addresses node {} here by default: add --dest {}\n",
+                            derived->node, node_text(found->address));
+    out.print(doc, text);
+    return exit_ok;
+}
+
+}  // namespace fins::cli

@@ -1,0 +1,200 @@
+// The README's sample sessions are what the programs print today.
+//
+// Checked: every fenced block with at least one line starting with "$ ". Such a block
+// is a session against a finsd started for it alone (port 0, a control socket, a
+// scratch working directory); an HTML comment on the line before the fence adds finsd
+// flags:   <!-- readme-test: finsd --profile cs1h-lcb -->
+// In the block:
+//   "$ fins ARGS"       runs build/bin/fins with --port of that finsd added
+//   "$ finsd ctl ARGS"  runs finsd ctl with --socket of that finsd added
+//   "  # text"          after a command is a comment (not passed)
+//   other lines         the expected output: stdout, then stderr, line by line; none
+//                       means none. A line "..." stands for any number of lines, and
+//                       "..." inside a line for any text (clock, cycle times).
+// Blocks without "$ " lines (shell recipes, TOML, C++) are not run.
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "finsd_run.hpp"
+#include "process.hpp"
+
+namespace fins::test {
+namespace {
+
+const std::string readme_path = std::string(FINS_SOURCE_DIR) + "/README.md";
+const std::string fins_bin = std::string(FINS_BIN_DIR) + "/fins";
+constexpr std::string_view wildcard = "...";
+constexpr std::string_view marker = "<!-- readme-test: finsd";
+
+struct Step {
+    int line = 0;
+    std::string command;
+    std::vector<std::string> expected;
+};
+struct Block {
+    int line = 0;
+    std::vector<std::string> finsd_args;
+    std::vector<Step> steps;
+};
+
+// Shell-like words: blanks separate, '...' and "..." quote, an unquoted " #" starts a comment.
+std::vector<std::string> split_words(const std::string& text) {
+    std::vector<std::string> words;
+    std::string word;
+    bool in_word = false;
+    char quote = 0;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (quote != 0) {
+            if (c == quote)
+                quote = 0;
+            else
+                word += c;
+        } else if (c == '\'' || c == '"') {
+            quote = c;
+            in_word = true;
+        } else if (c == ' ' || c == '\t') {
+            if (in_word) words.push_back(word);
+            word.clear();
+            in_word = false;
+        } else if (c == '#' && !in_word) {
+            break;
+        } else {
+            word += c;
+            in_word = true;
+        }
+    }
+    if (in_word) words.push_back(word);
+    return words;
+}
+
+std::vector<Block> checked_blocks(const std::string& path) {
+    std::ifstream f(path);
+    std::vector<Block> blocks;
+    std::string line;
+    std::string previous;
+    int number = 0;
+    std::optional<Block> open;
+    while (std::getline(f, line)) {
+        ++number;
+        if (line.rfind("```", 0) == 0) {
+            if (!open) {
+                open = Block{};
+                open->line = number;
+                if (const auto at = previous.find(marker); at != std::string::npos) {
+                    auto args = previous.substr(at + marker.size());
+                    args = args.substr(0, args.find("-->"));
+                    open->finsd_args = split_words(args);
+                }
+            } else {
+                if (!open->steps.empty()) blocks.push_back(*open);
+                open.reset();
+            }
+        } else if (open) {
+            if (line.rfind("$ ", 0) == 0)
+                open->steps.push_back(Step{number, line.substr(2), {}});
+            else if (!open->steps.empty())
+                open->steps.back().expected.push_back(line);
+        }
+        if (!line.empty()) previous = line;
+    }
+    return blocks;
+}
+
+bool line_matches(std::string_view pattern, std::string_view text) {
+    const auto star = pattern.find(wildcard);
+    if (star == std::string_view::npos) return pattern == text;
+    const auto head = pattern.substr(0, star);
+    if (text.substr(0, head.size()) != head) return false;
+    const auto rest = pattern.substr(star + wildcard.size());
+    for (std::size_t i = head.size(); i <= text.size(); ++i)
+        if (line_matches(rest, text.substr(i))) return true;
+    return false;
+}
+
+bool lines_match(const std::vector<std::string>& pattern, std::size_t p,
+                 const std::vector<std::string>& text, std::size_t t) {
+    if (p == pattern.size()) return t == text.size();
+    if (pattern[p] == wildcard) {
+        for (std::size_t k = t; k <= text.size(); ++k)
+            if (lines_match(pattern, p + 1, text, k)) return true;
+        return false;
+    }
+    return t < text.size() && line_matches(pattern[p], text[t]) &&
+           lines_match(pattern, p + 1, text, t + 1);
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+    std::vector<std::string> lines;
+    std::istringstream in(text);
+    std::string line;
+    while (std::getline(in, line))
+        lines.push_back(line);
+    return lines;
+}
+
+std::string joined(const std::vector<std::string>& lines) {
+    std::string s;
+    for (const auto& l : lines)
+        s += "    " + l + "\n";
+    return s;
+}
+
+TEST(Readme, ParsesItsOwnRules) {
+    EXPECT_EQ(split_words("fins clock --set \"2030-01-02 03:04:05\"  # comment"),
+              (std::vector<std::string>{"fins", "clock", "--set", "2030-01-02 03:04:05"}));
+    EXPECT_TRUE(line_matches("average ... ms", "average 3.0 ms"));
+    EXPECT_FALSE(line_matches("average ... ms", "average 3.0 s"));
+    EXPECT_TRUE(lines_match({"a", "...", "d"}, 0, {"a", "b", "c", "d"}, 0));
+    EXPECT_TRUE(lines_match({"a", "..."}, 0, {"a"}, 0));
+    EXPECT_FALSE(lines_match({"a"}, 0, {"a", "b"}, 0));
+    EXPECT_FALSE(lines_match({}, 0, {"unexpected"}, 0));
+}
+
+TEST(Readme, EverySampleSessionPrintsWhatTheReadmeShows) {
+    const auto blocks = checked_blocks(readme_path);
+    ASSERT_GE(blocks.size(), 4u) << "no sample sessions found in " << readme_path;
+    const auto home = std::filesystem::current_path();
+    for (const auto& block : blocks) {
+        SCOPED_TRACE("README.md:" + std::to_string(block.line));
+        ScratchDir dir("readme");
+        const std::string socket = (dir.path() / "ctl.sock").string();
+        auto args = block.finsd_args;
+        args.insert(args.end(), {"--control", socket});
+        Finsd finsd(args);
+        ASSERT_TRUE(finsd.started()) << finsd.result().err;
+        // Files a session writes (program-read --out) land in the scratch directory.
+        std::filesystem::current_path(dir.path());
+        for (const auto& step : block.steps) {
+            const auto words = split_words(step.command);
+            std::vector<std::string> argv;
+            if (!words.empty() && words[0] == "fins") {
+                argv = {fins_bin, "--port", std::to_string(finsd.port()), "--timeout", "5"};
+            } else if (words.size() > 1 && words[0] == "finsd" && words[1] == "ctl") {
+                argv = {finsd_path, "ctl", "--socket", socket};
+                argv.insert(argv.end(), words.begin() + 1, words.end());
+                argv.erase(argv.begin() + 4);  // the second "ctl"
+            }
+            ASSERT_FALSE(argv.empty())
+                << "README.md:" << step.line
+                << ": only fins and finsd ctl run in a session: " << step.command;
+            if (words[0] == "fins") argv.insert(argv.end(), words.begin() + 1, words.end());
+            const auto r = run(argv);
+            const auto actual = lines_of(r.out + r.err);
+            EXPECT_TRUE(lines_match(step.expected, 0, actual, 0))
+                << "README.md:" << step.line << ": $ " << step.command << "\nREADME shows:\n"
+                << joined(step.expected) << "the program printed (exit " << r.exit_code << "):\n"
+                << joined(actual);
+        }
+        std::filesystem::current_path(home);
+    }
+}
+
+}  // namespace
+}  // namespace fins::test
