@@ -1,5 +1,8 @@
 #include "server/tcp_session.hpp"
 
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+
 #include <cstring>
 
 #include <spdlog/spdlog.h>
@@ -14,6 +17,8 @@ namespace {
 // Auto-assigned client nodes: CS/CJ Ethernet units hand out 239-254 to FINS/TCP clients
 // by default (one per connection); we fall back to the rest of 1-254 when those are taken.
 constexpr std::uint8_t first_auto_node = 239;
+
+using quick_ack = asio::detail::socket_option::boolean<IPPROTO_TCP, TCP_QUICKACK>;
 
 }  // namespace
 
@@ -81,6 +86,12 @@ void TcpSession::read_more() {
                 return;
             }
             self->in_size_ += n;
+            // A client that writes the FINS/TCP header and the frame separately without
+            // TCP_NODELAY holds the frame until its header is acknowledged. Linux delays
+            // that ACK (~40 ms) once we answer promptly; quick-ack mode does not stick,
+            // so re-arm it after every read (issue 6 item 13).
+            std::error_code ignored;
+            self->socket_.set_option(quick_ack(true), ignored);
             self->process();
         });
 }
