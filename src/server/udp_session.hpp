@@ -5,8 +5,8 @@
 // Batched and never blocking, on the one I/O thread the whole server shares:
 //   wait until readable -> recvmmsg() up to `batch_size` datagrams (MSG_DONTWAIT) ->
 //   Dispatcher::handle each into its own reply slot -> one sendmmsg() for the replies ->
-//   again while a batch came back full (at most `rounds_per_turn` batches, then the
-//   turn goes back to the other sessions), else wait.
+//   again until recvmmsg finds nothing (at most `rounds_per_turn` batches, then the
+//   turn goes back to the other sessions and continues after them), then wait.
 // All buffers live in the session, allocated once: the path allocates nothing per
 // datagram.
 //
@@ -63,7 +63,7 @@ class UdpSession : public std::enable_shared_from_this<UdpSession> {
 
     void wait_readable();
     void on_readable();
-    // Serves up to rounds_per_turn batches; false when the socket was drained.
+    // Serves up to rounds_per_turn batches; false when the socket was found empty.
     bool serve_turn();
     // Receives, answers and sends one batch; returns the datagrams received (-1: none).
     int serve_batch();
