@@ -1,9 +1,9 @@
 // FINS/TCP prompt acknowledgement (issue 6 item 13). A client that writes the 16-byte
 // FINS/TCP header and the frame in two writes without TCP_NODELAY holds the frame
 // (Nagle) until the header is acknowledged; Linux delays that ACK by ~40 ms once a
-// server answers promptly (its "pingpong" mode). finsd re-arms TCP_QUICKACK after every
-// read. The test pins that re-arming on the server's own socket, without timing: the
-// I/O thread is this one, so "the server has handled the read" is a fact, not a wait.
+// server answers promptly (its "pingpong" mode). finsd re-arms TCP_QUICKACK after a
+// read that no answer follows. The tests pin that on the server's own socket, without
+// timing: the I/O thread is this one, so "the server has handled the read" is a fact.
 #include <gtest/gtest.h>
 
 #include <netinet/in.h>
@@ -17,6 +17,7 @@
 #include <array>
 #include <chrono>
 #include <cstring>
+#include <memory>
 #include <vector>
 
 #include <asio/io_context.hpp>
@@ -67,74 +68,129 @@ int server_end_of(int client) {
     return -1;
 }
 
-TEST(TcpSession, QuickAckIsReArmedAfterEveryRead) {
-    Harness h;
-    asio::io_context io{1};
-    server::ServerOptions options;
-    options.port = 0;
-    options.udp = false;
-    auto server = server::Server::start(io, h.plc, options);
-    ASSERT_TRUE(server.has_value());
+class TcpQuickAck : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        server::ServerOptions options;
+        options.port = 0;
+        options.udp = false;
+        auto started = server::Server::start(io_, h_.plc, options);
+        ASSERT_TRUE(started.has_value());
+        server_ = std::move(*started);
 
-    // A client as the issue describes it: no TCP_NODELAY.
-    const int client = ::socket(AF_INET, SOCK_STREAM, 0);
-    timeval tv{5, 0};
-    ::setsockopt(client, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
-    sockaddr_in to{};
-    to.sin_family = AF_INET;
-    to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    to.sin_port = htons((*server)->tcp_port());
-    ASSERT_EQ(::connect(client, reinterpret_cast<sockaddr*>(&to), sizeof to), 0);
-    // Runs the server until `done` holds (bounded in count and time).
-    const auto pump = [&](auto done) {
-        for (int i = 0; i < 500 && !done(); ++i) io.run_one_for(std::chrono::milliseconds(10));
-        io.poll();  // handlers the last reactor pass completed
+        // A client as the issue describes it: no TCP_NODELAY.
+        client_ = ::socket(AF_INET, SOCK_STREAM, 0);
+        timeval tv{5, 0};
+        ::setsockopt(client_, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+        sockaddr_in to{};
+        to.sin_family = AF_INET;
+        to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+        to.sin_port = htons(server_->tcp_port());
+        ASSERT_EQ(::connect(client_, reinterpret_cast<sockaddr*>(&to), sizeof to), 0);
+
+        std::array<std::uint8_t, 20> hello{};
+        ByteWriter w{hello};
+        write_node_address_request(w, 0);
+        ASSERT_EQ(::send(client_, hello.data(), w.size(), 0), static_cast<ssize_t>(w.size()));
+        ASSERT_TRUE(pump([&] { return readable(client_) >= 24; }));
+        std::array<std::uint8_t, 24> answer{};
+        ASSERT_EQ(::recv(client_, answer.data(), answer.size(), 0), 24);
+        node_ = answer[19];
+        server_fd_ = server_end_of(client_);
+        ASSERT_GE(server_fd_, 0);
+    }
+    void TearDown() override {
+        if (client_ >= 0) ::close(client_);
+        if (server_) server_->stop();
+    }
+
+    // Runs the server (on this thread) until `done` holds, bounded in count and time.
+    template <typename Done>
+    bool pump(Done done) {
+        for (int i = 0; i < 500 && !done(); ++i) io_.run_one_for(std::chrono::milliseconds(10));
+        io_.poll();  // handlers the last reactor pass completed
         return done();
-    };
+    }
 
-    std::array<std::uint8_t, 64> buf{};
-    ByteWriter hs{buf};
-    write_node_address_request(hs, 0);
-    ASSERT_EQ(::send(client, buf.data(), hs.size(), 0), static_cast<ssize_t>(hs.size()));
-    ASSERT_TRUE(pump([&] { return readable(client) >= 24; }));
-    ASSERT_EQ(::recv(client, buf.data(), 24, 0), 24);
-    const std::uint8_t node = buf[19];
-    const int server_fd = server_end_of(client);
-    ASSERT_GE(server_fd, 0);
-
-    for (std::uint8_t sid = 1; sid <= 3; ++sid) {
+    std::vector<std::uint8_t> frame(std::uint8_t sid, std::uint8_t icf = 0x80) const {
         FrameFields f;
+        f.icf = icf;
         f.service_id = sid;
         f.destination = {0, 0, 0};
-        f.source = {0, node, 0};
-        const auto frame = request_frame("0101 82000000 0001", f);
+        f.source = {0, node_, 0};
+        return request_frame("0101 82000000 0001", f);
+    }
+
+    // Puts the server's socket in the state it is in after a prompt answer (delayed
+    // ACKs), sends `bytes`, lets the server read them and returns its TCP_QUICKACK.
+    int quick_ack_after_reading(const std::uint8_t* bytes, std::size_t size) {
+        const int off = 0;
+        if (::setsockopt(server_fd_, IPPROTO_TCP, TCP_QUICKACK, &off, sizeof off) != 0 ||
+            quick_ack(server_fd_) != 0)
+            return -1;
+        if (::send(client_, bytes, size, 0) != static_cast<ssize_t>(size)) return -1;
+        pollfd arrived{server_fd_, POLLIN, 0};
+        if (::poll(&arrived, 1, 5000) != 1) return -1;  // in the server's socket, unread
+        if (!pump([&] { return readable(server_fd_) == 0; })) return -1;
+        return quick_ack(server_fd_);
+    }
+
+    // Sends one whole request and returns its answer's end code (0xFFFF: none).
+    std::uint16_t round_trip(std::uint8_t sid) {
+        const auto request = frame(sid);
+        std::vector<std::uint8_t> packet(tcp_header_size + request.size());
+        ByteWriter w{packet};
+        write_tcp_header(w, TcpCommand::frame, request.size());
+        w.bytes(request);
+        if (::send(client_, packet.data(), packet.size(), 0) != static_cast<ssize_t>(packet.size()))
+            return 0xFFFF;
+        return answer(sid);
+    }
+
+    std::uint16_t answer(std::uint8_t sid) {
+        if (!pump([&] { return readable(client_) >= tcp_header_size + 16; })) return 0xFFFF;
+        std::array<std::uint8_t, tcp_header_size + 16> in{};
+        if (::recv(client_, in.data(), in.size(), 0) != static_cast<ssize_t>(in.size()) ||
+            in[tcp_header_size + 9] != sid)
+            return 0xFFFF;
+        return static_cast<std::uint16_t>((in[tcp_header_size + 12] << 8) | in[tcp_header_size + 13]);
+    }
+
+    Harness h_;
+    asio::io_context io_{1};
+    std::unique_ptr<server::Server> server_;
+    int client_ = -1;
+    int server_fd_ = -1;
+    std::uint8_t node_ = 0;
+};
+
+// The split-write client: the header alone arrives first. Once finsd has read it, the
+// ACK the client waits for must not be delayed.
+TEST_F(TcpQuickAck, ReArmedAfterAReadThatEndsInsideAPacket) {
+    for (std::uint8_t sid = 1; sid <= 3; ++sid) {
+        const auto request = frame(sid);
         std::array<std::uint8_t, tcp_header_size> header{};
         ByteWriter w{header};
-        write_tcp_header(w, TcpCommand::frame, frame.size());
-
-        // As after an answer sent promptly: the kernel delays its ACKs.
-        const int off = 0;
-        ASSERT_EQ(::setsockopt(server_fd, IPPROTO_TCP, TCP_QUICKACK, &off, sizeof off), 0);
-        ASSERT_EQ(quick_ack(server_fd), 0);
-
-        // The client's first write: the header alone. Once finsd has read it, its ACK
-        // must not wait: quick-ack mode is on again.
-        ASSERT_EQ(::send(client, header.data(), header.size(), 0), static_cast<ssize_t>(header.size()));
-        pollfd arrived{server_fd, POLLIN, 0};
-        ASSERT_EQ(::poll(&arrived, 1, 5000), 1);  // in the server's socket, not yet read
-        ASSERT_TRUE(pump([&] { return readable(server_fd) == 0; }));
-        EXPECT_EQ(quick_ack(server_fd), 1) << "request " << int{sid};
-
+        write_tcp_header(w, TcpCommand::frame, request.size());
+        EXPECT_EQ(quick_ack_after_reading(header.data(), header.size()), 1) << int{sid};
         // The second write: the frame; the answer follows.
-        ASSERT_EQ(::send(client, frame.data(), frame.size(), 0), static_cast<ssize_t>(frame.size()));
-        ASSERT_TRUE(pump([&] { return readable(client) >= tcp_header_size + 16; }));
-        std::array<std::uint8_t, tcp_header_size + 16> answer{};
-        ASSERT_EQ(::recv(client, answer.data(), answer.size(), 0), static_cast<ssize_t>(answer.size()));
-        EXPECT_EQ(answer[tcp_header_size + 9], sid);
-        EXPECT_EQ((answer[tcp_header_size + 12] << 8) | answer[tcp_header_size + 13], 0x0000);
+        ASSERT_EQ(::send(client_, request.data(), request.size(), 0),
+                  static_cast<ssize_t>(request.size()));
+        EXPECT_EQ(answer(sid), 0x0000);
     }
-    ::close(client);
-    (*server)->stop();
+}
+
+// ICF bit 0 (fins-frames.md 1.2): a request that asks for no response gets none, so no
+// answer carries the ACK either: the client's next write would wait for it.
+TEST_F(TcpQuickAck, ReArmedAfterAFrameThatAsksForNoResponse) {
+    const auto request = frame(0x21, 0x81);
+    std::vector<std::uint8_t> packet(tcp_header_size + request.size());
+    ByteWriter w{packet};
+    write_tcp_header(w, TcpCommand::frame, request.size());
+    w.bytes(request);
+    EXPECT_EQ(quick_ack_after_reading(packet.data(), packet.size()), 1);
+    EXPECT_EQ(readable(client_), 0U);  // no answer
+    EXPECT_EQ(round_trip(0x22), 0x0000);
 }
 
 }  // namespace
