@@ -10,8 +10,8 @@
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
-#include <sys/socket.h>
 #include <pthread.h>
+#include <sys/socket.h>
 #include <sys/uio.h>
 #include <unistd.h>
 
@@ -77,7 +77,8 @@ void set_quickack(int fd) {
 double cpu_seconds(std::thread& thread) {
     clockid_t clock{};
     timespec ts{};
-    if (pthread_getcpuclockid(thread.native_handle(), &clock) != 0 || clock_gettime(clock, &ts) != 0)
+    if (pthread_getcpuclockid(thread.native_handle(), &clock) != 0 ||
+        clock_gettime(clock, &ts) != 0)
         return 0;
     return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
 }
@@ -159,11 +160,13 @@ class EchoServer {
             out[i].msg_hdr.msg_name = &peers[i];
         }
         while (!stop_) {
-            for (auto& m : in) m.msg_hdr.msg_namelen = sizeof(sockaddr_storage);
+            for (auto& m : in)
+                m.msg_hdr.msg_namelen = sizeof(sockaddr_storage);
             const int n = ::recvmmsg(fd_, in.data(), batch, MSG_WAITFORONE, nullptr);
             if (n <= 0) return;
-            for (int i = 0; i < n; ++i) out[static_cast<unsigned>(i)].msg_hdr.msg_namelen =
-                in[static_cast<unsigned>(i)].msg_hdr.msg_namelen;
+            for (int i = 0; i < n; ++i)
+                out[static_cast<unsigned>(i)].msg_hdr.msg_namelen =
+                    in[static_cast<unsigned>(i)].msg_hdr.msg_namelen;
             ::sendmmsg(fd_, out.data(), static_cast<unsigned>(n), 0);
         }
     }

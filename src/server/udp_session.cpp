@@ -118,7 +118,8 @@ bool UdpSession::serve_turn() {
 
 int UdpSession::serve_batch() {
     Slots& s = *slots_;
-    for (auto& m : s.in_msgs) m.msg_hdr.msg_namelen = sizeof(sockaddr_storage);
+    for (auto& m : s.in_msgs)
+        m.msg_hdr.msg_namelen = sizeof(sockaddr_storage);
     const int received =
         ::recvmmsg(socket_.native_handle(), s.in_msgs.data(), batch_size, MSG_DONTWAIT, nullptr);
     if (received <= 0) {
@@ -137,8 +138,8 @@ int UdpSession::serve_batch() {
         const auto& request = s.in_msgs[static_cast<std::size_t>(i)];
         // A longer datagram was cut to receive_size (MSG_TRUNC), still more than a frame.
         const std::size_t size = std::min<std::size_t>(request.msg_len, receive_size);
-        const std::size_t n = dispatcher_.handle(Bytes{s.in[static_cast<std::size_t>(i)].data(), size},
-                                                 s.out[replies], context);
+        const std::size_t n = dispatcher_.handle(
+            Bytes{s.in[static_cast<std::size_t>(i)].data(), size}, s.out[replies], context);
         if (n == 0) continue;
         s.out_iov[replies].iov_len = n;
         auto& reply = s.out_msgs[replies].msg_hdr;

@@ -77,13 +77,15 @@ TEST(UdpSession, ServingDatagramsDoesNotAllocate) {
         std::size_t answered = 0;
         for (int spin = 0; spin < 500 && answered < count; ++spin) {
             io.run_one_for(std::chrono::milliseconds(10));
-            while (::recv(fds[1], in.data(), in.size(), MSG_DONTWAIT) > 0) ++answered;
+            while (::recv(fds[1], in.data(), in.size(), MSG_DONTWAIT) > 0)
+                ++answered;
         }
         return answered == count;
     };
     ASSERT_TRUE(round(8));
     const auto before = allocations.load();
-    for (int i = 0; i < 4; ++i) ASSERT_TRUE(round(8));
+    for (int i = 0; i < 4; ++i)
+        ASSERT_TRUE(round(8));
     EXPECT_EQ(allocations.load(), before);
     session->close();
     ::close(fds[1]);

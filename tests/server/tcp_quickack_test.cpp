@@ -107,7 +107,8 @@ class TcpQuickAck : public ::testing::Test {
     // Runs the server (on this thread) until `done` holds, bounded in count and time.
     template <typename Done>
     bool pump(Done done) {
-        for (int i = 0; i < 500 && !done(); ++i) io_.run_one_for(std::chrono::milliseconds(10));
+        for (int i = 0; i < 500 && !done(); ++i)
+            io_.run_one_for(std::chrono::milliseconds(10));
         io_.poll();  // handlers the last reactor pass completed
         return done();
     }
@@ -153,7 +154,8 @@ class TcpQuickAck : public ::testing::Test {
         if (::recv(client_, in.data(), in.size(), 0) != static_cast<ssize_t>(in.size()) ||
             in[tcp_header_size + 9] != sid)
             return 0xFFFF;
-        return static_cast<std::uint16_t>((in[tcp_header_size + 12] << 8) | in[tcp_header_size + 13]);
+        return static_cast<std::uint16_t>((in[tcp_header_size + 12] << 8) |
+                                          in[tcp_header_size + 13]);
     }
 
     Harness h_;

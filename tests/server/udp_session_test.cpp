@@ -51,7 +51,8 @@ void set_timeouts(int fd, int seconds) {
 // the session meets a send buffer that stays full for as long as the peer does not read.
 struct UnixPair {
     UnixPair() {
-        if (::socketpair(AF_UNIX, SOCK_DGRAM, 0, fds.data()) != 0) throw std::runtime_error("socketpair");
+        if (::socketpair(AF_UNIX, SOCK_DGRAM, 0, fds.data()) != 0)
+            throw std::runtime_error("socketpair");
         const int small = 4096;  // the kernel doubles it: a dozen replies or so
         ::setsockopt(fds[0], SOL_SOCKET, SO_SNDBUF, &small, sizeof small);
     }
@@ -87,10 +88,12 @@ TEST(UdpSession, BatchAnswersEachDatagramToItsOwnSenderInOrder) {
     constexpr std::size_t per_peer = 48;
     static_assert(peers * per_peer > UdpSession::batch_size * UdpSession::rounds_per_turn);
     std::vector<asio::ip::udp::socket> clients;
-    for (std::size_t c = 0; c < peers; ++c) clients.emplace_back(io, asio::ip::udp::v4());
+    for (std::size_t c = 0; c < peers; ++c)
+        clients.emplace_back(io, asio::ip::udp::v4());
     for (std::size_t i = 0; i < per_peer; ++i)
         for (std::size_t c = 0; c < peers; ++c)
-            clients[c].send_to(asio::buffer(read_request(static_cast<std::uint8_t>(c * 64 + i))), to);
+            clients[c].send_to(asio::buffer(read_request(static_cast<std::uint8_t>(c * 64 + i))),
+                               to);
 
     std::vector<std::vector<std::uint8_t>> sids(peers);
     std::size_t total = 0;
@@ -99,7 +102,8 @@ TEST(UdpSession, BatchAnswersEachDatagramToItsOwnSenderInOrder) {
         io.run_one_for(std::chrono::milliseconds(10));
         for (std::size_t c = 0; c < peers; ++c) {
             ssize_t n = 0;
-            while ((n = ::recv(clients[c].native_handle(), in.data(), in.size(), MSG_DONTWAIT)) > 0) {
+            while ((n = ::recv(clients[c].native_handle(), in.data(), in.size(), MSG_DONTWAIT)) >
+                   0) {
                 ASSERT_EQ(n, 16);  // header, command, end code, one word
                 EXPECT_EQ((in[12] << 8) | in[13], 0x0000);
                 sids[c].push_back(in[9]);
@@ -109,7 +113,8 @@ TEST(UdpSession, BatchAnswersEachDatagramToItsOwnSenderInOrder) {
     }
     for (std::size_t c = 0; c < peers; ++c) {
         ASSERT_EQ(sids[c].size(), per_peer) << "peer " << c;
-        for (std::size_t i = 0; i < per_peer; ++i) EXPECT_EQ(sids[c][i], c * 64 + i);
+        for (std::size_t i = 0; i < per_peer; ++i)
+            EXPECT_EQ(sids[c][i], c * 64 + i);
     }
     EXPECT_EQ(session->counters().received, peers * per_peer);
     EXPECT_EQ(session->counters().sent, peers * per_peer);
@@ -134,7 +139,8 @@ class TcpPeer {
         std::array<std::uint8_t, 24> buf{};
         ByteWriter w{buf};
         write_node_address_request(w, 0);
-        if (!connected_ || !send_all(buf.data(), w.size()) || !receive(buf.data(), 24)) return false;
+        if (!connected_ || !send_all(buf.data(), w.size()) || !receive(buf.data(), 24))
+            return false;
         node_ = buf[19];  // the client node the server gave us (frames 3.4)
         return true;
     }
@@ -150,9 +156,11 @@ class TcpPeer {
         write_tcp_header(w, TcpCommand::frame, frame.size());
         w.bytes(frame);
         std::array<std::uint8_t, tcp_header_size + 16> in{};
-        if (!send_all(packet.data(), packet.size()) || !receive(in.data(), in.size())) return 0xFFFF;
+        if (!send_all(packet.data(), packet.size()) || !receive(in.data(), in.size()))
+            return 0xFFFF;
         if (in[tcp_header_size + 9] != sid) return 0xFFFE;
-        return static_cast<std::uint16_t>((in[tcp_header_size + 12] << 8) | in[tcp_header_size + 13]);
+        return static_cast<std::uint16_t>((in[tcp_header_size + 12] << 8) |
+                                          in[tcp_header_size + 13]);
     }
 
   private:
@@ -214,7 +222,8 @@ TEST(UdpSession, FullSendBufferDropsRepliesWhileTcpKeepsBeingServed) {
     std::size_t flooded = 0;
     for (std::size_t i = 0; i < flood; ++i) {
         const auto frame = read_request(static_cast<std::uint8_t>(i));
-        if (::send(pair.peer(), frame.data(), frame.size(), 0) == static_cast<ssize_t>(frame.size()))
+        if (::send(pair.peer(), frame.data(), frame.size(), 0) ==
+            static_cast<ssize_t>(frame.size()))
             ++flooded;
     }
     EXPECT_EQ(flooded, flood);
@@ -224,7 +233,8 @@ TEST(UdpSession, FullSendBufferDropsRepliesWhileTcpKeepsBeingServed) {
     ASSERT_TRUE(port.has_value()) << "the I/O thread is stuck";
     TcpPeer client(*port);
     ASSERT_TRUE(client.handshake());
-    for (std::uint8_t sid = 1; sid <= 20; ++sid) EXPECT_EQ(client.read_word(sid), 0x0000);
+    for (std::uint8_t sid = 1; sid <= 20; ++sid)
+        EXPECT_EQ(client.read_word(sid), 0x0000);
 
     // Every request was read and either answered or dropped (none blocked, none refused).
     UdpSession::Counters counters;
@@ -241,7 +251,8 @@ TEST(UdpSession, FullSendBufferDropsRepliesWhileTcpKeepsBeingServed) {
     // What was sent is exactly what the peer finds queued; once it reads, UDP answers again.
     std::array<std::uint8_t, 64> in{};
     std::uint64_t queued = 0;
-    while (::recv(pair.peer(), in.data(), in.size(), MSG_DONTWAIT) > 0) ++queued;
+    while (::recv(pair.peer(), in.data(), in.size(), MSG_DONTWAIT) > 0)
+        ++queued;
     EXPECT_EQ(queued, counters.sent);
     const auto last = read_request(0xEE);
     ASSERT_EQ(::send(pair.peer(), last.data(), last.size(), 0), static_cast<ssize_t>(last.size()));
