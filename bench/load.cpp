@@ -1,6 +1,8 @@
 // fins_load: drives finsd with 1-word MEMORY AREA READs over FINS/UDP and FINS/TCP with
 // 1 and 32 requests in flight, and measures a raw loopback echo of the same frame sizes
 // in the same run, so the ratio tells what finsd costs over the kernel's own loopback.
+// One more TCP case is a client that writes the FINS/TCP header and the frame in two
+// writes without TCP_NODELAY (its second write waits for the server's ACK of the first).
 //
 // Both servers run in this process on one thread each (finsd is single-threaded too);
 // the generator uses blocking sockets on the main thread. Output: one line per case,
@@ -8,7 +10,9 @@
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
+#include <pthread.h>
 #include <sys/socket.h>
+#include <sys/uio.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -17,6 +21,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <string>
 #include <thread>
 #include <vector>
@@ -62,21 +67,49 @@ void set_nodelay(int fd) {
     setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
 }
 
-bool read_exact(int fd, std::uint8_t* p, std::size_t n) {
+void set_quickack(int fd) {
+    int one = 1;
+    setsockopt(fd, IPPROTO_TCP, TCP_QUICKACK, &one, sizeof one);
+}
+
+// CPU time (user + system) a thread has used so far: what a server pays per request,
+// which contention from other processes on the machine hardly changes.
+double cpu_seconds(std::thread& thread) {
+    clockid_t clock{};
+    timespec ts{};
+    if (pthread_getcpuclockid(thread.native_handle(), &clock) != 0 ||
+        clock_gettime(clock, &ts) != 0)
+        return 0;
+    return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+}
+
+bool read_exact(int fd, std::uint8_t* p, std::size_t n, bool quickack = false) {
     while (n > 0) {
         const ssize_t r = ::recv(fd, p, n, 0);
         if (r <= 0) return false;
         p += r;
         n -= static_cast<std::size_t>(r);
+        if (quickack && n > 0) set_quickack(fd);  // the client waits for this ACK
     }
     return true;
 }
 
-// Raw echo servers: answer each request with a canned reply of the size finsd sends.
+// Raw echo servers: answer each request with a canned reply of the size finsd sends, on
+// blocking sockets in a thread of their own. UDP: recvmmsg (blocking until at least one
+// datagram, then whatever else is queued, up to 32) and one sendmmsg for the replies:
+// the fewest system calls per datagram a server can make, so the ratio is finsd's cost
+// over the kernel's own datagram path (`per_datagram`: one recvfrom and one sendto per
+// datagram, the simplest echo). TCP: reads one request, writes one reply (TCP_NODELAY);
+// with `quickack` it re-arms TCP_QUICKACK after a read that ends inside a request, as
+// finsd does, so split-write clients are not held up by its delayed ACKs.
 class EchoServer {
   public:
-    EchoServer(bool tcp, std::size_t request_size, std::size_t response_size)
-        : tcp_(tcp), request_size_(request_size), response_(response_size, 0xC0) {
+    struct Style {
+        bool udp_batched = true;  // false: per datagram
+        bool quickack = false;
+    };
+    EchoServer(bool tcp, std::size_t request_size, std::size_t response_size, Style style)
+        : tcp_(tcp), style_(style), request_size_(request_size), response_(response_size, 0xC0) {
         fd_ = ::socket(AF_INET, tcp ? SOCK_STREAM : SOCK_DGRAM, 0);
         int one = 1;
         setsockopt(fd_, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
@@ -88,7 +121,14 @@ class EchoServer {
         ::getsockname(fd_, reinterpret_cast<sockaddr*>(&a), &len);
         port_ = ntohs(a.sin_port);
         if (tcp) ::listen(fd_, 4);
-        thread_ = std::thread([this] { tcp_ ? serve_tcp() : serve_udp(); });
+        thread_ = std::thread([this] {
+            if (tcp_)
+                serve_tcp();
+            else if (style_.udp_batched)
+                serve_udp();
+            else
+                serve_udp_per_datagram();
+        });
     }
     ~EchoServer() {
         stop_ = true;
@@ -99,9 +139,38 @@ class EchoServer {
         if (conn_ >= 0) ::close(conn_);
     }
     [[nodiscard]] std::uint16_t port() const { return port_; }
+    double cpu() { return cpu_seconds(thread_); }
 
   private:
     void serve_udp() {
+        constexpr unsigned batch = 32;
+        std::vector<std::array<std::uint8_t, 2048>> bufs(batch);
+        std::array<sockaddr_storage, batch> peers{};
+        std::array<iovec, batch> in_iov{};
+        std::array<mmsghdr, batch> in{};
+        std::array<mmsghdr, batch> out{};
+        iovec reply{response_.data(), response_.size()};
+        for (unsigned i = 0; i < batch; ++i) {
+            in_iov[i] = {bufs[i].data(), bufs[i].size()};
+            in[i].msg_hdr.msg_iov = &in_iov[i];
+            in[i].msg_hdr.msg_iovlen = 1;
+            in[i].msg_hdr.msg_name = &peers[i];
+            out[i].msg_hdr.msg_iov = &reply;
+            out[i].msg_hdr.msg_iovlen = 1;
+            out[i].msg_hdr.msg_name = &peers[i];
+        }
+        while (!stop_) {
+            for (auto& m : in)
+                m.msg_hdr.msg_namelen = sizeof(sockaddr_storage);
+            const int n = ::recvmmsg(fd_, in.data(), batch, MSG_WAITFORONE, nullptr);
+            if (n <= 0) return;
+            for (int i = 0; i < n; ++i)
+                out[static_cast<unsigned>(i)].msg_hdr.msg_namelen =
+                    in[static_cast<unsigned>(i)].msg_hdr.msg_namelen;
+            ::sendmmsg(fd_, out.data(), static_cast<unsigned>(n), 0);
+        }
+    }
+    void serve_udp_per_datagram() {
         std::array<std::uint8_t, 4096> buf{};
         while (!stop_) {
             sockaddr_storage peer{};
@@ -118,11 +187,12 @@ class EchoServer {
         if (conn_ < 0) return;
         set_nodelay(conn_);
         std::array<std::uint8_t, 4096> buf{};
-        while (!stop_ && read_exact(conn_, buf.data(), request_size_))
+        while (!stop_ && read_exact(conn_, buf.data(), request_size_, style_.quickack))
             if (::send(conn_, response_.data(), response_.size(), MSG_NOSIGNAL) <= 0) return;
     }
 
     bool tcp_;
+    Style style_;
     std::size_t request_size_;
     std::vector<std::uint8_t> response_;
     int fd_ = -1;
@@ -137,9 +207,14 @@ struct Stats {
     double p50_us = 0;
     double p99_us = 0;
     std::size_t count = 0;
+    double cpu_us = 0;  // the server thread's CPU time over the case
+
+    [[nodiscard]] double cpu_per_request_us() const {
+        return count > 0 ? cpu_us / static_cast<double>(count) : 0;
+    }
 };
 
-int connect_to(bool tcp, std::uint16_t port) {
+int connect_to(bool tcp, std::uint16_t port, bool nodelay = true) {
     const int fd = ::socket(AF_INET, tcp ? SOCK_STREAM : SOCK_DGRAM, 0);
     sockaddr_in a{};
     a.sin_family = AF_INET;
@@ -149,7 +224,7 @@ int connect_to(bool tcp, std::uint16_t port) {
         ::close(fd);
         return -1;
     }
-    if (tcp) set_nodelay(fd);
+    if (tcp && nodelay) set_nodelay(fd);
     // A lost datagram must end the case, not hang it.
     timeval tv{1, 0};
     setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
@@ -158,7 +233,8 @@ int connect_to(bool tcp, std::uint16_t port) {
 
 // Keeps `depth` requests outstanding for `seconds`; a request's latency is measured
 // from its send to the arrival of the next response (responses come back in order).
-Stats drive(int fd, bool tcp, const Frames& f, unsigned depth, double seconds) {
+// `split`: each request goes out in two writes, the FINS/TCP header, then the frame.
+Stats drive(int fd, bool tcp, const Frames& f, unsigned depth, double seconds, bool split = false) {
     std::vector<Clock::time_point> sent;
     sent.reserve(1 << 20);
     std::vector<double> latencies;
@@ -170,6 +246,10 @@ Stats drive(int fd, bool tcp, const Frames& f, unsigned depth, double seconds) {
     std::size_t next_reply = 0;
     auto send_one = [&] {
         sent.push_back(Clock::now());
+        if (split)
+            return ::send(fd, f.request.data(), fins::tcp_header_size, MSG_NOSIGNAL) > 0 &&
+                   ::send(fd, f.request.data() + fins::tcp_header_size,
+                          f.request.size() - fins::tcp_header_size, MSG_NOSIGNAL) > 0;
         return ::send(fd, f.request.data(), f.request.size(), MSG_NOSIGNAL) > 0;
     };
     for (unsigned i = 0; i < depth; ++i)
@@ -216,8 +296,13 @@ int main(int argc, char** argv) {
     CLI::App app{"fins_load: finsd request rate vs a raw loopback echo"};
     double seconds = 2.0;
     bool json = false;
+    std::string udp_echo = "batched";
     app.add_option("--seconds", seconds, "Duration of each case")->capture_default_str();
     app.add_flag("--json", json, "Print JSON lines");
+    app.add_option("--udp-echo", udp_echo,
+                   "The UDP echo: batched (recvmmsg/sendmmsg) or per-datagram (recvfrom/sendto)")
+        ->check(CLI::IsMember({"batched", "per-datagram"}))
+        ->capture_default_str();
     CLI11_PARSE(app, argc, argv);
     spdlog::set_level(spdlog::level::warn);
 
@@ -246,35 +331,49 @@ int main(int argc, char** argv) {
             f.request.insert(f.request.begin(), env.begin(), env.end());
             f.response_size += fins::tcp_header_size;
         }
-        for (const unsigned depth : {1u, 32u}) {
-            const int fd = connect_to(tcp, (*server)->tcp_port());
+        // TCP adds the split-write client: header and frame in two writes, no TCP_NODELAY.
+        struct Shape {
+            unsigned depth;
+            bool split;
+        };
+        const auto shapes = tcp ? std::vector<Shape>{{1, false}, {32, false}, {1, true}}
+                                : std::vector<Shape>{{1, false}, {32, false}};
+        for (const auto [depth, split] : shapes) {
+            const int fd = connect_to(tcp, (*server)->tcp_port(), !split);
             if (fd < 0 || (tcp && !tcp_handshake(fd))) {
                 std::fprintf(stderr, "fins_load: cannot reach finsd\n");
                 return 1;
             }
-            const Stats finsd = drive(fd, tcp, f, depth, seconds);
+            const double finsd_cpu_before = cpu_seconds(server_thread);
+            Stats finsd = drive(fd, tcp, f, depth, seconds, split);
+            finsd.cpu_us = (cpu_seconds(server_thread) - finsd_cpu_before) * 1e6;
             ::close(fd);
 
-            EchoServer echo(tcp, f.request.size(), f.response_size);
-            const int efd = connect_to(tcp, echo.port());
-            const Stats raw = drive(efd, tcp, f, depth, seconds);
+            EchoServer echo(tcp, f.request.size(), f.response_size,
+                            {.udp_batched = udp_echo == "batched", .quickack = split});
+            const int efd = connect_to(tcp, echo.port(), !split);
+            const double echo_cpu_before = echo.cpu();
+            Stats raw = drive(efd, tcp, f, depth, seconds, split);
+            raw.cpu_us = (echo.cpu() - echo_cpu_before) * 1e6;
             ::close(efd);
 
             const double ratio = raw.rate > 0 ? finsd.rate / raw.rate : 0;
-            const char* proto = tcp ? "tcp" : "udp";
+            const char* proto = !tcp ? "udp" : split ? "tcp-split" : "tcp";
             if (json) {
                 fmt::print(
                     "{{\"transport\":\"{}\",\"in_flight\":{},\"finsd_rps\":{:.0f},"
                     "\"finsd_p50_us\":{:.1f},\"finsd_p99_us\":{:.1f},\"echo_rps\":{:.0f},"
-                    "\"echo_p50_us\":{:.1f},\"echo_p99_us\":{:.1f},\"ratio\":{:.2f}}}\n",
+                    "\"echo_p50_us\":{:.1f},\"echo_p99_us\":{:.1f},\"ratio\":{:.2f},"
+                    "\"finsd_cpu_us_per_request\":{:.2f},\"echo_cpu_us_per_request\":{:.2f}}}\n",
                     proto, depth, finsd.rate, finsd.p50_us, finsd.p99_us, raw.rate, raw.p50_us,
-                    raw.p99_us, ratio);
+                    raw.p99_us, ratio, finsd.cpu_per_request_us(), raw.cpu_per_request_us());
             } else {
                 fmt::print(
-                    "{} in-flight {:>2}: finsd {:>8.0f} req/s p50 {:>6.1f} us p99 {:>6.1f} us | "
-                    "echo {:>8.0f} req/s p50 {:>6.1f} us p99 {:>6.1f} us | ratio {:.2f}\n",
+                    "{:<9} in-flight {:>2}: finsd {:>8.0f} req/s p50 {:>6.1f} us p99 {:>6.1f} us | "
+                    "echo {:>8.0f} req/s p50 {:>6.1f} us p99 {:>6.1f} us | ratio {:.2f} | "
+                    "cpu/req finsd {:.2f} us echo {:.2f} us\n",
                     proto, depth, finsd.rate, finsd.p50_us, finsd.p99_us, raw.rate, raw.p50_us,
-                    raw.p99_us, ratio);
+                    raw.p99_us, ratio, finsd.cpu_per_request_us(), raw.cpu_per_request_us());
             }
             std::fflush(stdout);
         }

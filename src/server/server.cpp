@@ -13,6 +13,7 @@
 
 #include "server/dispatcher.hpp"
 #include "server/tcp_session.hpp"
+#include "server/udp_session.hpp"
 #include "transport/transport.hpp"
 
 namespace fins::server {
@@ -29,36 +30,12 @@ std::uint8_t derive_node(const std::string& bind_address) noexcept {
 struct Server::Impl {
     Impl(asio::io_context& context, plc::Plc& plc, NodeAddress self, const ServerOptions& options)
         : dispatcher(plc, self),
-          udp_socket(context),
           acceptor(context),
           nodes(self.node, options.max_tcp_connections),
           limits(options.tcp_limits),
           accept_retry_max(options.accept_retry_max),
           accept_log_interval(options.accept_log_interval),
           accept_timer(context) {}
-
-    void receive_udp() {
-        udp_socket.async_receive_from(
-            asio::buffer(udp_in), udp_peer, [this](std::error_code ec, std::size_t n) {
-                if (ec == asio::error::operation_aborted || !udp_socket.is_open()) return;
-                if (!ec) {
-                    const RequestContext context{Link::udp, std::chrono::system_clock::now()};
-                    const std::size_t out =
-                        dispatcher.handle(Bytes{udp_in.data(), n}, udp_out, context);
-                    if (out > 0) {
-                        std::error_code send_ec;
-                        udp_socket.send_to(asio::buffer(udp_out.data(), out), udp_peer, 0, send_ec);
-                        if (send_ec)
-                            spdlog::warn("fins/udp: reply to {} failed: {}",
-                                         udp_peer.address().to_string(), send_ec.message());
-                    }
-                } else {
-                    // e.g. ICMP port unreachable from an earlier reply: keep serving.
-                    spdlog::debug("fins/udp: receive: {}", ec.message());
-                }
-                receive_udp();
-            });
-    }
 
     void accept_tcp() {
         acceptor.async_accept([this](std::error_code ec, asio::ip::tcp::socket socket) {
@@ -143,12 +120,7 @@ struct Server::Impl {
     }
 
     Dispatcher dispatcher;
-    asio::ip::udp::socket udp_socket;
-    asio::ip::udp::endpoint udp_peer;
-    // A datagram one byte longer than the largest frame is still received whole, so the
-    // dispatcher can answer 1001 instead of seeing a silently truncated frame.
-    std::array<std::uint8_t, max_frame_size + 1> udp_in{};
-    std::array<std::uint8_t, max_frame_size> udp_out{};
+    std::shared_ptr<UdpSession> udp;  // null without FINS/UDP
     asio::ip::tcp::acceptor acceptor;
     TcpNodeTable nodes;
     TcpLimits limits;
@@ -185,12 +157,14 @@ Result<std::unique_ptr<Server>> Server::start(asio::io_context& io, plc::Plc& pl
     }
     if (options.udp) {
         const asio::ip::udp::endpoint ep{ip, port};
-        impl->udp_socket.open(ep.protocol(), ec);
-        if (!ec) impl->udp_socket.bind(ep, ec);
+        asio::ip::udp::socket socket{io};
+        socket.open(ep.protocol(), ec);
+        if (!ec) socket.bind(ep, ec);
         if (ec) return Unexpected(ec);
+        impl->udp = std::make_shared<UdpSession>(std::move(socket), impl->dispatcher);
     }
     if (options.tcp) impl->accept_tcp();
-    if (options.udp) impl->receive_udp();
+    if (impl->udp) impl->udp->start();
     return std::unique_ptr<Server>(new Server(std::move(impl)));
 }
 
@@ -201,8 +175,7 @@ Server::~Server() {
 }
 
 std::uint16_t Server::udp_port() const noexcept {
-    std::error_code ec;
-    return impl_->udp_socket.is_open() ? impl_->udp_socket.local_endpoint(ec).port() : 0;
+    return impl_->udp ? impl_->udp->local_port() : 0;
 }
 
 std::uint16_t Server::tcp_port() const noexcept {
@@ -220,7 +193,7 @@ std::size_t Server::tcp_connections() const noexcept {
 
 void Server::stop() {
     std::error_code ignored;
-    impl_->udp_socket.close(ignored);
+    if (impl_->udp) impl_->udp->close();
     impl_->acceptor.close(ignored);
     impl_->accept_timer.cancel();
     for (auto& weak : impl_->sessions)

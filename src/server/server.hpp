@@ -4,7 +4,7 @@
 //
 // UDP: one datagram is one FINS frame; the response goes to the datagram's source
 //      address and port (what CS/CJ Ethernet units do with the dynamic conversion
-//      method, frames section 2).
+//      method, frames section 2). Batched and non-blocking: see udp_session.hpp.
 // TCP: the FINS/TCP envelope (frames section 3): node-address handshake with
 //      auto-assignment, then FRAME SEND packets in both directions. Each response is
 //      sent with one write; TCP_NODELAY keeps request/response traffic off delayed ACKs.

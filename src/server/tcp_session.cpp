@@ -10,6 +10,7 @@
 #include <spdlog/spdlog.h>
 #include <asio/write.hpp>
 
+#include "fins/frame.hpp"
 #include "server/dispatcher.hpp"
 
 namespace fins::server {
@@ -22,6 +23,25 @@ constexpr std::size_t drain_limit = 256 * 1024;
 // DA2 SNA SA1 SA2 SID).
 constexpr std::size_t source_network_offset = 6;
 constexpr std::size_t source_node_offset = 7;
+
+using quick_ack = asio::detail::socket_option::boolean<IPPROTO_TCP, TCP_QUICKACK>;
+
+// Must what the client sent be acknowledged now? When `buffer` ends inside a FINS/TCP
+// packet the client may be holding the rest (Nagle) until it is; when its last packet
+// is a frame that asks for no response, no answer will carry the ACK. Otherwise the
+// answer we are about to send carries it.
+bool needs_prompt_ack(Bytes buffer) noexcept {
+    bool answered = true;
+    while (!buffer.empty()) {
+        const TcpParse parsed = parse_tcp_frame(buffer);
+        if (parsed.status != TcpParse::Status::packet)
+            return parsed.status == TcpParse::Status::need_more;
+        answered = parsed.packet.command != static_cast<std::uint32_t>(TcpCommand::frame) ||
+                   parsed.packet.data.empty() || (parsed.packet.data[0] & icf_no_response) == 0;
+        buffer = buffer.subspan(parsed.consumed);
+    }
+    return !answered;
+}
 
 }  // namespace
 
@@ -90,6 +110,14 @@ void TcpSession::read_more() {
                 return;
             }
             self->in_size_ += n;
+            // A client that writes the FINS/TCP header and the frame separately without
+            // TCP_NODELAY holds the frame until its header is acknowledged. Linux delays
+            // that ACK (~40 ms) once we answer promptly; quick-ack mode does not stick,
+            // so re-arm it after a read that no answer follows (issue 6 item 13).
+            if (needs_prompt_ack({self->in_.data(), self->in_size_})) {
+                std::error_code ignored;
+                self->socket_.set_option(quick_ack(true), ignored);
+            }
             self->process();
         });
 }
