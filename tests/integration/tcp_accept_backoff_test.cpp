@@ -13,7 +13,7 @@ namespace {
 
 using namespace std::chrono_literals;
 
-// Lines of finsd's log (stdout) until one contains `text`, at most `timeout`.
+// Lines of finsd's output (its log is on stderr, sent to stdout here) until one contains `text`, at most `timeout`.
 bool wait_for_log(Child& child, const std::string& text, std::vector<std::string>& seen,
                   std::chrono::seconds timeout) {
     const auto deadline = std::chrono::steady_clock::now() + timeout;
@@ -34,7 +34,7 @@ TEST(TcpAccept, OutOfDescriptorsBacksOffLogsOncePerIntervalAndRecovers) {
     // vptr" once no descriptor is left: a sanitizer artifact, not a finsd fault.
     Child child({"/bin/sh", "-c",
                  "ulimit -n 24 && exec " + finsd_path +
-                     " --port 0 --log-level info --max-connections 64 --tcp-max-pending 64"});
+                     " --port 0 --log-level info --max-connections 64 --tcp-max-pending 64 2>&1"});
     std::vector<std::string> log;
     ASSERT_TRUE(wait_for_log(child, "listening ", log, 20s));
     const std::string listening = log.back();
