@@ -1,5 +1,8 @@
 #include "transport/tcp_transport.hpp"
 
+#include <sys/socket.h>
+
+#include <cerrno>
 #include <cstring>
 #include <string>
 #include <utility>
@@ -77,6 +80,7 @@ void TcpTransport::read_handshake() {
             if (life.expired() || gen != generation_) return;
             // The server closes right after an error answer; EOF before it is a failure.
             if (ec) return finish_open(Unexpected(make_error_code(ClientError::handshake_failed)));
+            ++reads_;
             rx_size_ += n;
             auto parsed = parse_tcp_frame(Bytes{rx_.data(), rx_size_});
             if (parsed.status == TcpParse::Status::need_more) return read_handshake();
@@ -123,6 +127,7 @@ void TcpTransport::read_frames() {
                                 if (life.expired() || gen != generation_) return;
                                 if (ec)
                                     return fail(make_error_code(ClientError::connection_closed));
+                                ++reads_;
                                 rx_size_ += n;
                                 if (process_frames()) read_frames();
                             });
@@ -156,6 +161,15 @@ bool TcpTransport::process_frames() {
         consume(parsed.consumed);
     }
     return true;
+}
+
+bool TcpTransport::peer_gone() {
+    if (state_ != State::open) return false;
+    std::uint8_t byte = 0;
+    const auto r = ::recv(socket_.native_handle(), &byte, 1, MSG_PEEK | MSG_DONTWAIT);
+    if (r == 0) return true;  // end of stream
+    if (r > 0) return false;  // data waits: the reader handles it (and a close after it)
+    return errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR;
 }
 
 void TcpTransport::consume(std::size_t n) noexcept {

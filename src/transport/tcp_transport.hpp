@@ -13,7 +13,8 @@
 // (connection confirmation) is ignored as frames 3.4 says; command 3 closes the
 // transport with its TcpError; an envelope error, or command 0/1/unknown, is answered
 // with command 3 (frames 3.4 items 4-5) and closes with that TcpError. The peer
-// closing or resetting closes with ClientError::connection_closed.
+// closing or resetting closes with ClientError::connection_closed. peer_gone() peeks
+// (MSG_PEEK, non-blocking) for an end of stream or reset that nobody has read yet.
 #pragma once
 
 #include <array>
@@ -40,6 +41,10 @@ class TcpTransport final : public Transport {
     void close() override;
     [[nodiscard]] State state() const noexcept override { return state_; }
     [[nodiscard]] bool write_pending() const noexcept override { return !queue_.empty(); }
+    [[nodiscard]] bool peer_gone() override;
+    // Reads that returned bytes since construction (handshake included); lets tests see
+    // how the bytes of a packet actually arrived.
+    [[nodiscard]] std::uint64_t reads() const noexcept { return reads_; }
 
   private:
     void on_connected();
@@ -69,6 +74,7 @@ class TcpTransport final : public Transport {
     // Room for two maximal packets: whatever is left after parsing fits with room to read.
     std::array<std::uint8_t, 2 * tcp_max_packet> rx_{};
     std::size_t rx_size_ = 0;
+    std::uint64_t reads_ = 0;
 };
 
 }  // namespace fins::transport
