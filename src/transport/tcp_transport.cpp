@@ -136,10 +136,13 @@ void TcpTransport::read_frames() {
 bool TcpTransport::process_frames() {
     std::weak_ptr<int> life = life_;
     auto gen = generation_;
+    // Walks the packets with an offset and moves the leftover to the front once, at the
+    // end (moving it after every packet costs a copy of the buffer per answer).
+    std::size_t pos = 0;
     // Each pass consumes at least one whole packet or stops, so this ends.
-    while (rx_size_ > 0) {
-        auto parsed = parse_tcp_frame(Bytes{rx_.data(), rx_size_});
-        if (parsed.status == TcpParse::Status::need_more) return true;
+    while (pos < rx_size_) {
+        auto parsed = parse_tcp_frame(Bytes{rx_.data() + pos, rx_size_ - pos});
+        if (parsed.status == TcpParse::Status::need_more) break;
         if (parsed.status == TcpParse::Status::error) {
             send_error_and_fail(parsed.error);
             return false;
@@ -158,8 +161,9 @@ bool TcpTransport::process_frames() {
                 send_error_and_fail(TcpError::command_not_supported);
                 return false;
         }
-        consume(parsed.consumed);
+        pos += parsed.consumed;
     }
+    consume(pos);
     return true;
 }
 
