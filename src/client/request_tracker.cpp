@@ -86,8 +86,11 @@ void RequestTracker::pump(SteadyTime now) {
 Result<std::uint8_t> RequestTracker::submit_no_response(CommandCode command, Bytes parameters) {
     if (!link_up_) return Unexpected(make_error_code(ClientError::not_connected));
     // Nothing answers such a frame, so its SID needs no reservation; a counter of its own
-    // keeps consecutive frames distinguishable in a capture.
-    const auto id = next_unanswered_sid_++;
+    // keeps consecutive frames distinguishable in a capture. It avoids SIDs in flight, so
+    // that even a unit that answers anyway cannot complete another request.
+    auto id = next_unanswered_sid_++;
+    for (std::size_t i = 0; i < by_sid_.size() && by_sid_[id] != none; ++i)
+        id = next_unanswered_sid_++;
     std::array<std::uint8_t, max_frame_size> frame{};
     auto size = encode_request(make_header(id, false), command, parameters, frame);
     if (!size) return Unexpected(size.error());
