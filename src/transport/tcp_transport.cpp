@@ -139,6 +139,7 @@ bool TcpTransport::process_frames() {
     // Walks the packets with an offset and moves the leftover to the front once, at the
     // end (moving it after every packet costs a copy of the buffer per answer).
     std::size_t pos = 0;
+    corked_ = true;
     // Each pass consumes at least one whole packet or stops, so this ends.
     while (pos < rx_size_) {
         auto parsed = parse_tcp_frame(Bytes{rx_.data() + pos, rx_size_ - pos});
@@ -164,7 +165,15 @@ bool TcpTransport::process_frames() {
         pos += parsed.consumed;
     }
     consume(pos);
-    return true;
+    uncork();
+    return life.expired() ? false : gen == generation_;
+}
+
+void TcpTransport::uncork() {
+    corked_ = false;
+    if (cork_.empty()) return;
+    write_raw(Bytes{cork_.data(), cork_.size()}, {});
+    cork_.clear();
 }
 
 bool TcpTransport::peer_gone() {
@@ -200,6 +209,11 @@ void TcpTransport::send(Bytes frame) {
     std::array<std::uint8_t, tcp_header_size> header{};
     ByteWriter w(header);
     write_tcp_header(w, TcpCommand::frame, frame.size());
+    if (corked_) {
+        cork_.insert(cork_.end(), header.begin(), header.begin() + static_cast<std::ptrdiff_t>(w.size()));
+        cork_.insert(cork_.end(), frame.begin(), frame.end());
+        return;
+    }
     write_raw(Bytes{header.data(), w.size()}, frame);
 }
 
@@ -254,6 +268,8 @@ void TcpTransport::close() {
     writing_ = false;
     front_written_ = 0;
     rx_size_ = 0;
+    corked_ = false;
+    cork_.clear();
     open_done_ = nullptr;
     state_ = State::closed;
 }

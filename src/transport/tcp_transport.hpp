@@ -15,11 +15,14 @@
 // with command 3 (frames 3.4 items 4-5) and closes with that TcpError. The peer
 // closing or resetting closes with ClientError::connection_closed. peer_gone() peeks
 // (MSG_PEEK, non-blocking) for an end of stream or reset that nobody has read yet.
+// Frames sent from inside the frame handler (completion callbacks that send the next
+// request) are gathered and written together once the read's packets are handled.
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include <asio/io_context.hpp>
 #include <asio/ip/tcp.hpp>
@@ -58,6 +61,7 @@ class TcpTransport final : public Transport {
     void write_next();
     void fail(std::error_code reason);
     void consume(std::size_t n) noexcept;
+    void uncork();
 
     TransportOptions options_;
     asio::ip::tcp::resolver resolver_;
@@ -75,6 +79,10 @@ class TcpTransport final : public Transport {
     std::array<std::uint8_t, 2 * tcp_max_packet> rx_{};
     std::size_t rx_size_ = 0;
     std::uint64_t reads_ = 0;
+    // While the answers of one read are handed out, the requests their callbacks send
+    // are gathered here and leave in one write when the read is done.
+    bool corked_ = false;
+    std::vector<std::uint8_t> cork_;
 };
 
 }  // namespace fins::transport
