@@ -1,5 +1,6 @@
 // RequestTracker with a fake wire and a fake clock: no sockets, no sleeps.
 #include "client/request_tracker.hpp"
+#include "client/tracker_fixture.hpp"
 
 #include <gtest/gtest.h>
 
@@ -14,58 +15,7 @@ using namespace std::chrono_literals;
 
 namespace {
 
-struct FakeWire : FrameSink {
-    std::vector<std::vector<std::uint8_t>> frames;
-    void send_frame(Bytes frame) override { frames.emplace_back(frame.begin(), frame.end()); }
-};
-
-constexpr NodeAddress plc{0, 10, 0};
-constexpr NodeAddress host{0, 20, 0};
-constexpr CommandCode read_code{0x01, 0x01};
-constexpr CommandCode write_code{0x01, 0x02};
-const SteadyTime t0 = SteadyTime{} + 1h;
-// D10, 10 words (W342 5-3-2 example parameters).
-constexpr std::array<std::uint8_t, 6> read_params{0x82, 0x00, 0x0A, 0x00, 0x00, 0x0A};
-
-std::vector<std::uint8_t> answer(Bytes request, std::uint16_t end_code = 0,
-                                 std::vector<std::uint8_t> data = {}, NodeAddress responder = plc) {
-    auto req = decode_request(request);
-    EXPECT_TRUE(req.has_value());
-    std::vector<std::uint8_t> out(max_frame_size);
-    ByteWriter w(out);
-    write_response_prefix(w, response_header(req->header, responder), req->command, end_code);
-    w.bytes(data);
-    out.resize(w.size());
-    return out;
-}
-
-// Collects one completion.
-struct Outcome {
-    std::optional<Result<ResponseView>> result;
-    std::vector<std::uint8_t> data;
-    RequestTracker::Completion callback() {
-        return [this](Result<ResponseView> r) {
-            if (r) data.assign(r->data.begin(), r->data.end());
-            result = r;
-        };
-    }
-};
-
-class TrackerTest : public ::testing::Test {
-  protected:
-    TrackerTest() { tracker.link_up(plc, host, t0); }
-
-    // The SID of the frame sent for it (the last frame on the wire).
-    std::uint8_t submit(Outcome& o, RequestTiming timing = {}, SteadyTime at = t0,
-                        CommandCode code = read_code) {
-        auto ok = tracker.submit(code, read_params, timing, o.callback(), at);
-        EXPECT_TRUE(ok.has_value());
-        return wire.frames.empty() ? 0 : wire.frames.back()[9];
-    }
-
-    FakeWire wire;
-    RequestTracker tracker{wire};
-};
+using namespace fins::test;
 
 TEST_F(TrackerTest, BuildsTheRequestFrameAndMatchesTheResponse) {
     Outcome o;
@@ -162,77 +112,6 @@ TEST_F(TrackerTest, CleanServiceIdsAreReusedLeastRecentlyUsedFirst) {
     EXPECT_EQ(submit(wrap1, {}, step()), 0) << "freed first, used first";
     EXPECT_EQ(submit(wrap2, {}, step()), 3);
     EXPECT_EQ(tracker.stats().quarantined, 0u) << "every SID was clean";
-}
-
-// Issue 7 item 1: a SID whose request timed out may still get that request's answer; it
-// is not handed out again until its quarantine ends, even with 256 requests waiting.
-TEST_F(TrackerTest, TimedOutServiceIdIsQuarantinedAndRequestsWaitRatherThanReuseIt) {
-    tracker.set_quarantine(200ms);
-    std::vector<Outcome> first(256);
-    for (auto& o : first)
-        submit(o, RequestTiming{100ms, 0}, t0);
-    std::vector<std::vector<std::uint8_t>> sent = wire.frames;
-    for (std::size_t i = 0; i < sent.size(); ++i)
-        if (sent[i][9] != 5) tracker.on_frame(answer(sent[i]), t0 + 1ms);
-    tracker.on_timer(t0 + 100ms);
-    ASSERT_TRUE(first[5].result && !*first[5].result);
-    EXPECT_TRUE(tracker.service_ids().is_quarantined(5));
-
-    std::vector<Outcome> second(256);
-    for (std::size_t i = 0; i < 255; ++i)
-        EXPECT_NE(submit(second[i], RequestTiming{1s, 0}, t0 + 110ms), 5);
-    const auto frames_before = wire.frames.size();
-    ASSERT_TRUE(tracker.submit(read_code, read_params, RequestTiming{1s, 0},
-                               second[255].callback(), t0 + 110ms));
-    EXPECT_EQ(wire.frames.size(), frames_before) << "waits: the only free SID is quarantined";
-    EXPECT_EQ(tracker.stats().waited_for_id, 1u);
-    EXPECT_EQ(tracker.next_deadline(), t0 + 300ms) << "the end of SID 5's quarantine";
-    // The late answer to the timed-out request arrives meanwhile: stale, not a match.
-    EXPECT_EQ(tracker.on_frame(answer(sent[5]), t0 + 150ms), RequestTracker::Disposition::stale);
-    tracker.on_timer(t0 + 300ms);
-    ASSERT_EQ(wire.frames.size(), frames_before + 1);
-    EXPECT_EQ(wire.frames.back()[9], 5);
-    EXPECT_FALSE(second[255].result) << "its clock started when it was sent";
-    EXPECT_EQ(tracker.next_deadline(), t0 + 1110ms);
-}
-
-TEST_F(TrackerTest, RetransmittedServiceIdIsQuarantinedEvenWhenAnswered) {
-    tracker.set_quarantine(200ms);
-    Outcome o;
-    const auto sid = submit(o, RequestTiming{100ms, 1});
-    tracker.on_timer(t0 + 100ms);
-    ASSERT_EQ(wire.frames.size(), 2u);
-    EXPECT_EQ(tracker.on_frame(answer(wire.frames[1]), t0 + 110ms),
-              RequestTracker::Disposition::matched);
-    EXPECT_TRUE(tracker.service_ids().is_quarantined(sid)) << "the first attempt may answer too";
-    EXPECT_EQ(tracker.stats().quarantined, 1u);
-    EXPECT_EQ(tracker.on_frame(answer(wire.frames[0]), t0 + 150ms),
-              RequestTracker::Disposition::stale);
-    EXPECT_EQ(tracker.stats().quarantined, 1u) << "an awaited late answer is no new evidence";
-}
-
-// A duplicate of an answer that was already consumed shows that the network duplicates:
-// SIDs released cleanly just before may get a duplicate too, so they rest as well.
-TEST_F(TrackerTest, DuplicateAnswerQuarantinesRecentlyReleasedIds) {
-    tracker.set_quarantine(200ms);
-    Outcome a, b;
-    const auto sid_a = submit(a, {}, t0);
-    const auto sid_b = submit(b, {}, t0);
-    const auto answer_a = answer(wire.frames[0]);
-    tracker.on_frame(answer_a, t0 + 1ms);
-    tracker.on_frame(answer(wire.frames[1]), t0 + 2ms);
-    EXPECT_FALSE(tracker.service_ids().is_quarantined(sid_a));
-    EXPECT_FALSE(tracker.service_ids().is_quarantined(sid_b));
-    EXPECT_EQ(tracker.on_frame(answer_a, t0 + 3ms), RequestTracker::Disposition::stale);
-    EXPECT_TRUE(tracker.service_ids().is_quarantined(sid_a));
-    EXPECT_TRUE(tracker.service_ids().is_quarantined(sid_b));
-    Outcome c;
-    submit(c, {}, t0 + 4ms);
-    EXPECT_TRUE(tracker.service_ids().is_quarantined(sid_a) &&
-                tracker.service_ids().is_quarantined(sid_b));
-    tracker.on_frame(answer(wire.frames.back()), t0 + 5ms);
-    EXPECT_TRUE(tracker.service_ids().is_quarantined(wire.frames.back()[9]))
-        << "while the network is troubled, clean SIDs rest too";
 }
 
 TEST_F(TrackerTest, ResponseForAServiceIdNotInFlightIsStale) {
