@@ -22,6 +22,7 @@
 #include <cstdio>
 #include <cstring>
 #include <ctime>
+#include <functional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -292,6 +293,10 @@ bool tcp_handshake(int fd) {
 
 }  // namespace
 
+// bench/load_client.cpp: --client mode.
+int run_client_mode(std::uint16_t port, double seconds, bool json,
+                    const std::function<double(bool tcp, unsigned depth)>& raw_rate);
+
 int main(int argc, char** argv) {
     CLI::App app{"fins_load: finsd request rate vs a raw loopback echo"};
     double seconds = 2.0;
@@ -303,6 +308,9 @@ int main(int argc, char** argv) {
                    "The UDP echo: batched (recvmmsg/sendmmsg) or per-datagram (recvfrom/sendto)")
         ->check(CLI::IsMember({"batched", "per-datagram"}))
         ->capture_default_str();
+    bool client_mode = false;
+    app.add_flag("--client", client_mode,
+                 "Drive finsd through fins::Client (32 in flight) next to the raw generator");
     CLI11_PARSE(app, argc, argv);
     spdlog::set_level(spdlog::level::warn);
 
@@ -320,6 +328,28 @@ int main(int argc, char** argv) {
 
     const auto frame = read_frame(1);
     const std::size_t fins_response = fins::header_size + 2 + 2 + 2;  // header, cmd, end, 1 word
+    if (client_mode) {
+        const int rc = run_client_mode(
+            (*server)->tcp_port(), seconds, json, [&](bool tcp, unsigned depth) {
+                Frames f{frame, fins_response};
+                if (tcp) {
+                    std::array<std::uint8_t, 16> env{};
+                    fins::ByteWriter w{env};
+                    fins::write_tcp_header(w, fins::TcpCommand::frame, frame.size());
+                    f.request.insert(f.request.begin(), env.begin(), env.end());
+                    f.response_size += fins::tcp_header_size;
+                }
+                const int fd = connect_to(tcp, (*server)->tcp_port());
+                if (fd < 0 || (tcp && !tcp_handshake(fd))) return 0.0;
+                const double rate = drive(fd, tcp, f, depth, seconds).rate;
+                ::close(fd);
+                return rate;
+            });
+        (*server)->stop();
+        io.stop();
+        server_thread.join();
+        return rc;
+    }
     for (const bool tcp : {false, true}) {
         Frames f;
         f.request = frame;

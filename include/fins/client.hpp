@@ -7,25 +7,41 @@
 // Threading: a Client owns one asio::io_context and runs it only inside its own calls
 // (send*, run, the helpers, connect). It is NOT thread-safe: use it from one thread.
 // Completion callbacks of async_send*() run on that thread, inside send*()/run()/a
-// helper; a callback may call async_send*() again, but must not call the synchronous
-// methods (send, send_raw, send_no_response, run, the helpers: they run the io_context,
-// which asio forbids from inside one of its handlers) and must not destroy the Client.
+// helper; a callback may call async_send*() again, but must not destroy the Client. A
+// synchronous call (send, send_raw, send_no_response, the helpers) made inside a callback
+// fails at once with ClientError::called_from_callback, and run() returns at once there.
 //
-// Requests: up to 256 in flight (service IDs allocated round-robin); one more fails
-// with ClientError::too_many_in_flight rather than waiting in a queue. Each
-// attempt waits `timeout`; after `retries` retransmissions the request fails with
-// ClientError::timeout. A response is matched by SID, command code and addresses;
-// stale or duplicate answers are dropped and counted in stats().
+// Requests: up to 256 accepted at once; one more fails with
+// ClientError::too_many_in_flight. Each attempt waits `timeout`; after `retries`
+// retransmissions the request fails with ClientError::timeout. A response is matched by
+// service ID (SID), command code and addresses; stale or duplicate answers are dropped
+// and counted in stats().
+//
+// No late answer completes the wrong request: a read answer carries no address, only
+// the SID. A SID whose request was retransmitted, timed out or failed after it was sent
+// is quarantined for `sid_quarantine` (default twice the timeout) before it is used
+// again; other SIDs are reused least recently used first; once the network has shown
+// that it duplicates answers (an answer to a SID that had all its answers), every SID
+// released within `sid_quarantine` of that is quarantined too. When no SID is usable a
+// request waits in a queue (its timeout runs) instead of reusing one early. This holds
+// as long as no datagram outlives `sid_quarantine` in the network (client/sid_pool.hpp).
 //
 // Errors (all std::error_code): EndCode for a non-zero end code in send<C>() and the
 // helpers (end-code flag bits 0x0040/0x0080 alone still count as success; send_raw()
 // returns every end code to the caller instead), ClientError for local failures, TcpError
-// for FINS/TCP envelope and handshake errors, and system errors from resolve/connect.
+// for FINS/TCP envelope and handshake errors, and system errors from resolve/connect and
+// from the network (UDP: ICMP port unreachable fails the requests waiting at that moment
+// with asio::error::connection_refused, "nothing listening"; host or network unreachable
+// only costs the attempt, which times out and is retried). An error_code cannot carry the
+// endpoint: describe_error() / Client::describe() put it in front of the message
+// ("127.0.0.1:9600: connection refused").
 //
 // Connection loss: every request in flight fails with ClientError::connection_closed
 // (TcpError after a command-3 notification). Nothing is re-sent automatically, since the
 // PLC may have executed it. The next request reconnects (TCP: with a fresh handshake,
-// which may allocate a different client node) and is sent once the link is up.
+// which may allocate a different client node) and is sent once the link is up. A peer
+// that closed while the client was idle (finsd restarted) is noticed before the next
+// request is sent, so that request goes out on the new connection.
 //
 // Address defaults (node 0 in ClientOptions means "derive"):
 //   destination: TCP -> the server node from the handshake; UDP -> the last octet of
@@ -66,7 +82,15 @@ struct ClientOptions {
     std::chrono::milliseconds timeout{2000};
     unsigned retries = 0;  // W596 p. 3-16 Option.Retry: 0-15
     std::uint8_t gateway_count = default_gateway_count;
+    // How long a suspect SID rests before reuse: the longest a late answer may take to
+    // arrive after its request was given up. 0: twice `timeout`.
+    std::chrono::milliseconds sid_quarantine{0};
 };
+
+// "host:port" of the options ("[::1]:9600" for an IPv6 literal).
+std::string endpoint_name(const ClientOptions& options);
+// "<endpoint>: <message>", e.g. "127.0.0.1:9600: connection refused".
+std::string describe_error(const ClientOptions& options, std::error_code ec);
 
 // A response exactly as received (W596 SendCmd p. 3-16 RespDat): the end code is not
 // interpreted.
@@ -87,6 +111,8 @@ struct ClientStats {
     std::uint64_t stale_discarded = 0;    // answers to no request in flight / wrong command
     std::uint64_t invalid_discarded = 0;  // undecodable frames, wrong addresses
     std::uint64_t reconnects = 0;         // successful opens after the first
+    std::uint64_t quarantined = 0;        // SIDs put into quarantine (see above)
+    std::uint64_t waited_for_id = 0;      // requests that waited for a usable SID
 };
 
 class Client {
@@ -118,7 +144,7 @@ class Client {
     // to the kernel (or after `timeout` if it could not be). Reconnects first if needed.
     Result<void> send_no_response(CommandCode code, Bytes parameters);
 
-    // Runs until no request is in flight.
+    // Runs until no request is in flight (returns at once inside a completion callback).
     void run();
 
     // ---- I/O memory helpers (01 01 .. 01 05, W342 5-3-2 .. 5-3-6) ----
@@ -168,6 +194,8 @@ class Client {
     // The addresses put in request headers (after derivation).
     [[nodiscard]] NodeAddress destination() const noexcept;
     [[nodiscard]] NodeAddress source() const noexcept;
+    // describe_error(options(), ec).
+    [[nodiscard]] std::string describe(std::error_code ec) const;
     // Closes the connection; requests in flight fail with ClientError::canceled. The next
     // request reconnects.
     void close();
@@ -185,6 +213,8 @@ class Client {
     Result<void> submit_no_response(CommandCode code, Bytes parameters);
     // Runs the io_context until `done()` is true; every request ends by its deadline.
     void run_until(const std::function<bool()>& done);
+    // True inside a completion callback (the io_context is running).
+    [[nodiscard]] bool in_callback() const noexcept;
 
     std::unique_ptr<Impl> impl_;
 };
@@ -208,6 +238,7 @@ void Client::async_send(const C& command, std::function<void(Result<typename C::
 
 template <class C>
 Result<typename C::Response> Client::send(const C& command) {
+    if (in_callback()) return Unexpected(make_error_code(ClientError::called_from_callback));
     std::optional<Result<typename C::Response>> out;
     async_send(command, [&out](Result<typename C::Response> r) { out.emplace(std::move(r)); });
     run_until([&out] { return out.has_value(); });
@@ -217,6 +248,7 @@ Result<typename C::Response> Client::send(const C& command) {
 
 template <class C>
 Result<void> Client::send_no_response(const C& command) {
+    if (in_callback()) return Unexpected(make_error_code(ClientError::called_from_callback));
     std::array<std::uint8_t, max_parameter_size> buffer{};
     ByteWriter w(buffer);
     command.encode(w);

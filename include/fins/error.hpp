@@ -91,6 +91,7 @@ enum class ClientError : int {
     canceled,             // client destroyed or request canceled
     handshake_failed,     // FINS/TCP node-address exchange did not complete
     invalid_argument,     // caller passed a value the command cannot carry
+    called_from_callback,  // a synchronous Client call made inside a completion callback
 };
 const std::error_category& client_category() noexcept;
 std::error_code make_error_code(ClientError e) noexcept;

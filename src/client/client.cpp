@@ -1,129 +1,16 @@
-// fins::Client core: the io_context, the transport, the request tracker and the one
-// timer that follows the tracker's next deadline. See include/fins/client.hpp.
+// fins::Client core: opening, submitting, running the io_context. See
+// include/fins/client.hpp and client/client_impl.hpp.
 #include "fins/client.hpp"
 
 #include <memory>
+#include <string>
 #include <utility>
 
-#include <asio/io_context.hpp>
 #include <asio/post.hpp>
-#include <asio/steady_timer.hpp>
 
-#include "client/request_tracker.hpp"
-#include "transport/tcp_transport.hpp"
-#include "transport/udp_transport.hpp"
+#include "client/client_impl.hpp"
 
 namespace fins {
-
-namespace {
-
-SteadyTime now() {
-    return std::chrono::steady_clock::now();
-}
-
-// UDP on loopback derives node 1 for both ends; a source equal to the destination would
-// look like the PLC talking to itself (W421 7-4 refuses it on TCP with error 0x24).
-constexpr std::uint8_t fallback_source_node = 254;
-
-}  // namespace
-
-struct Client::Impl final : FrameSink {
-    explicit Impl(ClientOptions o)
-        : options(std::move(o)), tracker(*this, options.gateway_count), timer(io) {
-        transport::TransportOptions t;
-        t.host = options.host;
-        t.port = options.port;
-        t.open_timeout = options.timeout;
-        t.requested_node = options.source.node;
-        if (options.protocol == ClientOptions::Protocol::tcp)
-            transport = std::make_unique<transport::TcpTransport>(io, std::move(t));
-        else
-            transport = std::make_unique<transport::UdpTransport>(io, std::move(t));
-        transport->set_frame_handler([this](Bytes frame) {
-            tracker.on_frame(frame, now());
-            rearm();
-        });
-        transport->set_close_handler([this](std::error_code reason) {
-            tracker.link_down(reason);
-            rearm();
-        });
-    }
-
-    void send_frame(Bytes frame) override { transport->send(frame); }
-
-    // Starts opening unless already open or opening; `notify` hears how this open ends.
-    void ensure_open(std::function<void(std::error_code)> notify = nullptr) {
-        if (transport->state() != transport::Transport::State::closed) return;
-        transport->async_open([this, notify = std::move(notify)](Result<transport::LinkInfo> r) {
-            if (!r) {
-                last_open_error = r.error();
-                tracker.link_down(r.error());
-            } else {
-                last_open_error.clear();
-                ++opens;
-                tracker.link_up(derive_destination(*r), derive_source(*r), now());
-            }
-            rearm();
-            if (notify) notify(r ? std::error_code{} : r.error());
-        });
-    }
-
-    NodeAddress derive_destination(const transport::LinkInfo& info) const {
-        NodeAddress d = options.destination;
-        if (d.node == 0) d.node = info.remote_node;
-        return d;
-    }
-
-    NodeAddress derive_source(const transport::LinkInfo& info) const {
-        NodeAddress s = options.source;
-        if (options.protocol == ClientOptions::Protocol::tcp) {
-            // The server's answer is authoritative (it may have allocated the node).
-            s.node = info.local_node;
-            return s;
-        }
-        if (s.node == 0) {
-            s.node = info.local_node;
-            auto d = derive_destination(info);
-            if (s.node == d.node)
-                s.node = d.node == fallback_source_node ? fallback_source_node - 1
-                                                        : fallback_source_node;
-        }
-        return s;
-    }
-
-    void rearm() {
-        auto next = tracker.next_deadline();
-        if (next == armed) return;
-        armed = next;
-        auto gen = ++timer_generation;
-        if (!next) {
-            timer.cancel();
-            return;
-        }
-        timer.expires_at(*next);
-        timer.async_wait([this, gen](std::error_code ec) {
-            if (ec || gen != timer_generation) return;
-            armed.reset();
-            tracker.on_timer(now());
-            rearm();
-        });
-    }
-
-    [[nodiscard]] RequestTiming timing() const { return {options.timeout, options.retries}; }
-
-    // Declaration order is destruction order in reverse: the io_context goes last, so
-    // no handler that refers to the members below can run after they are gone.
-    asio::io_context io;
-    ClientOptions options;
-    std::unique_ptr<transport::Transport> transport;
-    RequestTracker tracker;
-    asio::steady_timer timer;
-    std::optional<SteadyTime> armed;
-    std::uint64_t timer_generation = 0;
-    std::uint64_t opens = 0;
-    std::size_t posted = 0;  // failures posted by fail_later() and not yet delivered
-    std::error_code last_open_error;
-};
 
 Client::Client(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
@@ -146,11 +33,20 @@ Result<std::unique_ptr<Client>> Client::connect(ClientOptions options) {
 
 void Client::submit(CommandCode code, Bytes parameters, ViewCompletion done) {
     auto& i = *impl_;
+    i.check_idle_link();
+    const auto t = now();
     // The tracker takes `done` only on success; on failure it is untouched and still ours.
-    auto id = i.tracker.submit(code, parameters, i.timing(), std::move(done), now());
-    if (!id) return fail_later(std::move(done), id.error());
+    auto ok = i.tracker.submit(code, parameters, i.timing(), std::move(done), t);
+    if (!ok) return fail_later(std::move(done), ok.error());
     if (!i.tracker.is_link_up()) i.ensure_open();
-    i.rearm();
+    if (i.tracker.waiting() > 0)
+        i.rearm();  // a quarantine may end before the deadline
+    else
+        i.arm_by(t + i.options.timeout);
+}
+
+bool Client::in_callback() const noexcept {
+    return impl_->running > 0;
 }
 
 void Client::fail_later(ViewCompletion done, std::error_code ec) {
@@ -164,6 +60,8 @@ void Client::fail_later(ViewCompletion done, std::error_code ec) {
 
 Result<void> Client::submit_no_response(CommandCode code, Bytes parameters) {
     auto& i = *impl_;
+    if (in_callback()) return Unexpected(make_error_code(ClientError::called_from_callback));
+    i.check_idle_link();
     if (!i.tracker.is_link_up()) {
         i.ensure_open();
         run_until([&i] {
@@ -195,28 +93,44 @@ void Client::run_until(const std::function<bool()>& done) {
     // Every request ends by its deadline, and the open and flush waits have timers, so
     // run_one() always has something to wait for; the idle guard only ensures that a
     // broken invariant ends the wait instead of hanging.
+    // `running` tells the synchronous calls that they are inside a handler.
+    struct Running {
+        int& depth;
+        explicit Running(int& d) : depth(d) { ++depth; }
+        ~Running() { --depth; }
+        Running(const Running&) = delete;
+        Running& operator=(const Running&) = delete;
+    };
     int idle = 0;
     while (!done()) {
         if (io.stopped()) io.restart();
-        if (io.run_one() > 0) {
+        std::size_t ran = 0;
+        {
+            Running r(impl_->running);
+            ran = io.run_one();
+        }
+        if (ran > 0) {
             idle = 0;
             continue;
         }
         io.restart();
-        if (++idle == 2) impl_->tracker.cancel_all(make_error_code(ClientError::canceled));
+        if (++idle == 2) impl_->tracker.cancel_all(make_error_code(ClientError::canceled), now());
         if (idle > 2) return;
     }
     // Also run whatever is ready right now (e.g. completions queued behind ours).
     if (io.stopped()) io.restart();
+    Running r(impl_->running);
     io.poll();
 }
 
 void Client::run() {
     auto& i = *impl_;
+    if (in_callback()) return;  // documented: a no-op inside a completion callback
     run_until([&i] { return i.tracker.in_flight() == 0 && i.posted == 0; });
 }
 
 Result<RawResponse> Client::send_raw(CommandCode code, Bytes parameters) {
+    if (in_callback()) return Unexpected(make_error_code(ClientError::called_from_callback));
     std::optional<Result<RawResponse>> out;
     async_send_raw(code, parameters, [&out](Result<RawResponse> r) { out.emplace(std::move(r)); });
     run_until([&out] { return out.has_value(); });
@@ -249,7 +163,29 @@ ClientStats Client::stats() const noexcept {
     out.stale_discarded = s.stale_discarded;
     out.invalid_discarded = s.invalid_discarded;
     out.reconnects = impl_->opens > 0 ? impl_->opens - 1 : 0;
+    out.quarantined = s.quarantined;
+    out.waited_for_id = s.waited_for_id;
     return out;
+}
+
+std::string endpoint_name(const ClientOptions& options) {
+    const bool v6_literal = options.host.find(':') != std::string::npos;
+    return (v6_literal ? "[" + options.host + "]" : options.host) + ":" +
+           std::to_string(options.port);
+}
+
+std::string describe_error(const ClientOptions& options, std::error_code ec) {
+    auto message = ec.message();
+    // strerror() capitalises ("Connection refused"); the library's own texts do not, and
+    // an acronym ("FINS/TCP ...") is left alone.
+    if (message.size() > 1 && message[0] >= 'A' && message[0] <= 'Z' &&
+        message[1] >= 'a' && message[1] <= 'z')
+        message[0] = static_cast<char>(message[0] - 'A' + 'a');
+    return endpoint_name(options) + ": " + message;
+}
+
+std::string Client::describe(std::error_code ec) const {
+    return describe_error(impl_->options, ec);
 }
 
 std::size_t Client::in_flight() const noexcept {

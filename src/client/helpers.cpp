@@ -58,6 +58,7 @@ bool steps_by_bit(const MemoryAddress& a) {
 }  // namespace
 
 Result<std::vector<std::uint16_t>> Client::read_words(const Address& start, std::size_t count) {
+    if (in_callback()) return Unexpected(make_error_code(ClientError::called_from_callback));
     auto mem = to_memory_address(start, Access::word);
     if (!mem) return Unexpected(mem.error());
     if (element_size(mem->area_code) != 2 || !fits(*mem, count, false))
@@ -83,6 +84,7 @@ Result<std::vector<std::uint16_t>> Client::read_words(const Address& start, std:
 }
 
 Result<void> Client::write_words(const Address& start, std::span<const std::uint16_t> words) {
+    if (in_callback()) return Unexpected(make_error_code(ClientError::called_from_callback));
     auto mem = to_memory_address(start, Access::word);
     if (!mem) return Unexpected(mem.error());
     if (element_size(mem->area_code) != 2 || !fits(*mem, words.size(), false))
@@ -105,6 +107,7 @@ Result<void> Client::write_words(const Address& start, std::span<const std::uint
 }
 
 Result<std::vector<bool>> Client::read_bits(const Address& start, std::size_t count) {
+    if (in_callback()) return Unexpected(make_error_code(ClientError::called_from_callback));
     auto mem = to_memory_address(start, Access::bit);
     if (!mem) return Unexpected(mem.error());
     const bool bit_steps = steps_by_bit(*mem);
@@ -130,6 +133,7 @@ Result<std::vector<bool>> Client::read_bits(const Address& start, std::size_t co
 }
 
 Result<void> Client::write_bits(const Address& start, const std::vector<bool>& bits) {
+    if (in_callback()) return Unexpected(make_error_code(ClientError::called_from_callback));
     auto mem = to_memory_address(start, Access::bit);
     if (!mem) return Unexpected(mem.error());
     const bool bit_steps = steps_by_bit(*mem);
@@ -176,6 +180,7 @@ Result<void> Client::transfer(const Address& from, const Address& to, std::size_
 }
 
 Result<std::vector<std::uint32_t>> Client::read_multiple(std::span<const Address> addresses) {
+    if (in_callback()) return Unexpected(make_error_code(ClientError::called_from_callback));
     std::vector<MemoryAddress> items;
     items.reserve(addresses.size());
     for (const auto& a : addresses) {

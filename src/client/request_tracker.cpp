@@ -6,17 +6,14 @@
 namespace fins {
 
 RequestTracker::RequestTracker(FrameSink& sink, std::uint8_t gateway_count)
-    : sink_(sink), slots_(max_in_flight), gateway_count_(gateway_count) {}
-
-std::optional<std::uint8_t> RequestTracker::allocate_service_id() noexcept {
-    for (std::size_t i = 0; i < max_in_flight; ++i) {
-        auto id = static_cast<std::uint8_t>(next_service_id_ + i);
-        if (!slots_[id].busy) {
-            next_service_id_ = static_cast<std::uint8_t>(id + 1);
-            return id;
-        }
-    }
-    return std::nullopt;
+    : sink_(sink),
+      requests_(max_in_flight),
+      sids_(default_timeout * default_quarantine_timeouts),
+      gateway_count_(gateway_count) {
+    by_sid_.fill(none);
+    free_requests_.reserve(max_in_flight);
+    for (std::size_t i = max_in_flight; i-- > 0;)
+        free_requests_.push_back(static_cast<std::uint16_t>(i));
 }
 
 Header RequestTracker::make_header(std::uint8_t service_id, bool response_required) const noexcept {
@@ -30,92 +27,129 @@ Header RequestTracker::make_header(std::uint8_t service_id, bool response_requir
     return h;
 }
 
-void RequestTracker::transmit(Slot& slot) {
-    sink_.send_frame(Bytes{slot.frame.data(), slot.size});
+void RequestTracker::transmit(Request& request) {
+    ++request.transmissions;
+    sink_.send_frame(Bytes{request.frame.data(), request.size});
 }
 
-Result<std::uint8_t> RequestTracker::submit(CommandCode command, Bytes parameters,
-                                            const RequestTiming& timing, Completion&& done,
-                                            SteadyTime now) {
+Result<void> RequestTracker::submit(CommandCode command, Bytes parameters,
+                                    const RequestTiming& timing, Completion&& done,
+                                    SteadyTime now) {
     if (timing.retries > max_retries)
         return Unexpected(make_error_code(ClientError::invalid_argument));
     if (header_size + command_code_size + parameters.size() > max_frame_size)
         return Unexpected(make_error_code(ClientError::request_too_long));
-    auto id = allocate_service_id();
-    if (!id) return Unexpected(make_error_code(ClientError::too_many_in_flight));
-
-    Slot& slot = slots_[*id];
-    slot.header = make_header(*id, true);
-    auto size = encode_request(slot.header, command, parameters, slot.frame);
+    if (free_requests_.empty()) return Unexpected(make_error_code(ClientError::too_many_in_flight));
+    const auto index = free_requests_.back();
+    Request& r = requests_[index];
+    r.header = make_header(0, true);
+    auto size = encode_request(r.header, command, parameters, r.frame);
     if (!size) return Unexpected(size.error());
-    slot.busy = true;
-    slot.sent = false;
-    slot.command = command;
-    slot.size = *size;
-    slot.attempts_left = timing.retries;
-    slot.timeout = timing.timeout.count() > 0 ? timing.timeout : default_timeout;
-    slot.deadline = now + slot.timeout;
-    slot.done = std::move(done);
+    free_requests_.pop_back();
+    r.busy = true;
+    r.sid = none;
+    r.command = command;
+    r.size = *size;
+    r.attempts_left = timing.retries;
+    r.transmissions = 0;
+    r.timeout = timing.timeout.count() > 0 ? timing.timeout : default_timeout;
+    r.deadline = now + r.timeout;
+    r.done = std::move(done);
     ++in_flight_;
-    if (link_up_) {
-        slot.sent = true;
+    queue_.push_back(index);
+    pump(now);
+    if (link_up_ && r.sid == none) ++stats_.waited_for_id;
+    return {};
+}
+
+void RequestTracker::pump(SteadyTime now) {
+    while (link_up_ && !queue_.empty()) {
+        auto sid = sids_.acquire(now);
+        if (!sid) return;
+        const auto index = queue_.front();
+        queue_.pop_front();
+        Request& r = requests_[index];
+        r.sid = *sid;
+        by_sid_[*sid] = index;
+        r.header.service_id = *sid;
+        r.header.destination = destination_;
+        r.header.source = source_;
+        ByteWriter w(MutableBytes{r.frame.data(), header_size});
+        write_header(w, r.header);
+        r.deadline = now + r.timeout;  // each attempt that is sent gets a whole timeout
+        r.sent_at = now;
         ++stats_.sent;
-        transmit(slot);
+        transmit(r);
     }
-    return *id;
 }
 
 Result<std::uint8_t> RequestTracker::submit_no_response(CommandCode command, Bytes parameters) {
     if (!link_up_) return Unexpected(make_error_code(ClientError::not_connected));
-    auto id = allocate_service_id();
-    if (!id) return Unexpected(make_error_code(ClientError::too_many_in_flight));
+    // Nothing answers such a frame, so its SID needs no reservation; a counter of its own
+    // keeps consecutive frames distinguishable in a capture. It avoids SIDs in flight, so
+    // that even a unit that answers anyway cannot complete another request.
+    auto id = next_unanswered_sid_++;
+    for (std::size_t i = 0; i < by_sid_.size() && by_sid_[id] != none; ++i)
+        id = next_unanswered_sid_++;
     std::array<std::uint8_t, max_frame_size> frame{};
-    auto size = encode_request(make_header(*id, false), command, parameters, frame);
+    auto size = encode_request(make_header(id, false), command, parameters, frame);
     if (!size) return Unexpected(size.error());
     ++stats_.sent;
     sink_.send_frame(Bytes{frame.data(), *size});
-    return *id;
+    return id;
 }
 
 void RequestTracker::link_up(const NodeAddress& destination, const NodeAddress& source,
                              SteadyTime now) {
-    (void)now;  // held requests keep the deadline they got at submit()
     destination_ = destination;
     source_ = source;
     link_up_ = true;
-    for (auto& slot : slots_) {
-        if (!slot.busy || slot.sent) continue;
-        slot.header.destination = destination_;
-        slot.header.source = source_;
-        ByteWriter w(MutableBytes{slot.frame.data(), header_size});
-        write_header(w, slot.header);
-        slot.sent = true;
-        ++stats_.sent;
-        transmit(slot);
-    }
+    sids_.reset();
+    smoothed_rtt_ = {};
+    sids_.set_min_rest(min_clean_rest);
+    pump(now);
 }
 
 void RequestTracker::link_down(std::error_code reason) {
     link_up_ = false;
-    fail_all(reason);
+    // Time is irrelevant here: the SIDs are reset by the next link_up().
+    fail_all(reason, SteadyTime{});
 }
 
-void RequestTracker::cancel_all(std::error_code reason) {
-    fail_all(reason);
+void RequestTracker::cancel_all(std::error_code reason, SteadyTime now) {
+    fail_all(reason, now);
 }
 
-void RequestTracker::fail_all(std::error_code reason) {
-    // Free every slot before calling anyone, so completions may submit again.
+RequestTracker::Completion RequestTracker::finish(std::uint16_t index, bool answered,
+                                                  SteadyTime now) {
+    Request& r = requests_[index];
+    if (r.sid != none) {
+        by_sid_[r.sid] = none;
+        const auto before = sids_.quarantined_count();
+        sids_.release(static_cast<std::uint8_t>(r.sid), r.transmissions - (answered ? 1 : 0), now);
+        stats_.quarantined += sids_.quarantined_count() - before;
+        r.sid = none;
+    } else {
+        auto it = std::find(queue_.begin(), queue_.end(), index);
+        if (it != queue_.end()) queue_.erase(it);
+    }
+    r.busy = false;
+    --in_flight_;
+    free_requests_.push_back(index);
+    auto done = std::move(r.done);
+    r.done = nullptr;
+    return done;
+}
+
+void RequestTracker::fail_all(std::error_code reason, SteadyTime now) {
+    // Free every request before calling anyone, so completions may submit again.
+    queue_.clear();
     std::vector<Completion> failed;
     failed.reserve(in_flight_);
-    for (auto& slot : slots_) {
-        if (!slot.busy) continue;
-        slot.busy = false;
-        failed.push_back(std::move(slot.done));
-        slot.done = nullptr;
-    }
-    in_flight_ = 0;
+    for (std::size_t i = 0; i < requests_.size(); ++i)
+        if (requests_[i].busy) failed.push_back(finish(static_cast<std::uint16_t>(i), false, now));
     stats_.failed += failed.size();
+    pump(now);
     for (auto& done : failed)
         if (done) done(Unexpected(reason));
 }
@@ -131,49 +165,58 @@ bool RequestTracker::addresses_match(const Header& request, const Header& respon
 }
 
 RequestTracker::Disposition RequestTracker::on_frame(Bytes frame, SteadyTime now) {
-    (void)now;
     auto response = decode_response(frame);
     if (!response) {
         ++stats_.invalid_discarded;
         return Disposition::invalid;
     }
-    Slot& slot = slots_[response->header.service_id];
-    if (!slot.busy || !slot.sent || response->command != slot.command) {
+    const auto sid = response->header.service_id;
+    const auto index = by_sid_[sid];
+    if (index == none || response->command != requests_[index].command) {
         ++stats_.stale_discarded;
+        const auto before = sids_.quarantined_count();
+        sids_.unexpected_answer(sid, index != none, now);
+        stats_.quarantined += sids_.quarantined_count() - before;
         return Disposition::stale;
     }
-    if (!addresses_match(slot.header, response->header)) {
+    if (!addresses_match(requests_[index].header, response->header)) {
         ++stats_.invalid_discarded;
         return Disposition::invalid;
     }
-    auto done = std::move(slot.done);
-    slot.done = nullptr;
-    slot.busy = false;
-    --in_flight_;
+    if (requests_[index].transmissions == 1) {
+        // Smoothed like TCP's SRTT (RFC 6298, gain 1/8); sets how long clean SIDs rest.
+        const auto rtt = now - requests_[index].sent_at;
+        smoothed_rtt_ = smoothed_rtt_.count() == 0 ? rtt : smoothed_rtt_ + (rtt - smoothed_rtt_) / 8;
+        const auto rest = std::clamp<std::chrono::nanoseconds>(smoothed_rtt_ * rest_rtts,
+                                                               min_clean_rest, sids_.quarantine());
+        sids_.set_min_rest(rest);
+    }
+    auto done = finish(index, true, now);
     ++stats_.completed;
+    pump(now);
     if (done) done(*response);
     return Disposition::matched;
 }
 
 void RequestTracker::on_timer(SteadyTime now) {
     std::vector<Completion> expired;
-    for (auto& slot : slots_) {
-        if (!slot.busy || slot.deadline > now) continue;
-        if (slot.attempts_left > 0) {
-            --slot.attempts_left;
-            slot.deadline = now + slot.timeout;
-            if (slot.sent) {
+    for (std::size_t i = 0; i < requests_.size(); ++i) {
+        Request& r = requests_[i];
+        if (!r.busy || r.deadline > now) continue;
+        if (r.sid == none && link_up_) continue;  // waits for a SID: its clock has not started
+        if (r.attempts_left > 0) {
+            --r.attempts_left;
+            r.deadline = now + r.timeout;
+            if (r.sid != none) {
                 ++stats_.retransmitted;
-                transmit(slot);
+                transmit(r);
             }
             continue;
         }
-        slot.busy = false;
-        --in_flight_;
         ++stats_.timed_out;
-        expired.push_back(std::move(slot.done));
-        slot.done = nullptr;
+        expired.push_back(finish(static_cast<std::uint16_t>(i), false, now));
     }
+    pump(now);
     for (auto& done : expired)
         if (done) done(Unexpected(make_error_code(ClientError::timeout)));
 }
@@ -181,8 +224,14 @@ void RequestTracker::on_timer(SteadyTime now) {
 std::optional<SteadyTime> RequestTracker::next_deadline() const noexcept {
     std::optional<SteadyTime> next;
     if (in_flight_ == 0) return next;
-    for (const auto& slot : slots_)
-        if (slot.busy && (!next || slot.deadline < *next)) next = slot.deadline;
+    for (const auto& r : requests_) {
+        if (!r.busy || (r.sid == none && link_up_)) continue;
+        if (!next || r.deadline < *next) next = r.deadline;
+    }
+    if (link_up_ && !queue_.empty()) {
+        auto usable = sids_.next_usable();
+        if (usable && (!next || *usable < *next)) next = usable;
+    }
     return next;
 }
 

@@ -5,12 +5,16 @@
 //
 // Contract (W596 section 3, Send/Rcv/SendCmd pp. 3-6..3-16, "Option": isNonResp,
 // TimeOut, Retry 0-15):
-// - Service IDs (SID) are allocated round-robin over 00-FF: the next SID after the
-//   last one handed out that is not in flight, so a freed SID is reused as late as
-//   possible and a late answer to it is unlikely to meet a new request. Up to 256
-//   requests are in flight at once; the 257th fails with ClientError::too_many_in_flight.
-// - The request frame is built once, at submit(), into a fixed per-slot buffer; no
-//   allocation per request besides the caller's Completion.
+// - Service IDs (SID): see client/sid_pool.hpp. A SID whose request was retransmitted,
+//   timed out or failed after it was sent is quarantined (ClientOptions::sid_quarantine,
+//   by default twice the timeout) so that no late answer can complete a later request;
+//   clean SIDs are reused least recently used first. Up to 256 requests are accepted at
+//   once; a request that finds no usable SID waits in a FIFO queue until
+//   one leaves quarantine; its clock starts when it is sent. The 257th request fails with
+//   ClientError::too_many_in_flight.
+// - The request frame is built once, at submit(), into a fixed per-request buffer (the
+//   SID and addresses are patched in when it is sent); no allocation per request besides
+//   the caller's Completion.
 // - A response matches when its SID is in flight, its command code equals the
 //   request's, and its addresses are the request's swapped (frames 1.5). A request field
 //   sent as 00 (network 00 "local network", node 00 "local node") matches any value,
@@ -22,12 +26,13 @@
 //   request stays in flight.
 // - On timeout the identical frame (same SID) is sent again, up to `retries` times; after
 //   the last attempt the request fails with ClientError::timeout. A request's clock
-//   starts at submit(), whether or not the link is up.
+//   starts at submit() while the link is down, and again when it is first sent.
 // - No-response mode (ICF bit 0, frames 1.2) is submit_no_response(): the frame is handed
 //   to the sink and nothing is kept in flight.
-// - Link state: while the link is down, submitted requests are held (built but not sent;
-//   a timeout while held consumes an attempt without sending anything). link_up() puts
-//   the current addresses into the held frames and sends them. link_down() fails every
+// - Link state: while the link is down, submitted requests are held (built but not sent,
+//   no SID; a timeout while held or queued consumes an attempt without sending anything).
+//   link_up() makes every SID clean again (a new connection or socket: no old answer
+//   reaches it), puts the current addresses into the held frames and sends them. link_down() fails every
 //   request, sent or held, with the given error: nothing is re-sent after a reconnect,
 //   because a request may already have been executed by the PLC.
 // - Completions are never called from inside submit(). They are called after the slot is
@@ -38,18 +43,18 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <optional>
 #include <system_error>
 #include <vector>
 
+#include "client/sid_pool.hpp"
 #include "fins/byte_io.hpp"
 #include "fins/error.hpp"
 #include "fins/frame.hpp"
 
 namespace fins {
-
-using SteadyTime = std::chrono::steady_clock::time_point;
 
 // W596 SendCmd p. 3-16: Option.Retry 0 to 15.
 inline constexpr unsigned max_retries = 15;
@@ -57,6 +62,8 @@ inline constexpr unsigned max_retries = 15;
 inline constexpr std::chrono::milliseconds default_timeout{2000};
 // One per service ID.
 inline constexpr std::size_t max_in_flight = 256;
+// Quarantine of a suspect SID, in timeouts (see sid_pool.hpp).
+inline constexpr int default_quarantine_timeouts = 2;
 
 struct RequestTiming {
     std::chrono::milliseconds timeout = default_timeout;  // per attempt; <= 0 means 2.0 s
@@ -71,6 +78,8 @@ struct TrackerStats {
     std::uint64_t failed = 0;             // requests failed by link_down() / cancel_all()
     std::uint64_t stale_discarded = 0;    // SID not in flight, or wrong command code
     std::uint64_t invalid_discarded = 0;  // undecodable, not a response, wrong addresses
+    std::uint64_t quarantined = 0;        // SIDs put into quarantine
+    std::uint64_t waited_for_id = 0;      // requests that had to wait for a usable SID
 };
 
 // Where frames go. send_frame() must copy the bytes (the slot buffer is reused) and
@@ -95,57 +104,81 @@ class RequestTracker {
     RequestTracker(const RequestTracker&) = delete;
     RequestTracker& operator=(const RequestTracker&) = delete;
 
-    // Sets the header addresses and sends every held request.
+    // Sets the header addresses, makes every SID clean and sends every held request.
     void link_up(const NodeAddress& destination, const NodeAddress& source, SteadyTime now);
     // Fails every request (sent or held) with `reason`; later submits are held.
     void link_down(std::error_code reason);
     [[nodiscard]] bool is_link_up() const noexcept { return link_up_; }
 
-    // Builds the frame, sends it (or holds it while the link is down) and returns the
-    // service ID. Fails with too_many_in_flight, request_too_long or invalid_argument
-    // (retries > 15); `done` is then left untouched (not moved from) and never called.
-    Result<std::uint8_t> submit(CommandCode command, Bytes parameters, const RequestTiming& timing,
-                                Completion&& done, SteadyTime now);
-    // ICF bit 0 set: sends and forgets. Fails with not_connected while the link is down.
+    // Builds the frame and sends it (or holds or queues it, see above). Fails with
+    // too_many_in_flight, request_too_long or invalid_argument (retries > 15); `done` is
+    // then left untouched (not moved from) and never called.
+    Result<void> submit(CommandCode command, Bytes parameters, const RequestTiming& timing,
+                        Completion&& done, SteadyTime now);
+    // ICF bit 0 set: sends and forgets (no SID is reserved: nothing answers). Fails with
+    // not_connected while the link is down. Returns the SID put in the frame.
     Result<std::uint8_t> submit_no_response(CommandCode command, Bytes parameters);
 
     Disposition on_frame(Bytes frame, SteadyTime now);
-    // Retransmits or fails every request whose deadline is <= now.
+    // Retransmits or fails every request whose deadline is <= now, and sends queued
+    // requests whose SID has left quarantine.
     void on_timer(SteadyTime now);
+    // The earliest request deadline, or end of a quarantine a queued request waits for.
     [[nodiscard]] std::optional<SteadyTime> next_deadline() const noexcept;
 
     // Fails every request with `reason`; the link state is unchanged.
-    void cancel_all(std::error_code reason);
+    void cancel_all(std::error_code reason, SteadyTime now);
 
+    // Requests accepted and not ended yet (sent, queued for a SID, or held).
     [[nodiscard]] std::size_t in_flight() const noexcept { return in_flight_; }
+    // Requests held for the link or queued for a SID.
+    [[nodiscard]] std::size_t waiting() const noexcept { return queue_.size(); }
     [[nodiscard]] const TrackerStats& stats() const noexcept { return stats_; }
     [[nodiscard]] const NodeAddress& destination() const noexcept { return destination_; }
     [[nodiscard]] const NodeAddress& source() const noexcept { return source_; }
     void set_gateway_count(std::uint8_t count) noexcept { gateway_count_ = count; }
+    void set_quarantine(std::chrono::nanoseconds q) noexcept { sids_.set_quarantine(q); }
+    // A clean SID rests rest_rtts round trips (at least min_clean_rest) before reuse.
+    static constexpr int rest_rtts = 4;
+    static constexpr std::chrono::microseconds min_clean_rest{500};
+    [[nodiscard]] const SidPool& service_ids() const noexcept { return sids_; }
 
   private:
-    struct Slot {
+    static constexpr std::uint16_t none = 0xFFFF;
+
+    struct Request {
         bool busy = false;
-        bool sent = false;  // false while held for the link
+        std::uint16_t sid = none;  // none while held or queued
         CommandCode command;
         Header header;
         unsigned attempts_left = 0;
+        unsigned transmissions = 0;
         std::chrono::milliseconds timeout{};
         SteadyTime deadline{};
+        SteadyTime sent_at{};  // first transmission
         std::size_t size = 0;
         std::array<std::uint8_t, max_frame_size> frame{};
         Completion done;
     };
 
-    std::optional<std::uint8_t> allocate_service_id() noexcept;
     Header make_header(std::uint8_t service_id, bool response_required) const noexcept;
-    void transmit(Slot& slot);
+    void transmit(Request& request);
+    // Gives queued requests a SID, oldest first, and sends them; stops at the first that
+    // finds none.
+    void pump(SteadyTime now);
+    // Frees a request (and its SID) and hands back its completion.
+    Completion finish(std::uint16_t index, bool answered, SteadyTime now);
     bool addresses_match(const Header& request, const Header& response) const noexcept;
-    void fail_all(std::error_code reason);
+    void fail_all(std::error_code reason, SteadyTime now);
 
     FrameSink& sink_;
-    std::vector<Slot> slots_;  // indexed by service ID
-    std::uint8_t next_service_id_ = 0;
+    std::vector<Request> requests_;              // max_in_flight of them
+    std::vector<std::uint16_t> free_requests_;   // indexes into requests_
+    std::array<std::uint16_t, 256> by_sid_{};    // request index of each SID in flight
+    std::deque<std::uint16_t> queue_;            // held or waiting for a SID, oldest first
+    SidPool sids_;
+    std::uint8_t next_unanswered_sid_ = 0;
+    std::chrono::nanoseconds smoothed_rtt_{0};  // of answers to first attempts
     std::size_t in_flight_ = 0;
     bool link_up_ = false;
     std::uint8_t gateway_count_;

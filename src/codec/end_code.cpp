@@ -65,6 +65,9 @@ class ClientCategory final : public std::error_category {
                 return "FINS/TCP node address exchange failed";
             case ClientError::invalid_argument:
                 return "invalid argument";
+            case ClientError::called_from_callback:
+                return "synchronous client call from inside a completion callback (use "
+                       "async_send there)";
         }
         return fmt::format("unknown client error {}", value);
     }

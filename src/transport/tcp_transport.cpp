@@ -1,5 +1,8 @@
 #include "transport/tcp_transport.hpp"
 
+#include <sys/socket.h>
+
+#include <cerrno>
 #include <cstring>
 #include <string>
 #include <utility>
@@ -77,6 +80,7 @@ void TcpTransport::read_handshake() {
             if (life.expired() || gen != generation_) return;
             // The server closes right after an error answer; EOF before it is a failure.
             if (ec) return finish_open(Unexpected(make_error_code(ClientError::handshake_failed)));
+            ++reads_;
             rx_size_ += n;
             auto parsed = parse_tcp_frame(Bytes{rx_.data(), rx_size_});
             if (parsed.status == TcpParse::Status::need_more) return read_handshake();
@@ -123,6 +127,7 @@ void TcpTransport::read_frames() {
                                 if (life.expired() || gen != generation_) return;
                                 if (ec)
                                     return fail(make_error_code(ClientError::connection_closed));
+                                ++reads_;
                                 rx_size_ += n;
                                 if (process_frames()) read_frames();
                             });
@@ -131,10 +136,14 @@ void TcpTransport::read_frames() {
 bool TcpTransport::process_frames() {
     std::weak_ptr<int> life = life_;
     auto gen = generation_;
+    // Walks the packets with an offset and moves the leftover to the front once, at the
+    // end (moving it after every packet costs a copy of the buffer per answer).
+    std::size_t pos = 0;
+    corked_ = true;
     // Each pass consumes at least one whole packet or stops, so this ends.
-    while (rx_size_ > 0) {
-        auto parsed = parse_tcp_frame(Bytes{rx_.data(), rx_size_});
-        if (parsed.status == TcpParse::Status::need_more) return true;
+    while (pos < rx_size_) {
+        auto parsed = parse_tcp_frame(Bytes{rx_.data() + pos, rx_size_ - pos});
+        if (parsed.status == TcpParse::Status::need_more) break;
         if (parsed.status == TcpParse::Status::error) {
             send_error_and_fail(parsed.error);
             return false;
@@ -153,9 +162,27 @@ bool TcpTransport::process_frames() {
                 send_error_and_fail(TcpError::command_not_supported);
                 return false;
         }
-        consume(parsed.consumed);
+        pos += parsed.consumed;
     }
-    return true;
+    consume(pos);
+    uncork();
+    return life.expired() ? false : gen == generation_;
+}
+
+void TcpTransport::uncork() {
+    corked_ = false;
+    if (cork_.empty()) return;
+    write_raw(Bytes{cork_.data(), cork_.size()}, {});
+    cork_.clear();
+}
+
+bool TcpTransport::peer_gone() {
+    if (state_ != State::open) return false;
+    std::uint8_t byte = 0;
+    const auto r = ::recv(socket_.native_handle(), &byte, 1, MSG_PEEK | MSG_DONTWAIT);
+    if (r == 0) return true;  // end of stream
+    if (r > 0) return false;  // data waits: the reader handles it (and a close after it)
+    return errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR;
 }
 
 void TcpTransport::consume(std::size_t n) noexcept {
@@ -182,6 +209,11 @@ void TcpTransport::send(Bytes frame) {
     std::array<std::uint8_t, tcp_header_size> header{};
     ByteWriter w(header);
     write_tcp_header(w, TcpCommand::frame, frame.size());
+    if (corked_) {
+        cork_.insert(cork_.end(), header.begin(), header.begin() + static_cast<std::ptrdiff_t>(w.size()));
+        cork_.insert(cork_.end(), frame.begin(), frame.end());
+        return;
+    }
     write_raw(Bytes{header.data(), w.size()}, frame);
 }
 
@@ -236,6 +268,8 @@ void TcpTransport::close() {
     writing_ = false;
     front_written_ = 0;
     rx_size_ = 0;
+    corked_ = false;
+    cork_.clear();
     open_done_ = nullptr;
     state_ = State::closed;
 }

@@ -13,12 +13,16 @@
 // (connection confirmation) is ignored as frames 3.4 says; command 3 closes the
 // transport with its TcpError; an envelope error, or command 0/1/unknown, is answered
 // with command 3 (frames 3.4 items 4-5) and closes with that TcpError. The peer
-// closing or resetting closes with ClientError::connection_closed.
+// closing or resetting closes with ClientError::connection_closed. peer_gone() peeks
+// (MSG_PEEK, non-blocking) for an end of stream or reset that nobody has read yet.
+// Frames sent from inside the frame handler (completion callbacks that send the next
+// request) are gathered and written together once the read's packets are handled.
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include <asio/io_context.hpp>
 #include <asio/ip/tcp.hpp>
@@ -40,6 +44,10 @@ class TcpTransport final : public Transport {
     void close() override;
     [[nodiscard]] State state() const noexcept override { return state_; }
     [[nodiscard]] bool write_pending() const noexcept override { return !queue_.empty(); }
+    [[nodiscard]] bool peer_gone() override;
+    // Reads that returned bytes since construction (handshake included); lets tests see
+    // how the bytes of a packet actually arrived.
+    [[nodiscard]] std::uint64_t reads() const noexcept { return reads_; }
 
   private:
     void on_connected();
@@ -53,6 +61,7 @@ class TcpTransport final : public Transport {
     void write_next();
     void fail(std::error_code reason);
     void consume(std::size_t n) noexcept;
+    void uncork();
 
     TransportOptions options_;
     asio::ip::tcp::resolver resolver_;
@@ -69,6 +78,11 @@ class TcpTransport final : public Transport {
     // Room for two maximal packets: whatever is left after parsing fits with room to read.
     std::array<std::uint8_t, 2 * tcp_max_packet> rx_{};
     std::size_t rx_size_ = 0;
+    std::uint64_t reads_ = 0;
+    // While the answers of one read are handed out, the requests their callbacks send
+    // are gathered here and leave in one write when the read is done.
+    bool corked_ = false;
+    std::vector<std::uint8_t> cork_;
 };
 
 }  // namespace fins::transport

@@ -13,6 +13,8 @@
 //   view is valid only during the call.
 // - The close handler is called once when an open transport fails or the peer closes it
 //   (not for close(), and not for a failed open, which reports to the open handler).
+// - The error handler hears errors after which the transport stays open (UDP: ICMP port
+//   unreachable, "nothing listening" at the moment); what waits for an answer may fail.
 // - Handlers may call send() and close(); after close() no handler of the old
 //   connection is called again.
 #pragma once
@@ -60,6 +62,7 @@ class Transport {
 
     void set_frame_handler(FrameHandler h) { on_frame_ = std::move(h); }
     void set_close_handler(CloseHandler h) { on_close_ = std::move(h); }
+    void set_error_handler(CloseHandler h) { on_error_ = std::move(h); }
 
     // Starts opening; requires State::closed. The handler gets the link info, or the
     // resolver/connect error, a TcpError from the handshake, or ClientError::timeout.
@@ -70,10 +73,15 @@ class Transport {
     [[nodiscard]] virtual State state() const noexcept = 0;
     // True while queued bytes have not been handed to the kernel yet.
     [[nodiscard]] virtual bool write_pending() const noexcept = 0;
+    // Looks at the socket without blocking and without calling any handler: true when
+    // the peer has closed or reset an open connection (an end of stream waits unread).
+    // UDP: clears an ICMP error left over from earlier traffic and returns false.
+    [[nodiscard]] virtual bool peer_gone() = 0;
 
   protected:
     FrameHandler on_frame_;
     CloseHandler on_close_;
+    CloseHandler on_error_;
 };
 
 // The FINS node number an IP address implies (frames section 2, automatic generation):

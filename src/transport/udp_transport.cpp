@@ -1,5 +1,9 @@
 #include "transport/udp_transport.hpp"
 
+#include <sys/socket.h>
+
+#include <cerrno>
+
 #include <string>
 #include <utility>
 
@@ -47,6 +51,11 @@ void UdpTransport::connect_first(const udp::resolver::results_type& results) {
         if (!ec) break;
     }
     if (!ec) socket_.non_blocking(true, ec);
+    if (!ec) {
+        // Best effort: the kernel caps it at net.core.rmem_max.
+        std::error_code ignored;
+        socket_.set_option(asio::socket_base::receive_buffer_size(udp_receive_buffer), ignored);
+    }
     LinkInfo info;
     if (!ec) {
         auto local = socket_.local_endpoint(ec);
@@ -73,20 +82,64 @@ void UdpTransport::finish_open(Result<LinkInfo> result) {
     if (done) done(std::move(result));
 }
 
+ReceiveError classify_receive_error(std::error_code ec) noexcept {
+    if (ec == asio::error::connection_refused) return ReceiveError::nothing_listening;
+    if (ec == asio::error::host_unreachable || ec == asio::error::network_unreachable ||
+        ec == std::error_code(EHOSTDOWN, std::system_category()) ||
+        ec == std::error_code(ENONET, std::system_category()) || ec == asio::error::network_down ||
+        ec == asio::error::connection_reset || ec == asio::error::timed_out ||
+        ec == std::errc::protocol_error || ec == std::errc::message_size ||
+        ec == asio::error::interrupted)
+        return ReceiveError::transient;
+    return ReceiveError::fatal;
+}
+
 void UdpTransport::receive() {
     auto gen = generation_;
     std::weak_ptr<int> life = life_;
     socket_.async_receive(asio::buffer(rx_), [this, life, gen](std::error_code ec, std::size_t n) {
         if (life.expired() || gen != generation_) return;
-        if (ec == asio::error::connection_refused) return receive();  // ICMP: keep waiting
-        if (ec) return fail(make_error_code(ClientError::connection_closed));
-        // A datagram that fills the whole buffer is longer than 2,012 bytes: not FINS.
-        if (n < rx_.size() && on_frame_) {
-            on_frame_(Bytes{rx_.data(), n});
-            if (life.expired() || gen != generation_) return;
+        if (!on_receive(ec, n)) return;
+        // Take what else is queued now, without another trip through the reactor.
+        for (int i = 0; i < 64; ++i) {
+            std::error_code e;
+            const auto m = socket_.receive(asio::buffer(rx_), 0, e);
+            if (e == asio::error::would_block || e == asio::error::try_again) break;
+            if (!on_receive(e, m)) return;
         }
         receive();
     });
+}
+
+bool UdpTransport::on_receive(std::error_code ec, std::size_t n) {
+    auto gen = generation_;
+    std::weak_ptr<int> life = life_;
+    if (ec) {
+        switch (classify_receive_error(ec)) {
+            case ReceiveError::nothing_listening:
+                if (on_error_) on_error_(ec);
+                break;
+            case ReceiveError::transient:
+                break;
+            case ReceiveError::fatal:
+                fail(make_error_code(ClientError::connection_closed));
+                return false;
+        }
+    } else if (n < rx_.size() && on_frame_) {
+        // A datagram that fills the whole buffer is longer than 2,012 bytes: not FINS.
+        on_frame_(Bytes{rx_.data(), n});
+    }
+    return !life.expired() && gen == generation_;
+}
+
+bool UdpTransport::peer_gone() {
+    if (state_ != State::open) return false;
+    // Reading SO_ERROR clears an ICMP error left by earlier traffic, so it cannot fail
+    // the request about to be sent.
+    int error = 0;
+    socklen_t size = sizeof error;
+    ::getsockopt(socket_.native_handle(), SOL_SOCKET, SO_ERROR, &error, &size);
+    return false;
 }
 
 void UdpTransport::send(Bytes frame) {

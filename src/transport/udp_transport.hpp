@@ -2,10 +2,16 @@
 // one datagram = one FINS frame. IPv4 and IPv6; the socket's family follows the first
 // resolved address that can be connected.
 //
-// Connecting the socket makes the kernel drop datagrams from other peers. An ICMP
-// "port unreachable" (ECONNREFUSED on the next receive) does not close the transport:
-// UDP has no connection, the request simply times out and is retried (W596 SendCmd,
-// p. 3-16).
+// Connecting the socket makes the kernel drop datagrams from other peers. Errors the
+// kernel reports on the socket after an ICMP message never close the transport (UDP has
+// no connection): "port unreachable" (ECONNREFUSED) means nothing listens there now and
+// goes to the error handler, so the client fails what waits instead of retrying into
+// the void; "host/network unreachable" (often transient, e.g. ARP) is ignored: the
+// attempt times out and is retried (W596 SendCmd, p. 3-16).
+//
+// The receive buffer (SO_RCVBUF) is sized for 256 answers in flight at once, each up to
+// 2,012 bytes; the kernel caps it at net.core.rmem_max (Debian's default, 208 KiB, still
+// holds 256 answers of up to about 400 bytes).
 // Datagrams longer than 2,012 bytes are dropped. LinkInfo nodes come from
 // node_from_address() of the local and the peer address.
 #pragma once
@@ -35,10 +41,14 @@ class UdpTransport final : public Transport {
     [[nodiscard]] State state() const noexcept override { return state_; }
     [[nodiscard]] bool write_pending() const noexcept override { return !queue_.empty(); }
 
+    [[nodiscard]] bool peer_gone() override;
+
   private:
     void connect_first(const asio::ip::udp::resolver::results_type& results);
     void finish_open(Result<LinkInfo> result);
     void receive();
+    // Handles one receive result; false once the transport was closed or replaced.
+    bool on_receive(std::error_code ec, std::size_t n);
     void write_next();
     void fail(std::error_code reason);
 
@@ -54,5 +64,17 @@ class UdpTransport final : public Transport {
     bool writing_ = false;
     std::array<std::uint8_t, max_frame_size + 1> rx_{};
 };
+
+// What a receive error on a connected UDP socket means.
+enum class ReceiveError {
+    nothing_listening,  // ICMP port unreachable: fail what waits, stay open
+    transient,          // host/network unreachable and the like: ignore, keep receiving
+    fatal,              // the socket itself is broken: close
+};
+ReceiveError classify_receive_error(std::error_code ec) noexcept;
+
+// SO_RCVBUF asked for: 256 answers of up to 2,012 bytes, at the ~4.5 KiB the kernel
+// charges for each (the kernel doubles the value it is given).
+inline constexpr int udp_receive_buffer = 256 * 4608 / 2;
 
 }  // namespace fins::transport

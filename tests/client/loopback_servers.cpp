@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <deque>
 
+#include <asio/post.hpp>
 #include <asio/write.hpp>
 
 #include "fins/tcp.hpp"
@@ -58,6 +59,8 @@ UdpResponder::UdpResponder(const std::string& address) : socket_(io_) {
     if (!ec) socket_.open(ip.is_v4() ? asio::ip::udp::v4() : asio::ip::udp::v6(), ec);
     if (!ec) socket_.bind({ip, 0}, ec);
     if (ec) return;
+    // Bursts of 256 requests must all arrive: the tests lose only what they mean to.
+    socket_.set_option(asio::socket_base::receive_buffer_size(1 << 21), ec);
     port_ = socket_.local_endpoint().port();
     ok_ = true;
     receive();
@@ -105,8 +108,18 @@ void UdpResponder::receive() {
                                        if (twice)
                                            socket_.send_to(asio::buffer(frame), peer_, 0, ignored);
                                    }
+                                   if (!out.empty()) {
+                                       std::lock_guard lock(mutex_);
+                                       answers_sent_ += out.size();
+                                       changed_.notify_all();
+                                   }
                                    receive();
                                });
+}
+
+bool UdpResponder::wait_for_answers(std::size_t n, std::chrono::milliseconds limit) {
+    std::unique_lock lock(mutex_);
+    return changed_.wait_for(lock, limit, [&] { return answers_sent_ >= n; });
 }
 
 // ---- TcpResponder ----
@@ -295,6 +308,21 @@ std::vector<std::uint32_t> TcpResponder::envelope_errors(std::size_t n,
     std::unique_lock lock(mutex_);
     changed_.wait_for(lock, limit, [&] { return envelope_errors_.size() >= n; });
     return envelope_errors_;
+}
+
+bool TcpResponder::drop_connections(std::chrono::milliseconds limit) {
+    bool done = false;
+    asio::post(io_, [this, &done] {
+        for (auto& session : sessions_) {
+            std::error_code ignored;
+            session->socket.close(ignored);
+        }
+        std::lock_guard lock(mutex_);
+        done = true;
+        changed_.notify_all();
+    });
+    std::unique_lock lock(mutex_);
+    return changed_.wait_for(lock, limit, [&] { return done; });
 }
 
 std::size_t TcpResponder::split_answers() {

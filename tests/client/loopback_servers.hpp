@@ -66,6 +66,8 @@ class UdpResponder : public ServerBase {
     void hold_until(std::size_t n);
     void set_silent(bool silent);        // never answer
     void set_duplicate(bool duplicate);  // send every answer twice
+    // Waits (bounded) until at least n answers have been handed to the kernel.
+    bool wait_for_answers(std::size_t n, std::chrono::milliseconds limit = 5s);
 
   private:
     void receive();
@@ -77,6 +79,7 @@ class UdpResponder : public ServerBase {
     std::size_t hold_ = 0;
     bool silent_ = false;
     bool duplicate_ = false;
+    std::size_t answers_sent_ = 0;
     bool ok_ = false;
     std::uint16_t port_ = 0;
 };
@@ -108,8 +111,12 @@ class TcpResponder : public ServerBase {
     [[nodiscard]] std::uint16_t port() const noexcept { return port_; }
     // Handshakes answered, and the client node each one asked for.
     std::vector<std::uint8_t> handshakes();
-    // Answers written split in two (the split position cycles through 1 .. size-1).
+    // Answers written split in two (the split position cycles through 1 .. size-1). Two
+    // writes may still reach the client as one read: this counts what the server did.
     std::size_t split_answers();
+    // Closes every accepted connection, as a restarting finsd does, and returns once the
+    // sockets are closed (their FIN is on its way); the listener keeps accepting.
+    bool drop_connections(std::chrono::milliseconds limit = 5s);
     // Error codes of the command-3 packets the client sent; waits (bounded) for n.
     std::vector<std::uint32_t> envelope_errors(std::size_t n = 0,
                                                std::chrono::milliseconds limit = 5s);

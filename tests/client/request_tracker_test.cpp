@@ -1,5 +1,6 @@
 // RequestTracker with a fake wire and a fake clock: no sockets, no sleeps.
 #include "client/request_tracker.hpp"
+#include "client/tracker_fixture.hpp"
 
 #include <gtest/gtest.h>
 
@@ -14,57 +15,7 @@ using namespace std::chrono_literals;
 
 namespace {
 
-struct FakeWire : FrameSink {
-    std::vector<std::vector<std::uint8_t>> frames;
-    void send_frame(Bytes frame) override { frames.emplace_back(frame.begin(), frame.end()); }
-};
-
-constexpr NodeAddress plc{0, 10, 0};
-constexpr NodeAddress host{0, 20, 0};
-constexpr CommandCode read_code{0x01, 0x01};
-constexpr CommandCode write_code{0x01, 0x02};
-const SteadyTime t0 = SteadyTime{} + 1h;
-// D10, 10 words (W342 5-3-2 example parameters).
-constexpr std::array<std::uint8_t, 6> read_params{0x82, 0x00, 0x0A, 0x00, 0x00, 0x0A};
-
-std::vector<std::uint8_t> answer(Bytes request, std::uint16_t end_code = 0,
-                                 std::vector<std::uint8_t> data = {}, NodeAddress responder = plc) {
-    auto req = decode_request(request);
-    EXPECT_TRUE(req.has_value());
-    std::vector<std::uint8_t> out(max_frame_size);
-    ByteWriter w(out);
-    write_response_prefix(w, response_header(req->header, responder), req->command, end_code);
-    w.bytes(data);
-    out.resize(w.size());
-    return out;
-}
-
-// Collects one completion.
-struct Outcome {
-    std::optional<Result<ResponseView>> result;
-    std::vector<std::uint8_t> data;
-    RequestTracker::Completion callback() {
-        return [this](Result<ResponseView> r) {
-            if (r) data.assign(r->data.begin(), r->data.end());
-            result = r;
-        };
-    }
-};
-
-class TrackerTest : public ::testing::Test {
-  protected:
-    TrackerTest() { tracker.link_up(plc, host, t0); }
-
-    std::uint8_t submit(Outcome& o, RequestTiming timing = {}, SteadyTime at = t0,
-                        CommandCode code = read_code) {
-        auto id = tracker.submit(code, read_params, timing, o.callback(), at);
-        EXPECT_TRUE(id.has_value());
-        return id.value_or(0);
-    }
-
-    FakeWire wire;
-    RequestTracker tracker{wire};
-};
+using namespace fins::test;
 
 TEST_F(TrackerTest, BuildsTheRequestFrameAndMatchesTheResponse) {
     Outcome o;
@@ -101,7 +52,7 @@ void answer_in_reverse(std::size_t n) {
     for (std::size_t i = 0; i < n; ++i) {
         std::array<std::uint8_t, 2> params{static_cast<std::uint8_t>(i >> 8),
                                            static_cast<std::uint8_t>(i)};
-        ASSERT_TRUE(tracker.submit(read_code, params, {}, outcomes[i].callback(), t0));
+        ASSERT_TRUE(tracker.submit(read_code, params, {}, outcomes[i].callback(), t0).has_value());
     }
     ASSERT_EQ(tracker.in_flight(), n);
     for (std::size_t i = n; i-- > 0;) {
@@ -140,24 +91,27 @@ TEST_F(TrackerTest, The257thRequestIsRefused) {
     EXPECT_FALSE(extra.result);
 }
 
-TEST_F(TrackerTest, ServiceIdsAreRoundRobinSoFreedIdsAreReusedLast) {
+TEST_F(TrackerTest, CleanServiceIdsAreReusedLeastRecentlyUsedFirst) {
+    auto t = t0;
+    auto step = [&t] { return t += 1ms; };  // longer than a clean SID's minimum rest
     Outcome a, b;
-    EXPECT_EQ(submit(a), 0);
-    EXPECT_EQ(submit(b), 1);
-    tracker.on_frame(answer(wire.frames[0]), t0);
+    EXPECT_EQ(submit(a, {}, step()), 0);
+    EXPECT_EQ(submit(b, {}, step()), 1);
+    tracker.on_frame(answer(wire.frames[0]), step());
     Outcome c;
-    EXPECT_EQ(submit(c), 2) << "SID 0 is free but must not be reused yet";
-    // Walk the counter to the end: 3..255, completing each so only SID 1 stays busy.
+    EXPECT_EQ(submit(c, {}, step()), 2) << "SID 0 is free but must not be reused yet";
+    // Walk to the end: 3..255, completing each so only SIDs 1 and 2 stay busy.
     for (int i = 3; i < 256; ++i) {
         Outcome o;
-        auto id = submit(o);
+        auto id = submit(o, {}, step());
         EXPECT_EQ(id, i);
-        tracker.on_frame(answer(wire.frames.back()), t0);
+        tracker.on_frame(answer(wire.frames.back()), step());
     }
-    tracker.on_frame(answer(wire.frames[2]), t0);  // frees SID 2
+    tracker.on_frame(answer(wire.frames[2]), step());  // frees SID 2, after 0 and 3..255
     Outcome wrap1, wrap2;
-    EXPECT_EQ(submit(wrap1), 0);
-    EXPECT_EQ(submit(wrap2), 2) << "SID 1 is still in flight and is skipped";
+    EXPECT_EQ(submit(wrap1, {}, step()), 0) << "freed first, used first";
+    EXPECT_EQ(submit(wrap2, {}, step()), 3);
+    EXPECT_EQ(tracker.stats().quarantined, 0u) << "every SID was clean";
 }
 
 TEST_F(TrackerTest, ResponseForAServiceIdNotInFlightIsStale) {

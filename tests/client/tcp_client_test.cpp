@@ -75,7 +75,11 @@ TEST(TcpClient, WorksOverIpv6Loopback) {
     EXPECT_EQ((*words)[0], 0x1234);
 }
 
-TEST(TcpClient, AnswersSplitAtEveryBytePosition) {
+// The server writes each answer in two parts; loopback often hands both to one read,
+// so this pins only that the client copes with the writes. That the client's reader
+// really sees every split position is pinned by
+// TcpTransport.SeesAPacketSplitAtEveryBytePosition (transport_test.cpp).
+TEST(TcpClient, AnswersWrittenSplitAtEveryBytePosition) {
     TcpBehaviour behaviour;
     behaviour.mode = TcpBehaviour::Mode::split;
     TcpResponder server(behaviour);
@@ -92,7 +96,7 @@ TEST(TcpClient, AnswersSplitAtEveryBytePosition) {
         ASSERT_TRUE(words) << "split at " << i + 1 << ": " << words.error().message();
         EXPECT_EQ((*words)[0], 0x0100 + i);
     }
-    EXPECT_EQ(server.split_answers(), packet - 1u);
+    EXPECT_EQ(server.split_answers(), packet - 1u) << "what the server wrote, not what was read";
 }
 
 TEST(TcpClient, TwoAnswersGluedInOneWrite) {
@@ -143,6 +147,27 @@ TEST(TcpClient, DropFailsEverythingInFlightThenTheNextRequestReconnects) {
     EXPECT_EQ(server.handshakes().size(), 2u);
     EXPECT_EQ(client->stats().reconnects, 1u);
     EXPECT_TRUE(client->is_connected());
+}
+
+// finsd restarted while the client was idle: its end of stream waits unread on the old
+// socket. The first request goes out on a new connection (header: "the next request
+// reconnects") instead of failing with connection_closed.
+TEST(TcpClient, FirstRequestAfterTheServerClosedAnIdleConnectionSucceeds) {
+    TcpResponder server;
+    auto client = connect_tcp(server);
+    ASSERT_TRUE(client);
+    server.with_plc([](FakePlc& plc) { plc.dm[7] = 0x0707; });
+    ASSERT_TRUE(client->read_words(dm(7), 1));
+    ASSERT_TRUE(server.drop_connections());
+    for (int round = 0; round < 3; ++round) {
+        auto words = client->read_words(dm(7), 1);
+        ASSERT_TRUE(words) << "round " << round << ": " << client->describe(words.error());
+        EXPECT_EQ((*words)[0], 0x0707);
+        ASSERT_TRUE(server.drop_connections());
+    }
+    EXPECT_EQ(server.handshakes().size(), 4u);
+    EXPECT_EQ(client->stats().failed, 0u);
+    EXPECT_EQ(client->stats().reconnects, 3u);
 }
 
 TEST(TcpClient, HandshakeErrorFailsConnectWithTheTcpError) {
@@ -204,6 +229,8 @@ TEST(TcpClient, ConnectionRefusedIsReported) {
     auto client = Client::connect(options);
     ASSERT_FALSE(client);
     EXPECT_EQ(client.error(), make_error_code(asio::error::connection_refused));
+    EXPECT_EQ(describe_error(options, client.error()),
+              "127.0.0.1:" + std::to_string(port) + ": connection refused");
 }
 
 TEST(TcpClient, CloseCancelsAndTheNextRequestReconnects) {

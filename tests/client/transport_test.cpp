@@ -1,13 +1,26 @@
-// Transport details seen through the client: node derivation from IP addresses, the
-// bound on a FINS/TCP handshake that never completes, ICMP port-unreachable on UDP.
+// Transport details: node derivation from IP addresses, the bound on a FINS/TCP
+// handshake that never completes, ICMP errors and the receive buffer on UDP, and how the
+// FINS/TCP reader sees a packet split across reads.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
 #include <asio/ip/address.hpp>
+#include <asio/ip/tcp.hpp>
 #include <asio/ip/udp.hpp>
+#include <asio/read.hpp>
+#include <asio/write.hpp>
 
 #include "client/loopback_servers.hpp"
 #include "fins/client.hpp"
+#include "fins/tcp.hpp"
+#include "transport/tcp_transport.hpp"
 #include "transport/transport.hpp"
+#include "transport/udp_transport.hpp"
 
 using namespace fins;
 using namespace fins::test;
@@ -45,24 +58,133 @@ TEST(TcpTransport, HandshakeThatNeverCompletesTimesOut) {
     EXPECT_LT(std::chrono::steady_clock::now() - start, 5s);
 }
 
-TEST(UdpTransport, PortUnreachableIsATimeoutNotAClosedConnection) {
-    std::uint16_t port = 0;
-    {
-        asio::io_context io;
-        asio::ip::udp::socket probe(io, {asio::ip::make_address("127.0.0.1"), 0});
-        port = probe.local_endpoint().port();
-    }  // closed again: the kernel answers ICMP port unreachable
+std::uint16_t closed_udp_port() {
+    asio::io_context io;
+    asio::ip::udp::socket probe(io, {asio::ip::make_address("127.0.0.1"), 0});
+    return probe.local_endpoint().port();
+}  // closed again: the kernel answers ICMP port unreachable
+
+// Nothing listens: the ICMP port unreachable fails the request at once with "connection
+// refused" instead of waiting out every attempt; the socket stays usable.
+TEST(UdpTransport, PortUnreachableFailsWaitingRequestsAtOnce) {
     ClientOptions options;
-    options.port = port;
-    options.timeout = 30ms;
-    options.retries = 1;
+    options.port = closed_udp_port();
+    options.timeout = 10s;  // never reached: the ICMP answer comes first
+    options.retries = 3;
     auto client = Client::connect(options);
     ASSERT_TRUE(client);
     auto r = (*client)->read_words(Address{Area::dm, 0, 0, std::nullopt}, 1);
     ASSERT_FALSE(r);
-    EXPECT_EQ(r.error(), make_error_code(ClientError::timeout));
-    EXPECT_TRUE((*client)->is_connected());
-    EXPECT_EQ((*client)->stats().retransmitted, 1u);
+    EXPECT_EQ(r.error(), make_error_code(asio::error::connection_refused));
+    EXPECT_EQ((*client)->describe(r.error()),
+              "127.0.0.1:" + std::to_string(options.port) + ": connection refused");
+    EXPECT_EQ((*client)->stats().retransmitted, 0u);
+    EXPECT_TRUE((*client)->is_connected()) << "UDP has no connection to lose";
+    // Still refused on the next request, not closed.
+    auto again = (*client)->read_words(Address{Area::dm, 0, 0, std::nullopt}, 1);
+    ASSERT_FALSE(again);
+    EXPECT_EQ(again.error(), make_error_code(asio::error::connection_refused));
+}
+
+// Host or network unreachable (often transient) must not close the transport and fail
+// everything in flight: the attempt times out and is retried. Loopback cannot produce
+// these ICMP messages, so the decision itself is pinned.
+TEST(UdpTransport, IcmpErrorsOtherThanPortUnreachableKeepTheTransportOpen) {
+    using transport::classify_receive_error;
+    using transport::ReceiveError;
+    EXPECT_EQ(classify_receive_error(asio::error::connection_refused),
+              ReceiveError::nothing_listening);
+    EXPECT_EQ(classify_receive_error(asio::error::host_unreachable), ReceiveError::transient);
+    EXPECT_EQ(classify_receive_error(asio::error::network_unreachable), ReceiveError::transient);
+    EXPECT_EQ(classify_receive_error(std::error_code(EHOSTDOWN, std::system_category())),
+              ReceiveError::transient);
+    EXPECT_EQ(classify_receive_error(asio::error::network_down), ReceiveError::transient);
+    EXPECT_EQ(classify_receive_error(asio::error::bad_descriptor), ReceiveError::fatal);
+}
+
+// 256 answers arrive while the client is not reading (it is busy elsewhere): all must
+// fit in its receive buffer. 100-word answers (214 bytes): the kernel's default buffer
+// holds about 166 of them.
+TEST(UdpTransport, ReceiveBufferHolds256AnswersInFlight) {
+    UdpResponder server;
+    server.hold_until(256);
+    auto client = Client::connect([&] {
+        ClientOptions o;
+        o.port = server.port();
+        o.timeout = 5s;
+        o.retries = 0;  // a dropped answer is a failed request
+        return o;
+    }());
+    ASSERT_TRUE(client);
+    std::size_t ok = 0;
+    for (std::uint16_t i = 0; i < 256; ++i)
+        (*client)->async_send(MemoryAreaRead{{0x82, static_cast<std::uint16_t>(i * 100), 0}, 100},
+                              [&ok](Result<MemoryAreaReadResponse> r) {
+                                  if (r && r->data.size() == 200) ++ok;
+                              });
+    ASSERT_TRUE(server.wait_for_answers(256)) << "the requests went out inside async_send";
+    (*client)->run();
+    EXPECT_EQ(ok, 256u);
+}
+
+// Reads one packet whose bytes arrive in two parts, split at every position, and counts
+// the reads the transport made: it must see both parts (two writes on loopback are
+// often read together, so the test writes the second part only after the transport has
+// read the first).
+TEST(TcpTransport, SeesAPacketSplitAtEveryBytePosition) {
+    asio::io_context io;
+    asio::ip::tcp::acceptor acceptor(io, {asio::ip::make_address("127.0.0.1"), 0});
+    transport::TransportOptions options;
+    options.port = acceptor.local_endpoint().port();
+    transport::TcpTransport link(io, options);
+    std::vector<std::vector<std::uint8_t>> frames;
+    link.set_frame_handler([&frames](Bytes f) { frames.emplace_back(f.begin(), f.end()); });
+    std::optional<Result<transport::LinkInfo>> opened;
+    link.async_open([&opened](Result<transport::LinkInfo> r) { opened = r; });
+
+    asio::ip::tcp::socket server(io);
+    acceptor.non_blocking(true);
+    for (int i = 0; i < 500 && !server.is_open(); ++i) {
+        io.run_for(10ms);
+        std::error_code ec;
+        acceptor.accept(server, ec);
+    }
+    ASSERT_TRUE(server.is_open());
+    std::array<std::uint8_t, 20> hello{};
+    asio::read(server, asio::buffer(hello));
+    std::array<std::uint8_t, 24> welcome{};
+    ByteWriter hw(welcome);
+    write_node_address_response(hw, 0x22, 10);
+    asio::write(server, asio::buffer(welcome.data(), hw.size()));
+    for (int i = 0; i < 500 && !opened; ++i)
+        io.run_one_for(10ms);
+    ASSERT_TRUE(opened && *opened);
+
+    auto run_until_reads = [&](std::uint64_t n) {
+        for (int i = 0; i < 500 && link.reads() < n; ++i)
+            io.run_one_for(10ms);
+        return link.reads() >= n;
+    };
+    // A FINS/TCP packet carrying a 16-byte frame: 32 bytes, split positions 1 .. 31.
+    for (std::size_t split = 1; split < 32; ++split) {
+        std::array<std::uint8_t, 16> frame{};
+        for (std::size_t i = 0; i < frame.size(); ++i)
+            frame[i] = static_cast<std::uint8_t>(split * 16 + i);
+        std::array<std::uint8_t, 32> packet{};
+        ByteWriter w(packet);
+        write_tcp_header(w, TcpCommand::frame, frame.size());
+        w.bytes(frame);
+        const auto reads = link.reads();
+        asio::write(server, asio::buffer(packet.data(), split));
+        ASSERT_TRUE(run_until_reads(reads + 1)) << split;
+        EXPECT_EQ(frames.size(), split - 1) << "nothing delivered from a partial packet";
+        asio::write(server, asio::buffer(packet.data() + split, packet.size() - split));
+        ASSERT_TRUE(run_until_reads(reads + 2)) << split;
+        ASSERT_EQ(frames.size(), split) << split;
+        EXPECT_EQ(link.reads(), reads + 2) << "the client read the packet in two parts";
+        EXPECT_TRUE(std::equal(frames.back().begin(), frames.back().end(), frame.begin(),
+                               frame.end()));
+    }
 }
 
 }  // namespace
