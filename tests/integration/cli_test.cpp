@@ -129,6 +129,9 @@ TEST_F(Cli, ExitCodesSeparateUsageTransportAndEndCode) {
     EXPECT_EQ(transport.exit_code, 3);
     auto tcp = run({fins_bin, "--port", "1", "--tcp", "--timeout", "0.5", "read", "D0"});
     EXPECT_EQ(tcp.exit_code, 3);
+    // Issue 7 item 3: a transport error names the endpoint.
+    EXPECT_NE(tcp.err.find("127.0.0.1:1: "), std::string::npos) << tcp.err;
+    EXPECT_NE(transport.err.find("127.0.0.1:1: "), std::string::npos) << transport.err;
 }
 
 TEST(Finsd, RefusesBadOptionsAndBusyPorts) {

@@ -83,7 +83,7 @@ std::unique_ptr<Client> open_client(const GlobalOptions& g, Output& out, int& ex
     }
     auto client = Client::connect(o);
     if (!client) {
-        exit_code = out.failure(client.error(), fmt::format("cannot reach {}", endpoint(g)));
+        exit_code = out.failure(client.error(), "cannot connect");
         return nullptr;
     }
     return std::move(*client);

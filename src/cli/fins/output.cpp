@@ -73,9 +73,13 @@ int Output::failure(std::error_code ec, const std::string& context) {
     } else if (ec == make_error_code(EndCode::unit_missing)) {
         hint = "no such unit at that node: the CPU Unit is unit 0 (--dest NET.NODE.0)";
     }
+    // A transport error names the endpoint it happened with (issue 7 item 3):
+    // "127.0.0.1:9600: connection refused".
+    const std::string message = kind == ErrorKind::transport && target_ != nullptr
+                                    ? fmt::format("{}: {}", endpoint(*target_), ec.message())
+                                    : ec.message();
     if (json_) {
-        nlohmann::json e{
-            {"kind", kind_name(kind)}, {"message", ec.message()}, {"context", context}};
+        nlohmann::json e{{"kind", kind_name(kind)}, {"message", message}, {"context", context}};
         if (kind == ErrorKind::end_code) {
             e["end_code"] = fmt::format("{:04X}", ec.value());
             const auto* info = find_end_code(static_cast<std::uint16_t>(ec.value()));
@@ -88,7 +92,7 @@ int Output::failure(std::error_code ec, const std::string& context) {
         std::fprintf(stderr, "fins: %s: the PLC answered %s\n", context.c_str(),
                      ec.message().c_str());
     else
-        std::fprintf(stderr, "fins: %s: %s\n", context.c_str(), ec.message().c_str());
+        std::fprintf(stderr, "fins: %s: %s\n", context.c_str(), message.c_str());
     if (!hint.empty()) std::fprintf(stderr, "fins: %s\n", hint.c_str());
     switch (kind) {
         case ErrorKind::usage:
