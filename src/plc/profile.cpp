@@ -46,9 +46,11 @@ bool same_ignoring_case(std::string_view a, std::string_view b) noexcept {
 }
 
 // CJ2H-CPU68-EIP: 250K steps, DM 32K, EM 32K x 25 banks (E00-E18), built-in
-// EtherNet/IP port = CPU Bus Unit 0 (unit address 10).
+// EtherNet/IP port = CPU Bus Unit 0 (unit address 10); a Memory Card inserted.
 Profile make_cj2h() {
     Profile p;
+    // A 30 MB flash Memory Card is inserted, so the 22 xx commands work out of the box.
+    p.memory_card_kbytes = 30720;
     p.units = {UnitInfo{0x10, "CJ2B-EIP21", 0}};
     return p;
 }

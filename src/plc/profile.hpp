@@ -46,7 +46,7 @@ struct Profile {
     std::uint8_t timer_counter_kwords = 8;  // timer/counter size (x 1024, "always 8")
     std::uint8_t dip_switch = 0;            // pin k -> bit k-1 (pin 1 = UM write protection)
     std::uint8_t memory_card_type = 0x04;   // 00 none, 04 flash
-    std::uint16_t memory_card_kbytes = 0;   // 0 when no card is inserted
+    std::uint16_t memory_card_kbytes = 0;   // 0 when no card is inserted (at start)
     std::uint8_t racks = 1;                 // CPU Rack + expansion racks
     bool battery = true;                    // 06 01 status bit 2
     std::vector<UnitInfo> units;            // mounted units, ascending unit address
@@ -62,6 +62,9 @@ struct Profile {
     // W342 5-2-2: EM banks 0x00-0x18 on the largest CS/CJ models; CJ2H-CPU68 has 25.
     std::uint8_t em_banks = 25;
     std::uint32_t em_bank_words = 32768;  // E n_00000-32767
+    // PLC Setup "EM file memory": banks from this one on are EM file memory (disk 8001,
+    // W342 5-3-35); >= em_banks: none. 05 01 reports the banks before it as non-file EM.
+    std::uint8_t em_file_bank = 0xFF;
 
     std::uint32_t cio_words = 6144;                 // CIO 0000-6143
     std::uint32_t work_words = 512;                 // W000-511

@@ -1,6 +1,7 @@
 // 05 xx machine configuration reading: CPU UNIT DATA READ 05 01, CONNECTION DATA READ
 // 05 02 (W342 5-3-15, 5-3-16). Everything comes from the Profile; both are accepted in
 // every mode and under every protection (5-1-2).
+#include <algorithm>
 #include <optional>
 
 #include "fins/commands/configuration.hpp"
@@ -37,9 +38,11 @@ CpuUnitDataReadResponse cpu_unit_data(const plc::Plc& plc,
     r.area.iom_kbytes = p.iom_kbytes;
     r.area.dm_words = static_cast<std::uint16_t>(p.dm_words > 0xFFFF ? 0xFFFF : p.dm_words);
     r.area.timer_counter_kwords = p.timer_counter_kwords;
-    r.area.em_non_file_banks = p.em_banks;  // no EM bank is formatted as file memory
+    r.area.em_non_file_banks = plc.files().em_non_file_banks();
     r.area.memory_card_type = p.memory_card_type;
-    r.area.memory_card_kbytes = p.memory_card_kbytes;
+    // The card as inserted now (finsd ctl card-insert/card-remove), in KB (2 bytes).
+    r.area.memory_card_kbytes =
+        static_cast<std::uint16_t>(std::min<std::uint32_t>(plc.files().card_kbytes(), 0xFFFF));
     for (const auto& unit : p.units) {
         if (unit.unit_address < first_bus_unit || unit.unit_address > last_bus_unit) continue;
         r.bus_units[unit.unit_address - first_bus_unit] = static_cast<std::uint16_t>(
@@ -52,7 +55,7 @@ CpuUnitDataReadResponse cpu_unit_data(const plc::Plc& plc,
         r.area.program_kwords = nx_program_kwords;
         r.area.timer_counter_kwords = nx_timer_counter_kwords;
         r.area.memory_card_type = nx_memory_card_type;
-        r.area.memory_card_kbytes = p.memory_card_kbytes != 0 ? nx_card_inserted_size : 0;
+        r.area.memory_card_kbytes = plc.files().card_inserted() ? nx_card_inserted_size : 0;
         r.sysmac_bus_masters = 0;
     }
     return r;
