@@ -171,5 +171,22 @@ TEST(FileMemoryHandlers, W342_5_1_2_ConditionsAndWriteAccessLog) {
     EXPECT_EQ(h.plc.write_access_log().at(0).command, (CommandCode{0x22, 0x03}));
 }
 
+// 05 01 reports the card as inserted now and the banks before the EM file banks.
+TEST(FileMemoryHandlers, W342_5_3_15_CpuUnitDataFollowsTheCardAndEmFileBanks) {
+    plc::Profile p = plc::cj2h();
+    p.em_file_bank = 0x10;
+    Harness h(p);
+    auto d = h.send("0501").data();
+    ASSERT_GE(d.size(), 92U);
+    EXPECT_EQ(d[86], 0x10);                                  // non-file EM banks
+    EXPECT_EQ(to_hex(Bytes(d).subspan(89, 3)), "04 78 00");  // 30,720 KB
+    h.plc.files().remove_card();
+    d = h.send("0501").data();
+    EXPECT_EQ(to_hex(Bytes(d).subspan(89, 3)), "04 00 00");
+    h.plc.files().insert_card(0x800);
+    d = h.send("0501").data();
+    EXPECT_EQ(to_hex(Bytes(d).subspan(89, 3)), "04 08 00");
+}
+
 }  // namespace
 }  // namespace fins::test

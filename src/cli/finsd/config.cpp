@@ -61,6 +61,8 @@ class Loader {
                 r = section(key, node, k, &Loader::memory);
             else if (k == "inject")
                 r = section(key, node, k, &Loader::inject);
+            else if (k == "files")
+                r = section(key, node, k, &Loader::files);
             else
                 r = fail(key, k, "unknown key");
             if (!r) return r;
@@ -162,6 +164,33 @@ class Loader {
         if (k == "port") s_.port = static_cast<std::uint16_t>(*v);
         if (k == "max_connections") s_.max_connections = static_cast<std::size_t>(*v);
         return {};
+    }
+
+    // [files] card = true/false, card_kbytes = 1-4194303, em_file_bank = 0-24.
+    Expected<void> files(const toml::key& key, const toml::node& node, const std::string& p) {
+        const std::string_view k = key.str();
+        if (k == "card") {
+            bool inserted = true;
+            if (auto r = flag(key, node, p, inserted); !r) return r;
+            if (!inserted)
+                s_.card_kbytes = 0;
+            else if (s_.card_kbytes == 0u)
+                s_.card_kbytes.reset();
+            return {};
+        }
+        if (k == "card_kbytes") {
+            const auto v = integer(key, node, p, 1, 4194303);
+            if (!v) return tl::unexpected(v.error());
+            if (s_.card_kbytes != 0u) s_.card_kbytes = static_cast<std::uint32_t>(*v);
+            return {};
+        }
+        if (k == "em_file_bank") {
+            const auto v = integer(key, node, p, 0, 24);
+            if (!v) return tl::unexpected(v.error());
+            s_.em_file_bank = static_cast<std::uint8_t>(*v);
+            return {};
+        }
+        return fail(key, p, "unknown key");
     }
 
     Expected<void> protection(const toml::key& key, const toml::node& node, const std::string& p) {

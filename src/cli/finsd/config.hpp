@@ -56,6 +56,11 @@ struct Settings {
     std::string um_password;            // [protection] password: releases UM read protection (ctl)
     bool dip_write_protection = false;  // DIP switch pin 1 ON
 
+    // [files]: memory card inserted at start (capacity in KB; 0 = no card) and the first
+    // EM bank of EM file memory. Unset: the profile's.
+    std::optional<std::uint32_t> card_kbytes;
+    std::optional<std::uint8_t> em_file_bank;
+
     std::vector<MemoryInit> memory;  // [memory]
     plc::Injections inject;          // [inject]
 };

@@ -136,6 +136,9 @@ Expected<void> validate(const Settings& s) {
         s.network_write_protection.nodes.empty())
         return error("protection.nodes: empty, so network_write = \"listed\" protects nothing");
     if (const auto e = plc::validate(s.inject); !e.empty()) return error("inject." + e);
+    if (s.em_file_bank && *s.em_file_bank >= plc::find_profile(s.profile)->em_banks)
+        return error(fmt::format("files.em_file_bank: the {} has no EM bank {}", s.profile,
+                                 *s.em_file_bank));
     return {};
 }
 
