@@ -84,6 +84,12 @@ struct DiskData {
 std::uint32_t pack_file_date(int year, unsigned month, unsigned day, unsigned hour, unsigned minute,
                              unsigned second) noexcept;
 
+// A whole directory as the client's list_directory() gathers it over several 22 01s.
+struct DirectoryListing {
+    DiskData disk;
+    std::vector<FileEntry> files;
+};
+
 struct FileNameReadResponse {
     DiskData disk;
     bool last = false;  // bit 15 of the number of files

@@ -86,6 +86,7 @@ void add_plc_data_verbs(CLI::App& app, const GlobalOptions& g, int& exit_code); 
 void add_control_verbs(CLI::App& app, const GlobalOptions& g, int& exit_code);   // 04-07 xx
 void add_diagnostic_verbs(CLI::App& app, const GlobalOptions& g,
                           int& exit_code);  // 06 01, 09, 0C, 21, 23
+void add_file_verbs(CLI::App& app, const GlobalOptions& g, int& exit_code);  // 22 xx
 
 // Connects with the global options, or prints why not and sets `exit_code`.
 std::unique_ptr<Client> open_client(const GlobalOptions& g, Output& out, int& exit_code);
