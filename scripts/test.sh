@@ -31,7 +31,7 @@ ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:ha
 echo "== fuzz (${fuzz_seconds}s per target)"
 "$root/scripts/build.sh" fuzz
 fuzz_ok=0
-for target in fuzz_frame fuzz_tcp fuzz_address fuzz_dispatch; do
+for target in fuzz_frame fuzz_tcp fuzz_address fuzz_dispatch fuzz_files; do
   corpus=$(mktemp -d)
   seeds="$root/fuzz/corpus/$target"
   [[ -d "$seeds" ]] && cp -r "$seeds/." "$corpus/"
