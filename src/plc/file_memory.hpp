@@ -32,6 +32,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "fins/commands/file_memory.hpp"
@@ -46,6 +47,8 @@ inline constexpr std::uint32_t em_bank_bytes = 32768 * 2;
 // 5-3-39 .. 5-3-41 data files (.IOM, .STD, .OBJ) start with a 48-byte header
 // (CJ2SW p.269/272); finskit writes zeros there and skips it on load.
 inline constexpr std::size_t data_file_header_size = 48;
+// Directories below the root: 5 levels counting the root (CJ2SW p.271).
+inline constexpr std::size_t max_file_directories = 4;
 
 class FileMemory {
   public:
@@ -94,6 +97,10 @@ class FileMemory {
     static std::optional<std::string> canonical_name(std::string_view text);
     // Name rules on the 12 wire bytes (padding included).
     static std::optional<std::string> canonical_name(const FileName& name);
+    // Path rules: "\A\B" gives {"A", "B"} (canonical), "" and "\" the root; nullopt
+    // when the path breaks them. visible(): a host entry FINS may see (canonical as is).
+    static std::optional<std::vector<std::string>> parse_directory(std::string_view path);
+    static bool visible(std::string_view name);
 
     struct Device;
 
