@@ -58,7 +58,8 @@ constexpr const char* volume_file = ".volume";
 }  // namespace
 
 struct FileMemory::Device {
-    Fd fd;
+    int fd = -1;  // kept open in device_fds_
+    std::size_t index = 0;
     std::uint64_t capacity = 0;
     std::string_view label;
 };
@@ -71,6 +72,7 @@ FileMemory::FileMemory(const Profile& profile)
 }
 
 FileMemory::~FileMemory() {
+    close_devices();
     if (root_fd_ >= 0) ::close(root_fd_);
     if (own_root_) {
         std::error_code ec;
@@ -91,6 +93,7 @@ Result<void> FileMemory::attach(const std::filesystem::path& root) {
     std::filesystem::create_directories(root, ec);
     const int fd = ::open(root.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     if (fd < 0) return Unexpected(std::error_code(errno, std::generic_category()));
+    close_devices();
     if (root_fd_ >= 0) ::close(root_fd_);
     if (own_root_) std::filesystem::remove_all(root_, ec);
     root_fd_ = fd;
@@ -119,27 +122,50 @@ Result<FileMemory::Device> FileMemory::open_device(std::uint16_t disk) {
     if (disk == disk_memory_card) {
         if (!card_inserted()) return fail(EndCode::file_device_missing);
         dir = "card";
+        d.index = 0;
         d.capacity = std::uint64_t{card_kbytes_} * 1024;
         d.label = "MEMCARD";
     } else if (disk == disk_em_file) {
         if (!em_bank_) return fail(EndCode::file_device_missing);
         dir = "em";
+        d.index = 1;
         d.capacity = static_cast<std::uint64_t>(profile_.em_banks - *em_bank_) * em_bank_bytes;
         d.label = "EMFILE";
     } else {
         return fail(EndCode::parameter_error);
     }
     if (!ensure_root()) return fail(EndCode::memory_error);
-    if (::mkdirat(root_fd_, dir, 0755) != 0 && errno != EEXIST) return fail(EndCode::memory_error);
-    d.fd = host::open_directory(root_fd_, dir);
-    if (!d.fd.valid()) return fail(EndCode::memory_error);
-    if (host::kind_of(d.fd.get(), volume_file) == Kind::missing) {
-        const Fd v(
-            ::openat(d.fd.get(), volume_file, O_WRONLY | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0644));
-        host::set_mtime(d.fd.get(), volume_file,
-                        Clock::host_local(std::chrono::system_clock::now()));
+    // The device directory stays open: one openat per request less, and the bytes in use
+    // are counted once and then tracked (used()).
+    int& fd = device_fds_[d.index];
+    if (fd < 0) {
+        if (::mkdirat(root_fd_, dir, 0755) != 0 && errno != EEXIST)
+            return fail(EndCode::memory_error);
+        fd = host::open_directory(root_fd_, dir).release();
+        if (fd < 0) return fail(EndCode::memory_error);
+        used_[d.index].reset();
+        if (host::kind_of(fd, volume_file) == Kind::missing) {
+            const Fd v(
+                ::openat(fd, volume_file, O_WRONLY | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0644));
+            host::set_mtime(fd, volume_file, Clock::host_local(std::chrono::system_clock::now()));
+        }
     }
+    d.fd = fd;
     return d;
+}
+
+void FileMemory::close_devices() noexcept {
+    for (std::size_t i = 0; i < 2; ++i) {
+        if (device_fds_[i] >= 0) ::close(device_fds_[i]);
+        device_fds_[i] = -1;
+        used_[i].reset();
+    }
+}
+
+std::uint64_t FileMemory::bytes_in_use(const Device& d) {
+    auto& used = used_[d.index];
+    if (!used) used = host::used_bytes(d.fd);
+    return *used;
 }
 
 // ---- 22 01 ----
@@ -150,7 +176,7 @@ Result<FileNameReadResponse> FileMemory::list(const FileNameRead& c) {
     if (!path) return fail(EndCode::parameter_error);
     auto device = open_device(c.disk);
     if (!device) return Unexpected(device.error());
-    const Fd dir = host::open_path(device->fd.get(), *path);
+    const Fd dir = host::open_path(device->fd, *path);
     if (!dir.valid()) return fail(EndCode::read_file_missing);
 
     std::vector<FileEntry> all;
@@ -167,9 +193,9 @@ Result<FileNameReadResponse> FileMemory::list(const FileNameRead& c) {
     FileNameReadResponse r;
     r.disk.volume_label = *FileName::from(device->label);
     struct stat volume {};
-    if (::fstatat(device->fd.get(), volume_file, &volume, AT_SYMLINK_NOFOLLOW) == 0)
+    if (::fstatat(device->fd, volume_file, &volume, AT_SYMLINK_NOFOLLOW) == 0)
         r.disk.date = date_of(volume.st_mtime);
-    const auto used = host::used_bytes(device->fd.get());
+    const auto used = bytes_in_use(*device);
     r.disk.total_capacity =
         static_cast<std::uint32_t>(std::min<std::uint64_t>(device->capacity, 0xFFFFFFFF));
     r.disk.free_capacity = static_cast<std::uint32_t>(
@@ -191,7 +217,7 @@ Result<SingleFileReadResponse> FileMemory::read(const SingleFileRead& c) {
     if (!name || !path || c.length > max_file_read_bytes) return fail(EndCode::parameter_error);
     auto device = open_device(c.disk);
     if (!device) return Unexpected(device.error());
-    const Fd dir = host::open_path(device->fd.get(), *path);
+    const Fd dir = host::open_path(device->fd, *path);
     if (!dir.valid()) return fail(EndCode::read_file_missing);
     const Fd fd(::openat(dir.get(), name->c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC));
     struct stat st {};
@@ -228,7 +254,7 @@ EndCode FileMemory::write(const SingleFileWrite& c, CivilSeconds now) {
     if (mode != FileWriteMode::overwrite && c.position != 0) return EndCode::parameter_error;
     auto device = open_device(c.disk);
     if (!device) return EndCode{static_cast<std::uint16_t>(device.error().value())};
-    const Fd dir = host::open_path(device->fd.get(), *path);
+    const Fd dir = host::open_path(device->fd, *path);
     if (!dir.valid()) return EndCode::write_file_missing;
     struct stat st {};
     const auto kind = host::kind_of(dir.get(), *name, &st);
@@ -258,7 +284,7 @@ EndCode FileMemory::write(const SingleFileWrite& c, CivilSeconds now) {
     const std::uint64_t end = offset + c.data.size();
     if (end > 0xFFFFFFFF) return EndCode::address_range_exceeded;
     const std::uint64_t new_size = replacing ? c.data.size() : std::max(old_size, end);
-    const auto used = host::used_bytes(device->fd.get());
+    const auto used = bytes_in_use(*device);
     if (new_size > old_size && used + (new_size - old_size) > device->capacity)
         return EndCode::address_range_exceeded;
 
@@ -276,7 +302,9 @@ EndCode FileMemory::write(const SingleFileWrite& c, CivilSeconds now) {
                   content->begin() + static_cast<std::ptrdiff_t>(offset));
         ok = host::replace(dir.get(), *name, *content, now, temp_counter_);
     }
-    return ok ? EndCode::normal_completion : EndCode::memory_error;
+    if (!ok) return EndCode::memory_error;
+    used_[device->index] = (used >= old_size ? used - old_size : 0) + new_size;
+    return EndCode::normal_completion;
 }
 
 // ---- 22 04 ----
@@ -286,10 +314,11 @@ EndCode FileMemory::format(std::uint16_t disk, std::uint8_t current_em_bank, Civ
         return EndCode::area_classification_missing;
     auto device = open_device(disk);
     if (!device) return EndCode{static_cast<std::uint16_t>(device.error().value())};
-    if (!host::clear(device->fd.get(), false)) return EndCode::memory_error;
+    used_[device->index].reset();
+    if (!host::clear(device->fd, false)) return EndCode::memory_error;
     const Fd v(
-        ::openat(device->fd.get(), volume_file, O_WRONLY | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0644));
-    host::set_mtime(device->fd.get(), volume_file, now);
+        ::openat(device->fd, volume_file, O_WRONLY | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0644));
+    host::set_mtime(device->fd, volume_file, now);
     return EndCode::normal_completion;
 }
 
@@ -306,8 +335,9 @@ Result<std::uint16_t> FileMemory::remove(const FileDelete& c) {
     }
     auto device = open_device(c.disk);
     if (!device) return Unexpected(device.error());
-    const Fd dir = host::open_path(device->fd.get(), *path);
+    const Fd dir = host::open_path(device->fd, *path);
     if (!dir.valid()) return fail(EndCode::write_file_missing);
+    used_[device->index].reset();
     std::uint16_t deleted = 0;
     // 5-3-36: names that do not exist are ignored; so are directories (22 15 removes those).
     for (const auto& name : names)
@@ -329,21 +359,22 @@ EndCode FileMemory::copy(const FileCopy& c) {
     if (!source) return EndCode{static_cast<std::uint16_t>(source.error().value())};
     auto target = open_device(c.destination_disk);
     if (!target) return EndCode{static_cast<std::uint16_t>(target.error().value())};
-    const Fd from_dir = host::open_path(source->fd.get(), *from_path);
+    const Fd from_dir = host::open_path(source->fd, *from_path);
     struct stat st {};
     if (!from_dir.valid() || host::kind_of(from_dir.get(), *from, &st) != Kind::file)
         return EndCode::read_file_missing;
-    const Fd to_dir = host::open_path(target->fd.get(), *to_path);
+    const Fd to_dir = host::open_path(target->fd, *to_path);
     if (!to_dir.valid()) return EndCode::write_file_missing;
     if (host::kind_of(to_dir.get(), *to) != Kind::missing) return EndCode::file_name_exists;
     const auto content = host::read_all(from_dir.get(), *from);
     if (!content) return EndCode::memory_error;
-    if (host::used_bytes(target->fd.get()) + content->size() > target->capacity)
-        return EndCode::address_range_exceeded;
+    const auto used = bytes_in_use(*target);
+    if (used + content->size() > target->capacity) return EndCode::address_range_exceeded;
     // 5-3-37: "The copy destination file is given the same date as the copy source file."
-    return host::replace(to_dir.get(), *to, *content, st.st_mtime, temp_counter_)
-               ? EndCode::normal_completion
-               : EndCode::memory_error;
+    if (!host::replace(to_dir.get(), *to, *content, st.st_mtime, temp_counter_))
+        return EndCode::memory_error;
+    used_[target->index] = used + content->size();
+    return EndCode::normal_completion;
 }
 
 // ---- 22 08 ----
@@ -355,7 +386,7 @@ EndCode FileMemory::rename(const FileNameChange& c) {
     if (!from || !to || !path) return EndCode::parameter_error;
     auto device = open_device(c.disk);
     if (!device) return EndCode{static_cast<std::uint16_t>(device.error().value())};
-    const Fd dir = host::open_path(device->fd.get(), *path);
+    const Fd dir = host::open_path(device->fd, *path);
     if (!dir.valid()) return EndCode::write_file_missing;
     const auto kind = host::kind_of(dir.get(), *from);
     if (kind != Kind::file && kind != Kind::directory) return EndCode::write_file_missing;
@@ -377,7 +408,7 @@ EndCode FileMemory::directory(const DirectoryCreateDelete& c, CivilSeconds now) 
         return EndCode::parameter_error;
     auto device = open_device(c.disk);
     if (!device) return EndCode{static_cast<std::uint16_t>(device.error().value())};
-    const Fd dir = host::open_path(device->fd.get(), *path);
+    const Fd dir = host::open_path(device->fd, *path);
     if (!dir.valid()) return EndCode::write_file_missing;
     const auto kind = host::kind_of(dir.get(), *name);
     if (c.operation == static_cast<std::uint16_t>(DirectoryOperation::create)) {
@@ -404,7 +435,7 @@ Result<std::vector<std::uint8_t>> FileMemory::load(std::uint16_t disk, const Fil
     if (!name || !path) return fail(EndCode::parameter_error);
     auto device = open_device(disk);
     if (!device) return Unexpected(device.error());
-    const Fd dir = host::open_path(device->fd.get(), *path);
+    const Fd dir = host::open_path(device->fd, *path);
     if (!dir.valid()) return fail(EndCode::read_file_missing);
     auto content = host::read_all(dir.get(), *name);
     if (!content) return fail(EndCode::read_file_missing);
@@ -418,13 +449,14 @@ EndCode FileMemory::create(std::uint16_t disk, const FileName& file, const std::
     if (!name || !path) return EndCode::parameter_error;
     auto device = open_device(disk);
     if (!device) return EndCode{static_cast<std::uint16_t>(device.error().value())};
-    const Fd dir = host::open_path(device->fd.get(), *path);
+    const Fd dir = host::open_path(device->fd, *path);
     if (!dir.valid()) return EndCode::write_file_missing;
     if (host::kind_of(dir.get(), *name) != Kind::missing) return EndCode::file_name_exists;
-    if (host::used_bytes(device->fd.get()) + content.size() > device->capacity)
-        return EndCode::address_range_exceeded;
-    return host::replace(dir.get(), *name, content, now, temp_counter_) ? EndCode::normal_completion
-                                                                        : EndCode::memory_error;
+    const auto used = bytes_in_use(*device);
+    if (used + content.size() > device->capacity) return EndCode::address_range_exceeded;
+    if (!host::replace(dir.get(), *name, content, now, temp_counter_)) return EndCode::memory_error;
+    used_[device->index] = used + content.size();
+    return EndCode::normal_completion;
 }
 
 }  // namespace fins::plc

@@ -107,6 +107,10 @@ class FileMemory {
   private:
     Result<Device> open_device(std::uint16_t disk);
     Result<void> ensure_root();
+    void close_devices() noexcept;
+    // File bytes on the device: counted at first use, then tracked by every change made
+    // here (recounted after 22 04 / 22 05); temp files of a replace in progress excluded.
+    std::uint64_t bytes_in_use(const Device& d);
 
     const Profile& profile_;
     std::filesystem::path root_;
@@ -115,6 +119,8 @@ class FileMemory {
     std::uint32_t card_kbytes_ = 0;
     std::optional<std::uint8_t> em_bank_;
     unsigned temp_counter_ = 0;
+    int device_fds_[2] = {-1, -1};  // card, em
+    std::optional<std::uint64_t> used_[2];
 };
 
 }  // namespace fins::plc
