@@ -256,4 +256,26 @@ Result<void> Client::send_no_response(const C& command) {
     return submit_no_response(C::code, w.written());
 }
 
+// ---- file memory helpers (22 xx, W342 5-3-32 .. 5-3-42): src/client/file_transfer.cpp ----
+// Types from fins/commands/file_memory.hpp; the other 22 xx commands go through
+// Client::send<C>() one to one. `directory`: "" (root) or "\DIR\SUB".
+struct FileName;
+struct DirectoryListing;
+// Called after each chunk: bytes done so far and the file's size.
+using FileProgress = std::function<void(std::uint64_t done, std::uint64_t total)>;
+// Every entry of a directory, over as many 22 01 requests (20 entries each) as needed.
+Result<DirectoryListing> list_directory(Client& client, std::uint16_t disk,
+                                        const std::string& directory);
+// A whole file of any size: 22 02 chunks of up to 1,988 bytes, `window` kept in flight.
+Result<std::vector<std::uint8_t>> get_file(Client& client, std::uint16_t disk,
+                                           const std::string& directory, const FileName& file,
+                                           const FileProgress& progress = {},
+                                           std::size_t window = 8);
+// Writes a whole file: the first 22 03 creates it (0001 with `replace`, else 0000: 2107
+// when it exists), the rest extend it with 0003 at their positions, `window` in flight.
+// If a chunk fails the file holds the chunks before it.
+Result<void> put_file(Client& client, std::uint16_t disk, const std::string& directory,
+                      const FileName& file, std::span<const std::uint8_t> data, bool replace,
+                      const FileProgress& progress = {}, std::size_t window = 8);
+
 }  // namespace fins

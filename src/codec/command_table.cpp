@@ -82,10 +82,10 @@ constexpr std::array commands{
     CommandInfo{{0x22, 0x0A}, "MEMORY AREA-FILE TRANSFER", "5-3-39", guarded_write},
     // Notes 1-3 of 5-1-2: in RUN/MONITOR (22 0B, 22 0C) and under DIP write protection
     // (22 0B) only the area-to-file direction is possible; the handler refuses the
-    // file-to-area direction. 22 0C under DIP protection: only program-to-file works.
+    // file-to-area direction. 22 0C under DIP protection: only program-to-file works,
+    // so its DIP column is OK here and the handler refuses file-to-program (2101).
     CommandInfo{{0x22, 0x0B}, "PARAMETER AREA-FILE TRANSFER", "5-3-40", guarded_write},
-    CommandInfo{
-        {0x22, 0x0C}, "PROGRAM AREA-FILE TRANSFER", "5-3-41", when(OK, OK, OK, NO, OK, NO, NO)},
+    CommandInfo{{0x22, 0x0C}, "PROGRAM AREA-FILE TRANSFER", "5-3-41", guarded_write},
     CommandInfo{{0x22, 0x15}, "CREATE/DELETE DIRECTORY", "5-3-42", guarded_write},
     // Note 4: with DIP protection, cassette contents with program data cannot be loaded.
     CommandInfo{

@@ -14,7 +14,8 @@ Plc::Plc(Profile profile, std::unique_ptr<Storage> storage)
       scan_cycle_(memory_.profile(), *storage_),
       errors_(memory_.profile(), *storage_),
       messages_(memory_.profile(), *storage_),
-      write_access_log_(memory_.profile(), *storage_) {
+      write_access_log_(memory_.profile(), *storage_),
+      files_(memory_.profile()) {
     // Log records carry the PLC's own clock (as 07 02 set it), like a real CPU Unit.
     errors_.use_clock(&clock_);
     write_access_log_.use_clock(&clock_);

@@ -18,6 +18,7 @@
 #include "fins/frame.hpp"
 #include "plc/clock.hpp"
 #include "plc/errors.hpp"
+#include "plc/file_memory.hpp"
 #include "plc/io_memory.hpp"
 #include "plc/loop_control.hpp"
 #include "plc/messages.hpp"
@@ -74,6 +75,8 @@ class Plc {
     [[nodiscard]] const ErrorState& errors() const noexcept { return errors_; }
     Messages& messages() noexcept { return messages_; }
     WriteAccessLog& write_access_log() noexcept { return write_access_log_; }
+    FileMemory& files() noexcept { return files_; }
+    [[nodiscard]] const FileMemory& files() const noexcept { return files_; }
 
     [[nodiscard]] OperatingMode mode() const noexcept { return mode_; }
     // Sets the mode without touching the scan cycle (tests and power-on only).
@@ -139,6 +142,7 @@ class Plc {
     ErrorState errors_;
     Messages messages_;
     WriteAccessLog write_access_log_;
+    FileMemory files_;
     OperatingMode mode_ = OperatingMode::run;
     std::optional<NodeAddress> access_right_holder_;
     NetworkWriteProtectionSetting network_write_protection_;

@@ -75,7 +75,8 @@ bool same_ignoring_case(std::string_view a, std::string_view b) noexcept {
 
 // CJ2H-CPU68-EIP: 400K steps [LF] -> program area 800 K words (0320) [SCAN]; DM 32K,
 // EM 32K x 25 banks E00-E18 [LF]; version "01.90" as the CJ2H-CPU65-EIP answers [SCAN];
-// no memory card (the scanned CJ2H has none [SCAN]). Its built-in EtherNet/IP port is
+// a 30 MB flash Memory Card inserted (a choice, so the 22 xx file commands work out of
+// the box; the scanned CJ2H had none [SCAN]). Its built-in EtherNet/IP port is
 // CPU Bus Unit 0 (unit address 10); the name "CJ2B-EIP21" is a choice.
 Profile make_cj2h() {
     Profile p;
@@ -83,8 +84,8 @@ Profile make_cj2h() {
     p.system_version = "01.90";
     p.program_kwords = 800;
     p.em_banks = 25;
-    p.memory_card_type = 0x00;
-    p.memory_card_kbytes = 0;
+    p.memory_card_type = 0x04;
+    p.memory_card_kbytes = 30720;
     p.units = {UnitInfo{0x10, "CJ2B-EIP21", 0, "V2.00"}};
     return p;
 }

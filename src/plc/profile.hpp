@@ -70,6 +70,9 @@ struct Profile {
     // W342 5-2-2: EM banks 0x00-0x18 on the largest CS/CJ models; CJ2H-CPU68 has 25.
     std::uint8_t em_banks = 25;
     std::uint32_t em_bank_words = 32768;  // E n_00000-32767
+    // PLC Setup "EM file memory": banks from this one on are EM file memory (disk 8001,
+    // W342 5-3-35); >= em_banks: none. 05 01 reports the banks before it as non-file EM.
+    std::uint8_t em_file_bank = 0xFF;
 
     std::uint32_t cio_words = 6144;                 // CIO 0000-6143
     std::uint32_t work_words = 512;                 // W000-511

@@ -15,6 +15,8 @@
 //   {"cmd":"um_read_protection","on":false,"password":"..."}  UM read protection
 //   {"cmd":"mode","mode":"program"}                 program, monitor or run
 //   {"cmd":"release_access_right"}                  as 0C 03 from any node
+//   {"cmd":"card","inserted":true,"kbytes":30720}   inserts (capacity in KB, default the
+//                                                   profile's or 30720) or removes the card
 // Anything else answers {"error":"..."} and the connection stays open. A line longer
 // than max_line_size answers an error and closes the connection; at most
 // max_connections clients at once (others get an error and are closed). Every handler
@@ -150,7 +152,8 @@ Json status(plc::Plc& plc) {
                 {"write_access_log_records", plc.write_access_log().size()},
                 {"access_right_holder", holder},
                 {"network_write_protection", plc.network_write_protection()},
-                {"um_read_protection", plc.um_read_protection()}};
+                {"um_read_protection", plc.um_read_protection()},
+                {"memory_card_kbytes", plc.files().card_kbytes()}};
 }
 
 Json raise_fal(plc::Plc& plc, const Json& j, bool fals, plc::ErrorState::TimePoint now) {
@@ -234,6 +237,20 @@ Json handle(plc::Plc& plc, const Json& j) {
             return fail("\"mode\" must be program, monitor or run");
     } else if (cmd == "release_access_right") {
         plc.set_access_right_holder(std::nullopt);
+    } else if (cmd == "card") {
+        // Memory card (22 xx disk 8000): the files stay on the host while it is out.
+        const auto on = flag(j, "inserted");
+        if (!on) return fail("\"inserted\" must be true or false");
+        if (!*on) {
+            plc.files().remove_card();
+        } else {
+            const auto kb = j.contains("kbytes") ? number(j, "kbytes") : std::nullopt;
+            if (j.contains("kbytes") && (!kb || *kb == 0 || *kb > 4194303))
+                return fail("\"kbytes\" must be 1-4194303");
+            const std::uint32_t profile_kb = plc.profile().memory_card_kbytes;
+            plc.files().insert_card(kb ? static_cast<std::uint32_t>(*kb)
+                                       : (profile_kb != 0 ? profile_kb : 30720U));
+        }
     } else {
         return fail("unknown cmd \"" + cmd + "\"");
     }

@@ -321,3 +321,24 @@ TEST(ControlStart, ReplacesAStaleSocketButNotALiveOneOrARegularFile) {
 
 }  // namespace
 }  // namespace fins::test
+
+namespace fins::test {
+namespace {
+
+// File memory: the card can be removed and inserted at run time (22 xx answer 2301
+// while it is out; 05 01 reports the capacity).
+TEST_F(Control, CardInsertAndRemove) {
+    ControlClient c(path_);
+    ASSERT_TRUE(c.connected());
+    EXPECT_EQ(status(c)["memory_card_kbytes"], 30720);
+    EXPECT_EQ(c.request(R"({"cmd":"card","inserted":false})")["ok"], true);
+    EXPECT_EQ(status(c)["memory_card_kbytes"], 0);
+    EXPECT_EQ(c.request(R"({"cmd":"card","inserted":true,"kbytes":2048})")["ok"], true);
+    EXPECT_EQ(status(c)["memory_card_kbytes"], 2048);
+    EXPECT_TRUE(c.request(R"({"cmd":"card","inserted":true,"kbytes":0})").contains("error"));
+    EXPECT_TRUE(c.request(R"({"cmd":"card"})").contains("error"));
+    EXPECT_EQ(status(c)["memory_card_kbytes"], 2048);
+}
+
+}  // namespace
+}  // namespace fins::test

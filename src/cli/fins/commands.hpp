@@ -147,6 +147,7 @@ void add_plc_data_verbs(CLI::App& app, const GlobalOptions& g, int& exit_code); 
 void add_control_verbs(CLI::App& app, const GlobalOptions& g, int& exit_code);   // 04-07 xx
 void add_diagnostic_verbs(CLI::App& app, const GlobalOptions& g,
                           int& exit_code);  // 06 01, 09, 0C, 21, 23
+void add_file_verbs(CLI::App& app, const GlobalOptions& g, int& exit_code);  // 22 xx
 
 // Sends `command` and decodes the answer like Client::send, noting the answer's CPU error
 // flags on `out` (Client::send drops them: 0040 is a normal completion).

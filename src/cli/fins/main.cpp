@@ -78,6 +78,7 @@ int main(int argc, char** argv) {
     add_plc_data_verbs(app, g, group_rc);
     add_control_verbs(app, g, group_rc);
     add_diagnostic_verbs(app, g, group_rc);
+    add_file_verbs(app, g, group_rc);
 
     describe_global_options(app);
 

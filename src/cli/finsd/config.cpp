@@ -65,6 +65,8 @@ class Loader {
                 r = section(key, node, k, &Loader::storage);
             else if (k == "inject")
                 r = section(key, node, k, &Loader::inject);
+            else if (k == "files")
+                r = section(key, node, k, &Loader::files);
             else
                 r = fail(key, k, "unknown key");
             if (!r) return r;
@@ -181,6 +183,33 @@ class Loader {
         if (k == "tcp_keepalive") s_.tcp_keepalive = static_cast<unsigned>(*v);
         if (k == "tcp_max_pending") s_.tcp_max_pending = static_cast<std::size_t>(*v);
         return {};
+    }
+
+    // [files] card = true/false, card_kbytes = 1-4194303, em_file_bank = 0-24.
+    Expected<void> files(const toml::key& key, const toml::node& node, const std::string& p) {
+        const std::string_view k = key.str();
+        if (k == "card") {
+            bool inserted = true;
+            if (auto r = flag(key, node, p, inserted); !r) return r;
+            if (!inserted)
+                s_.card_kbytes = 0;
+            else if (s_.card_kbytes == 0u)
+                s_.card_kbytes.reset();
+            return {};
+        }
+        if (k == "card_kbytes") {
+            const auto v = integer(key, node, p, 1, 4194303);
+            if (!v) return tl::unexpected(v.error());
+            if (s_.card_kbytes != 0u) s_.card_kbytes = static_cast<std::uint32_t>(*v);
+            return {};
+        }
+        if (k == "em_file_bank") {
+            const auto v = integer(key, node, p, 0, 24);
+            if (!v) return tl::unexpected(v.error());
+            s_.em_file_bank = static_cast<std::uint8_t>(*v);
+            return {};
+        }
+        return fail(key, p, "unknown key");
     }
 
     Expected<void> protection(const toml::key& key, const toml::node& node, const std::string& p) {

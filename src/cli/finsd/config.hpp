@@ -65,6 +65,10 @@ struct Settings {
     // [storage]
     plc::Durability durability = plc::Durability::process;
     bool reset_state = false;  // --reset-state only: a refused state file is moved aside
+    // [files]: memory card inserted at start (capacity in KB; 0 = no card) and the first
+    // EM bank of EM file memory. Unset: the profile's.
+    std::optional<std::uint32_t> card_kbytes;
+    std::optional<std::uint8_t> em_file_bank;
 
     std::vector<MemoryInit> memory;  // [memory]
     plc::Injections inject;          // [inject]

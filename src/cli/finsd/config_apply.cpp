@@ -156,6 +156,9 @@ Expected<void> validate(const Settings& s) {
     if (const auto e = plc::validate(s.inject); !e.empty()) return error("inject." + e);
     if (s.durability == plc::Durability::power && !s.data_dir)
         return error("storage.durability: \"power\" needs data_dir (without one nothing is kept)");
+    if (s.em_file_bank && *s.em_file_bank >= plc::find_profile(s.profile)->em_banks)
+        return error(fmt::format("files.em_file_bank: the {} has no EM bank {}", s.profile,
+                                 *s.em_file_bank));
     return {};
 }
 

@@ -12,6 +12,7 @@
 //   um-protect on|off [PASSWORD]    UM read protection; releasing needs the password
 //   mode program|monitor|run        operating mode
 //   release-access                  drops the access right (as 0C 03)
+//   card insert [KB] | card remove  inserts (capacity in KB) or removes the memory card
 //   send JSON                       any request line as is
 //
 // Exit codes: 0 the server answered "ok"; 2 usage error or the server refused the
@@ -162,6 +163,18 @@ int run_ctl(int argc, char** argv) {
     c_um->callback([&] {
         request = {{"cmd", "um_read_protection"}, {"on", on_off == "on"}};
         if (!password.empty()) request["password"] = password;
+    });
+    std::string card_action;
+    unsigned card_kbytes = 0;
+    auto* c_card = app.add_subcommand("card", "Insert (capacity in KB) or remove the memory card");
+    c_card->add_option("action", card_action, "insert or remove")
+        ->required()
+        ->check(CLI::IsMember({"insert", "remove"}));
+    c_card->add_option("kbytes", card_kbytes, "Capacity in KB (insert)")
+        ->check(CLI::Range(1U, 4194303U));
+    c_card->callback([&] {
+        request = {{"cmd", "card"}, {"inserted", card_action == "insert"}};
+        if (card_kbytes != 0) request["kbytes"] = card_kbytes;
     });
     auto* c_mode = app.add_subcommand("mode", "Set the operating mode");
     c_mode->add_option("mode", mode, "program, monitor or run")

@@ -287,6 +287,17 @@ int serve(const Settings& s) {
     plc.set_um_password(s.um_password);
     plc.set_dip_write_protection(s.dip_write_protection);
     fins::plc::apply(s.inject, plc, std::chrono::system_clock::now());
+    // File memory (22 xx): <data_dir>/card and <data_dir>/em; else a temp dir removed at exit.
+    if (s.card_kbytes) {
+        if (*s.card_kbytes == 0)
+            plc.files().remove_card();
+        else
+            plc.files().insert_card(*s.card_kbytes);
+    }
+    if (s.em_file_bank) plc.files().set_em_file_bank(*s.em_file_bank);
+    if (s.data_dir)
+        if (auto r = plc.files().attach(*s.data_dir); !r)
+            return fail(3, "file memory in " + s.data_dir->string() + ": " + r.error().message());
 
     fins::server::ServerOptions options;
     options.bind_address = s.bind;

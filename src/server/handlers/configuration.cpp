@@ -9,6 +9,7 @@
 // finsd does not model the unit's network settings: IP address, subnet mask and
 // Ethernet address are 0, the port is the default 9600 and the mode setting 0000
 // ("default" port, automatic address generation).
+#include <algorithm>
 #include <optional>
 
 #include "fins/commands/configuration.hpp"
@@ -50,10 +51,15 @@ CpuUnitDataReadResponse cpu_unit_data(const plc::Plc& plc,
     r.area.iom_kbytes = p.iom_kbytes;
     r.area.dm_words = static_cast<std::uint16_t>(p.dm_words > 0xFFFF ? 0xFFFF : p.dm_words);
     r.area.timer_counter_kwords = p.timer_counter_kwords;
-    r.area.em_non_file_banks = p.em_banks;  // no EM bank is formatted as file memory
-    // W342 5-3-15: no memory card = type 00 and size 0000.
-    r.area.memory_card_type = p.has_memory_card() ? p.memory_card_type : 0x00;
-    r.area.memory_card_kbytes = p.has_memory_card() ? p.memory_card_kbytes : 0;
+    r.area.em_non_file_banks = plc.files().em_non_file_banks();
+    // W342 5-3-15: the card as inserted now (finsd ctl card insert/remove): no card =
+    // type 00 and size 0000; a card = its type (04 flash when the profile names none)
+    // and its size in KB.
+    const std::uint32_t card_kb = plc.files().card_kbytes();
+    r.area.memory_card_type =
+        card_kb == 0 ? std::uint8_t{0x00}
+                     : (p.memory_card_type != 0 ? p.memory_card_type : std::uint8_t{0x04});
+    r.area.memory_card_kbytes = static_cast<std::uint16_t>(std::min<std::uint32_t>(card_kb, 0xFFFF));
     for (const auto& unit : p.units) {
         if (unit.unit_address < first_bus_unit || unit.unit_address > last_bus_unit) continue;
         r.bus_units[unit.unit_address - first_bus_unit] = static_cast<std::uint16_t>(
@@ -66,7 +72,7 @@ CpuUnitDataReadResponse cpu_unit_data(const plc::Plc& plc,
         r.area.program_kwords = nx_program_kwords;
         r.area.timer_counter_kwords = nx_timer_counter_kwords;
         r.area.memory_card_type = nx_memory_card_type;
-        r.area.memory_card_kbytes = p.memory_card_kbytes != 0 ? nx_card_inserted_size : 0;
+        r.area.memory_card_kbytes = plc.files().card_inserted() ? nx_card_inserted_size : 0;
         r.sysmac_bus_masters = 0;
     }
     return r;

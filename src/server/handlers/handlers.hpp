@@ -62,6 +62,7 @@ std::span<const HandlerEntry> message_handlers() noexcept;         // 09 20  mes
 std::span<const HandlerEntry> access_right_handlers() noexcept;    // 0C xx  access_right.cpp
 std::span<const HandlerEntry> error_log_handlers() noexcept;       // 21 xx  error_log.cpp
 std::span<const HandlerEntry> forced_handlers() noexcept;          // 23 xx  forced.cpp
+std::span<const HandlerEntry> file_memory_handlers() noexcept;     // 22 xx  file_memory.cpp
 
 // The execution conditions of W342 5-1-2, checked in this order: operating mode
 // (RUN 2206, MONITOR 2205, PROGRAM 2203), network write protection (2102, only for

@@ -1,0 +1,182 @@
+// fins_files_load: a 1 MiB file put and get through finsd over FINS/UDP with the
+// libfins helpers (22 03 / 22 02 chunks, 8 in flight), against a raw loopback UDP echo
+// of the same frame sizes and the same window in the same run. The ratio says what
+// finsd's file memory, the codec and the client cost over the kernel's loopback.
+//
+// finsd runs in this process on its own thread with a data directory under $TMPDIR;
+// the echo server runs on another thread. Timing lives here, never in tests.
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <random>
+#include <thread>
+#include <vector>
+
+#include <fmt/core.h>
+#include <spdlog/spdlog.h>
+#include <CLI/CLI.hpp>
+#include <asio/io_context.hpp>
+
+#include "fins/client.hpp"
+#include "fins/commands/file_memory.hpp"
+#include "plc/plc.hpp"
+#include "server/server.hpp"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Answers every datagram with `reply_size` bytes.
+class Echo {
+  public:
+    explicit Echo(std::size_t reply_size) : reply_(reply_size, 0xC0) {
+        fd_ = ::socket(AF_INET, SOCK_DGRAM, 0);
+        sockaddr_in a{};
+        a.sin_family = AF_INET;
+        a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+        ::bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a);
+        socklen_t len = sizeof a;
+        ::getsockname(fd_, reinterpret_cast<sockaddr*>(&a), &len);
+        port_ = ntohs(a.sin_port);
+        thread_ = std::thread([this] {
+            std::array<std::uint8_t, 4096> buf{};
+            for (;;) {
+                sockaddr_storage peer{};
+                socklen_t n = sizeof peer;
+                const auto r = ::recvfrom(fd_, buf.data(), buf.size(), 0,
+                                          reinterpret_cast<sockaddr*>(&peer), &n);
+                if (r <= 0 || stop_) return;
+                ::sendto(fd_, reply_.data(), reply_.size(), 0, reinterpret_cast<sockaddr*>(&peer),
+                         n);
+            }
+        });
+    }
+    ~Echo() {
+        stop_ = true;
+        ::shutdown(fd_, SHUT_RDWR);
+        ::close(fd_);
+        thread_.join();
+    }
+    [[nodiscard]] std::uint16_t port() const { return port_; }
+
+  private:
+    std::vector<std::uint8_t> reply_;
+    int fd_ = -1;
+    std::uint16_t port_ = 0;
+    std::atomic<bool> stop_{false};
+    std::thread thread_;
+};
+
+// `count` requests of `request_size` bytes, `window` in flight, to the echo: seconds.
+double drive_echo(std::size_t request_size, std::size_t reply_size, std::size_t count,
+                  std::size_t window) {
+    Echo echo(reply_size);
+    const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    a.sin_port = htons(echo.port());
+    ::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
+    std::vector<std::uint8_t> request(request_size, 0x80);
+    std::array<std::uint8_t, 4096> buf{};
+    const auto start = Clock::now();
+    std::size_t sent = 0;
+    std::size_t received = 0;
+    while (received < count) {
+        while (sent < count && sent - received < window) {
+            ::send(fd, request.data(), request.size(), 0);
+            ++sent;
+        }
+        if (::recv(fd, buf.data(), buf.size(), 0) > 0) ++received;
+    }
+    const double s = std::chrono::duration<double>(Clock::now() - start).count();
+    ::close(fd);
+    return s;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"fins_files_load: 1 MiB file put/get through finsd vs a raw loopback echo"};
+    std::size_t bytes = 1 << 20;
+    std::size_t window = 8;
+    unsigned rounds = 3;
+    bool json = false;
+    app.add_option("--bytes", bytes, "File size")->capture_default_str();
+    app.add_option("--window", window, "Chunks in flight")->capture_default_str();
+    app.add_option("--rounds", rounds, "Put/get rounds")->capture_default_str();
+    app.add_flag("--json", json, "Print JSON lines");
+    CLI11_PARSE(app, argc, argv);
+    spdlog::set_level(spdlog::level::warn);
+
+    const auto root =
+        std::filesystem::temp_directory_path() / fmt::format("fins-files-load-{}", ::getpid());
+    fins::plc::Plc plc{fins::plc::cj2h()};
+    if (!plc.files().attach(root)) return 1;
+    asio::io_context io{1};
+    fins::server::ServerOptions options;
+    options.port = 0;
+    auto server = fins::server::Server::start(io, plc, options);
+    if (!server) return 1;
+    std::thread server_thread([&] { io.run(); });
+
+    fins::ClientOptions o;
+    o.port = (*server)->udp_port();
+    auto client = fins::Client::connect(o);
+    if (!client) return 1;
+    std::vector<std::uint8_t> data(bytes);
+    std::mt19937 gen(1);
+    for (auto& b : data)
+        b = static_cast<std::uint8_t>(gen());
+    const auto name = *fins::FileName::from("BENCH.BIN");
+
+    // Frame sizes as they cross the wire (FINS header 10 + command code 2 ...).
+    const std::size_t put_chunk = fins::max_parameter_size - 24;
+    const std::size_t put_request = 12 + 24 + put_chunk, put_reply = 14;
+    const std::size_t get_request = 12 + 22, get_reply = 14 + 10 + fins::max_file_read_bytes;
+    const std::size_t put_count = (bytes + put_chunk - 1) / put_chunk;
+    const std::size_t get_count =
+        (bytes + fins::max_file_read_bytes - 1) / fins::max_file_read_bytes;
+    const double mb = static_cast<double>(bytes) / 1e6;
+
+    for (unsigned round = 0; round < rounds; ++round) {
+        auto t0 = Clock::now();
+        auto put =
+            fins::put_file(**client, fins::disk_memory_card, "", name, data, true, {}, window);
+        const double put_s = std::chrono::duration<double>(Clock::now() - t0).count();
+        t0 = Clock::now();
+        auto got = fins::get_file(**client, fins::disk_memory_card, "", name, {}, window);
+        const double get_s = std::chrono::duration<double>(Clock::now() - t0).count();
+        if (!put || !got || *got != data) {
+            std::fprintf(stderr, "fins_files_load: transfer failed\n");
+            return 1;
+        }
+        const double echo_put = drive_echo(put_request, put_reply, put_count, window);
+        const double echo_get = drive_echo(get_request, get_reply, get_count, window);
+        if (json)
+            fmt::print(
+                "{{\"round\":{},\"put_mbps\":{:.2f},\"echo_put_mbps\":{:.2f},\"put_ratio\":{:.2f},"
+                "\"get_mbps\":{:.2f},\"echo_get_mbps\":{:.2f},\"get_ratio\":{:.2f}}}\n",
+                round, mb / put_s, mb / echo_put, echo_put / put_s, mb / get_s, mb / echo_get,
+                echo_get / get_s);
+        else
+            fmt::print(
+                "round {}: put {:6.2f} MB/s (echo {:6.2f}, ratio {:.2f}) | get {:6.2f} MB/s "
+                "(echo {:6.2f}, ratio {:.2f})\n",
+                round, mb / put_s, mb / echo_put, echo_put / put_s, mb / get_s, mb / echo_get,
+                echo_get / get_s);
+    }
+    (*server)->stop();
+    io.stop();
+    server_thread.join();
+    std::error_code ec;
+    std::filesystem::remove_all(root, ec);
+    return 0;
+}

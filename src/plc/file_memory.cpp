@@ -1,0 +1,462 @@
+// plc::FileMemory: the 22 xx file devices (see file_memory.hpp for the rules).
+#include "plc/file_memory.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdlib>
+#include <ctime>
+
+#include "plc/file_memory_host.hpp"
+
+namespace fins::plc {
+
+using host::Fd;
+using host::Kind;
+
+namespace {
+
+constexpr std::uint32_t card_volume_date_fallback = 0;
+
+Unexpected fail(EndCode code) {
+    return Unexpected(make_error_code(code));
+}
+
+std::uint32_t date_of(std::int64_t mtime) noexcept {
+    const auto t = static_cast<std::time_t>(mtime);
+    std::tm tm{};
+    if (::gmtime_r(&t, &tm) == nullptr) return card_volume_date_fallback;
+    return pack_file_date(tm.tm_year + 1900, static_cast<unsigned>(tm.tm_mon + 1),
+                          static_cast<unsigned>(tm.tm_mday), static_cast<unsigned>(tm.tm_hour),
+                          static_cast<unsigned>(tm.tm_min), static_cast<unsigned>(tm.tm_sec));
+}
+
+FileEntry entry_of(const std::string& name, const struct stat& st, bool directory) {
+    FileEntry e;
+    e.name = *FileName::from(name);
+    e.date = date_of(st.st_mtime);
+    e.size = directory ? 0 : static_cast<std::uint32_t>(st.st_size);
+    e.attribute = directory ? attribute_directory : attribute_archive;
+    return e;
+}
+
+FileEntry dot_entry(std::string_view dots, const struct stat& st) {
+    FileEntry e;
+    e.name.bytes.fill(0x20);
+    for (std::size_t i = 0; i < dots.size(); ++i)
+        e.name.bytes[i] = '.';
+    e.date = date_of(st.st_mtime);
+    e.attribute = attribute_directory;
+    return e;
+}
+
+constexpr const char* volume_file = ".volume";
+
+}  // namespace
+
+struct FileMemory::Device {
+    int fd = -1;  // kept open in device_fds_
+    std::size_t index = 0;
+    std::uint64_t capacity = 0;
+    std::string_view label;
+};
+
+// ---- devices ----
+
+FileMemory::FileMemory(const Profile& profile)
+    : profile_(profile), card_kbytes_(profile.memory_card_kbytes) {
+    if (profile.em_file_bank < profile.em_banks) em_bank_ = profile.em_file_bank;
+}
+
+FileMemory::~FileMemory() {
+    close_devices();
+    if (root_fd_ >= 0) ::close(root_fd_);
+    if (own_root_) {
+        std::error_code ec;
+        std::filesystem::remove_all(root_, ec);
+    }
+}
+
+void FileMemory::set_em_file_bank(std::optional<std::uint8_t> bank) noexcept {
+    em_bank_ = bank && *bank < profile_.em_banks ? bank : std::nullopt;
+}
+
+std::uint8_t FileMemory::em_non_file_banks() const noexcept {
+    return em_bank_ ? *em_bank_ : profile_.em_banks;
+}
+
+Result<void> FileMemory::attach(const std::filesystem::path& root) {
+    std::error_code ec;
+    std::filesystem::create_directories(root, ec);
+    const int fd = ::open(root.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd < 0) return Unexpected(std::error_code(errno, std::generic_category()));
+    close_devices();
+    if (root_fd_ >= 0) ::close(root_fd_);
+    if (own_root_) std::filesystem::remove_all(root_, ec);
+    root_fd_ = fd;
+    root_ = root;
+    own_root_ = false;
+    for (const char* device : {"card", "em"}) {
+        const Fd dir = host::open_directory(root_fd_, device);
+        if (dir.valid()) host::clear(dir.get(), true);
+    }
+    return {};
+}
+
+Result<void> FileMemory::ensure_root() {
+    if (root_fd_ >= 0) return {};
+    std::string pattern = (std::filesystem::temp_directory_path() / "finsd-files-XXXXXX").string();
+    if (::mkdtemp(pattern.data()) == nullptr)
+        return Unexpected(std::error_code(errno, std::generic_category()));
+    if (auto r = attach(pattern); !r) return r;
+    own_root_ = true;
+    return {};
+}
+
+Result<FileMemory::Device> FileMemory::open_device(std::uint16_t disk) {
+    Device d;
+    const char* dir = nullptr;
+    if (disk == disk_memory_card) {
+        if (!card_inserted()) return fail(EndCode::file_device_missing);
+        dir = "card";
+        d.index = 0;
+        d.capacity = std::uint64_t{card_kbytes_} * 1024;
+        d.label = "MEMCARD";
+    } else if (disk == disk_em_file) {
+        if (!em_bank_) return fail(EndCode::file_device_missing);
+        dir = "em";
+        d.index = 1;
+        d.capacity = static_cast<std::uint64_t>(profile_.em_banks - *em_bank_) * em_bank_bytes;
+        d.label = "EMFILE";
+    } else {
+        return fail(EndCode::parameter_error);
+    }
+    if (!ensure_root()) return fail(EndCode::memory_error);
+    // The device directory stays open: one openat per request less, and the bytes in use
+    // are counted once and then tracked (used()).
+    int& fd = device_fds_[d.index];
+    if (fd < 0) {
+        if (::mkdirat(root_fd_, dir, 0755) != 0 && errno != EEXIST)
+            return fail(EndCode::memory_error);
+        fd = host::open_directory(root_fd_, dir).release();
+        if (fd < 0) return fail(EndCode::memory_error);
+        used_[d.index].reset();
+        if (host::kind_of(fd, volume_file) == Kind::missing) {
+            const Fd v(
+                ::openat(fd, volume_file, O_WRONLY | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0644));
+            host::set_mtime(fd, volume_file, Clock::host_local(std::chrono::system_clock::now()));
+        }
+    }
+    d.fd = fd;
+    return d;
+}
+
+void FileMemory::close_devices() noexcept {
+    for (std::size_t i = 0; i < 2; ++i) {
+        if (device_fds_[i] >= 0) ::close(device_fds_[i]);
+        device_fds_[i] = -1;
+        used_[i].reset();
+    }
+}
+
+std::uint64_t FileMemory::bytes_in_use(const Device& d) {
+    auto& used = used_[d.index];
+    if (!used) used = host::used_bytes(d.fd);
+    return *used;
+}
+
+// ---- 22 01 ----
+
+Result<FileNameReadResponse> FileMemory::list(const FileNameRead& c) {
+    if (c.count > max_file_entries) return fail(EndCode::parameter_error);
+    const auto path = parse_directory(c.directory);
+    if (!path) return fail(EndCode::parameter_error);
+    auto device = open_device(c.disk);
+    if (!device) return Unexpected(device.error());
+    const Fd dir = host::open_path(device->fd, *path);
+    if (!dir.valid()) return fail(EndCode::read_file_missing);
+
+    std::vector<FileEntry> all;
+    if (!path->empty()) {
+        struct stat st {};
+        ::fstat(dir.get(), &st);
+        all.push_back(dot_entry(".", st));
+        all.push_back(dot_entry("..", st));
+    }
+    for (const auto& e :
+         host::entries(dir.get(), [](std::string_view n) { return FileMemory::visible(n); }))
+        all.push_back(entry_of(e.name, e.info, e.kind == Kind::directory));
+
+    FileNameReadResponse r;
+    r.disk.volume_label = *FileName::from(device->label);
+    struct stat volume {};
+    if (::fstatat(device->fd, volume_file, &volume, AT_SYMLINK_NOFOLLOW) == 0)
+        r.disk.date = date_of(volume.st_mtime);
+    const auto used = bytes_in_use(*device);
+    r.disk.total_capacity =
+        static_cast<std::uint32_t>(std::min<std::uint64_t>(device->capacity, 0xFFFFFFFF));
+    r.disk.free_capacity = static_cast<std::uint32_t>(
+        std::min<std::uint64_t>(device->capacity - std::min(used, device->capacity), 0xFFFFFFFF));
+    r.disk.total_files = static_cast<std::uint16_t>(std::min<std::size_t>(all.size(), 0x7FFF));
+    const std::size_t first = std::min<std::size_t>(c.first, all.size());
+    const std::size_t end = std::min<std::size_t>(first + c.count, all.size());
+    r.files.assign(all.begin() + static_cast<std::ptrdiff_t>(first),
+                   all.begin() + static_cast<std::ptrdiff_t>(end));
+    r.last = end == all.size() && c.count != 0;
+    return r;
+}
+
+// ---- 22 02 ----
+
+Result<SingleFileReadResponse> FileMemory::read(const SingleFileRead& c) {
+    const auto name = canonical_name(c.file);
+    const auto path = parse_directory(c.directory);
+    if (!name || !path || c.length > max_file_read_bytes) return fail(EndCode::parameter_error);
+    auto device = open_device(c.disk);
+    if (!device) return Unexpected(device.error());
+    const Fd dir = host::open_path(device->fd, *path);
+    if (!dir.valid()) return fail(EndCode::read_file_missing);
+    const Fd fd(::openat(dir.get(), name->c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC));
+    struct stat st {};
+    if (!fd.valid() || ::fstat(fd.get(), &st) != 0 || !S_ISREG(st.st_mode))
+        return fail(EndCode::read_file_missing);
+    const auto size = static_cast<std::uint64_t>(st.st_size);
+    if (c.position > size) return fail(EndCode::address_range_error);
+    const auto n = static_cast<std::size_t>(std::min<std::uint64_t>(c.length, size - c.position));
+    SingleFileReadResponse r;
+    r.file_size = static_cast<std::uint32_t>(std::min<std::uint64_t>(size, 0xFFFFFFFF));
+    r.position = c.position;
+    r.data.resize(n);
+    std::size_t done = 0;
+    while (done < n) {
+        const auto got = ::pread(fd.get(), r.data.data() + done, n - done,
+                                 static_cast<off_t>(c.position + done));
+        if (got < 0 && errno == EINTR) continue;
+        if (got <= 0) return fail(EndCode::memory_error);
+        done += static_cast<std::size_t>(got);
+    }
+    r.last = c.position + n == size;
+    return r;
+}
+
+// ---- 22 03 ----
+
+EndCode FileMemory::write(const SingleFileWrite& c, CivilSeconds now) {
+    const auto name = canonical_name(c.file);
+    const auto path = parse_directory(c.directory);
+    if (!name || !path || c.mode > static_cast<std::uint16_t>(FileWriteMode::overwrite))
+        return EndCode::parameter_error;
+    const auto mode = static_cast<FileWriteMode>(c.mode);
+    // 5-3-34: "To create a new file or add data to an existing file, specify 00000000".
+    if (mode != FileWriteMode::overwrite && c.position != 0) return EndCode::parameter_error;
+    auto device = open_device(c.disk);
+    if (!device) return EndCode{static_cast<std::uint16_t>(device.error().value())};
+    const Fd dir = host::open_path(device->fd, *path);
+    if (!dir.valid()) return EndCode::write_file_missing;
+    struct stat st {};
+    const auto kind = host::kind_of(dir.get(), *name, &st);
+    if (kind != Kind::missing && kind != Kind::file) return EndCode::file_name_exists;
+    const bool exists = kind == Kind::file;
+    const std::uint64_t old_size = exists ? static_cast<std::uint64_t>(st.st_size) : 0;
+
+    std::uint64_t offset = 0;
+    switch (mode) {
+        case FileWriteMode::create:
+            if (exists) return EndCode::file_name_exists;
+            break;
+        case FileWriteMode::create_or_replace:
+            break;
+        case FileWriteMode::append:
+            if (!exists) return EndCode::write_file_missing;
+            offset = old_size;
+            break;
+        case FileWriteMode::overwrite:
+            if (!exists) return EndCode::write_file_missing;
+            if (c.position > old_size) return EndCode::address_range_error;
+            offset = c.position;
+            break;
+    }
+    const bool replacing =
+        mode == FileWriteMode::create || mode == FileWriteMode::create_or_replace;
+    const std::uint64_t end = offset + c.data.size();
+    if (end > 0xFFFFFFFF) return EndCode::address_range_exceeded;
+    const std::uint64_t new_size = replacing ? c.data.size() : std::max(old_size, end);
+    const auto used = bytes_in_use(*device);
+    if (new_size > old_size && used + (new_size - old_size) > device->capacity)
+        return EndCode::address_range_exceeded;
+
+    bool ok = false;
+    if (replacing) {
+        ok = host::replace(dir.get(), *name, c.data, now, temp_counter_);
+    } else if (offset == old_size) {
+        // Only adds bytes: nothing already in the file can be half-changed.
+        ok = host::write_at(dir.get(), *name, offset, c.data, now);
+    } else {
+        auto content = host::read_all(dir.get(), *name);
+        if (!content) return EndCode::memory_error;
+        content->resize(static_cast<std::size_t>(new_size));
+        std::copy(c.data.begin(), c.data.end(),
+                  content->begin() + static_cast<std::ptrdiff_t>(offset));
+        ok = host::replace(dir.get(), *name, *content, now, temp_counter_);
+    }
+    if (!ok) return EndCode::memory_error;
+    used_[device->index] = (used >= old_size ? used - old_size : 0) + new_size;
+    return EndCode::normal_completion;
+}
+
+// ---- 22 04 ----
+
+EndCode FileMemory::format(std::uint16_t disk, std::uint8_t current_em_bank, CivilSeconds now) {
+    if (disk == disk_em_file && em_bank_ && current_em_bank >= *em_bank_ && current_em_bank != 0)
+        return EndCode::area_classification_missing;
+    auto device = open_device(disk);
+    if (!device) return EndCode{static_cast<std::uint16_t>(device.error().value())};
+    used_[device->index].reset();
+    if (!host::clear(device->fd, false)) return EndCode::memory_error;
+    const Fd v(
+        ::openat(device->fd, volume_file, O_WRONLY | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0644));
+    host::set_mtime(device->fd, volume_file, now);
+    return EndCode::normal_completion;
+}
+
+// ---- 22 05 ----
+
+Result<std::uint16_t> FileMemory::remove(const FileDelete& c) {
+    const auto path = parse_directory(c.directory);
+    if (!path) return fail(EndCode::parameter_error);
+    std::vector<std::string> names;
+    for (const auto& f : c.files) {
+        auto name = canonical_name(f);
+        if (!name) return fail(EndCode::parameter_error);
+        names.push_back(std::move(*name));
+    }
+    auto device = open_device(c.disk);
+    if (!device) return Unexpected(device.error());
+    const Fd dir = host::open_path(device->fd, *path);
+    if (!dir.valid()) return fail(EndCode::write_file_missing);
+    used_[device->index].reset();
+    std::uint16_t deleted = 0;
+    // 5-3-36: names that do not exist are ignored; so are directories (22 15 removes those).
+    for (const auto& name : names)
+        if (host::kind_of(dir.get(), name) == Kind::file &&
+            ::unlinkat(dir.get(), name.c_str(), 0) == 0)
+            ++deleted;
+    return deleted;
+}
+
+// ---- 22 07 ----
+
+EndCode FileMemory::copy(const FileCopy& c) {
+    const auto from = canonical_name(c.source);
+    const auto to = canonical_name(c.destination);
+    const auto from_path = parse_directory(c.source_directory);
+    const auto to_path = parse_directory(c.destination_directory);
+    if (!from || !to || !from_path || !to_path) return EndCode::parameter_error;
+    auto source = open_device(c.source_disk);
+    if (!source) return EndCode{static_cast<std::uint16_t>(source.error().value())};
+    auto target = open_device(c.destination_disk);
+    if (!target) return EndCode{static_cast<std::uint16_t>(target.error().value())};
+    const Fd from_dir = host::open_path(source->fd, *from_path);
+    struct stat st {};
+    if (!from_dir.valid() || host::kind_of(from_dir.get(), *from, &st) != Kind::file)
+        return EndCode::read_file_missing;
+    const Fd to_dir = host::open_path(target->fd, *to_path);
+    if (!to_dir.valid()) return EndCode::write_file_missing;
+    if (host::kind_of(to_dir.get(), *to) != Kind::missing) return EndCode::file_name_exists;
+    const auto content = host::read_all(from_dir.get(), *from);
+    if (!content) return EndCode::memory_error;
+    const auto used = bytes_in_use(*target);
+    if (used + content->size() > target->capacity) return EndCode::address_range_exceeded;
+    // 5-3-37: "The copy destination file is given the same date as the copy source file."
+    if (!host::replace(to_dir.get(), *to, *content, st.st_mtime, temp_counter_))
+        return EndCode::memory_error;
+    used_[target->index] = used + content->size();
+    return EndCode::normal_completion;
+}
+
+// ---- 22 08 ----
+
+EndCode FileMemory::rename(const FileNameChange& c) {
+    const auto from = canonical_name(c.old_name);
+    const auto to = canonical_name(c.new_name);
+    const auto path = parse_directory(c.directory);
+    if (!from || !to || !path) return EndCode::parameter_error;
+    auto device = open_device(c.disk);
+    if (!device) return EndCode{static_cast<std::uint16_t>(device.error().value())};
+    const Fd dir = host::open_path(device->fd, *path);
+    if (!dir.valid()) return EndCode::write_file_missing;
+    const auto kind = host::kind_of(dir.get(), *from);
+    if (kind != Kind::file && kind != Kind::directory) return EndCode::write_file_missing;
+    if (*from == *to) return EndCode::file_name_exists;
+    if (host::kind_of(dir.get(), *to) != Kind::missing) return EndCode::file_name_exists;
+    // renameat keeps the date (5-3-38 "the date of the file will remain unchanged").
+    if (::renameat(dir.get(), from->c_str(), dir.get(), to->c_str()) != 0)
+        return EndCode::memory_error;
+    ::fsync(dir.get());
+    return EndCode::normal_completion;
+}
+
+// ---- 22 15 ----
+
+EndCode FileMemory::directory(const DirectoryCreateDelete& c, CivilSeconds now) {
+    const auto name = canonical_name(c.directory_name);
+    const auto path = parse_directory(c.parent);
+    if (!name || !path || c.operation > static_cast<std::uint16_t>(DirectoryOperation::remove))
+        return EndCode::parameter_error;
+    auto device = open_device(c.disk);
+    if (!device) return EndCode{static_cast<std::uint16_t>(device.error().value())};
+    const Fd dir = host::open_path(device->fd, *path);
+    if (!dir.valid()) return EndCode::write_file_missing;
+    const auto kind = host::kind_of(dir.get(), *name);
+    if (c.operation == static_cast<std::uint16_t>(DirectoryOperation::create)) {
+        if (kind != Kind::missing) return EndCode::file_name_exists;
+        if (path->size() >= max_file_directories) return EndCode::cannot_register;
+        if (::mkdirat(dir.get(), name->c_str(), 0755) != 0) return EndCode::memory_error;
+        host::set_mtime(dir.get(), name->c_str(), now);
+        ::fsync(dir.get());
+        return EndCode::normal_completion;
+    }
+    if (kind != Kind::directory) return EndCode::write_file_missing;
+    if (::unlinkat(dir.get(), name->c_str(), AT_REMOVEDIR) != 0)
+        return errno == ENOTEMPTY || errno == EEXIST ? EndCode::cannot_change
+                                                     : EndCode::memory_error;
+    return EndCode::normal_completion;
+}
+
+// ---- whole files for 22 0A .. 22 0C ----
+
+Result<std::vector<std::uint8_t>> FileMemory::load(std::uint16_t disk, const FileName& file,
+                                                   const std::string& directory) {
+    const auto name = canonical_name(file);
+    const auto path = parse_directory(directory);
+    if (!name || !path) return fail(EndCode::parameter_error);
+    auto device = open_device(disk);
+    if (!device) return Unexpected(device.error());
+    const Fd dir = host::open_path(device->fd, *path);
+    if (!dir.valid()) return fail(EndCode::read_file_missing);
+    auto content = host::read_all(dir.get(), *name);
+    if (!content) return fail(EndCode::read_file_missing);
+    return std::move(*content);
+}
+
+EndCode FileMemory::create(std::uint16_t disk, const FileName& file, const std::string& directory,
+                           Bytes content, CivilSeconds now) {
+    const auto name = canonical_name(file);
+    const auto path = parse_directory(directory);
+    if (!name || !path) return EndCode::parameter_error;
+    auto device = open_device(disk);
+    if (!device) return EndCode{static_cast<std::uint16_t>(device.error().value())};
+    const Fd dir = host::open_path(device->fd, *path);
+    if (!dir.valid()) return EndCode::write_file_missing;
+    if (host::kind_of(dir.get(), *name) != Kind::missing) return EndCode::file_name_exists;
+    const auto used = bytes_in_use(*device);
+    if (used + content.size() > device->capacity) return EndCode::address_range_exceeded;
+    if (!host::replace(dir.get(), *name, content, now, temp_counter_)) return EndCode::memory_error;
+    used_[device->index] = used + content.size();
+    return EndCode::normal_completion;
+}
+
+}  // namespace fins::plc

@@ -1,0 +1,126 @@
+// The file memory of a CS/CJ CPU Unit (W342 5-3-32 .. 5-3-42, frames-serial-files 4):
+// the memory card (disk 8000) and EM file memory (disk 8001), each a directory under
+// one root on the host (finsd: the data directory, else a private temporary directory
+// removed at exit): <root>/card and <root>/em.
+//
+// Safety: every name and path is checked against the CPU Unit's rules (8.3 names of
+// letters, digits and ! & $ # ' { } - ^ ( ) _ ~; no "~~" start, no 00/E5 first byte, no
+// DOS device names; paths "\A\B" of at most 65 characters and 4 directories below the
+// root) before any host call, and the host is then walked one component at a time with
+// openat(O_NOFOLLOW): a symlink planted in a device directory is never followed. Names are
+// case-insensitive and stored upper case (FAT convention; the seed does not say); host
+// entries that are not valid upper-case 8.3 names (".volume", temp files, "foo.txt")
+// are invisible to FINS.
+//
+// Durability: a write that creates or replaces bytes of a file goes to a temp file in
+// the same directory, is fsync'ed and renamed over the old one (directory fsync'ed): old
+// or new content, never a mix. A write that only extends a file (append, or 0003 at the
+// file's end) is one pwrite into the page cache, so an acknowledged write survives
+// SIGKILL of finsd. Capacity is the device's size (card: kilobytes from the profile or
+// config; EM: 64 KiB per file bank); the file bytes in use are counted, and a write that
+// would exceed it answers 1104 and changes nothing.
+//
+// End codes (choices where the seed only names the code, pinned by tests/plc and
+// tests/server file_memory tests): 110C bad name, path, disk number, mode or count;
+// 2301 device missing (card not inserted, EM not configured as file memory); 2006 file
+// or directory missing on a read, 2106 on a write; 2107 name exists; 2108 directory not
+// empty; 2103 directory depth limit; 1103 position past the file's end; 1104 capacity
+// or 32-bit size exceeded; 250F a host I/O error.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "fins/commands/file_memory.hpp"
+#include "fins/error.hpp"
+#include "plc/clock.hpp"
+#include "plc/profile.hpp"
+
+namespace fins::plc {
+
+// EM file memory: one bank of 32,768 words = 64 KiB of file space.
+inline constexpr std::uint32_t em_bank_bytes = 32768 * 2;
+// 5-3-39 .. 5-3-41 data files (.IOM, .STD, .OBJ) start with a 48-byte header
+// (CJ2SW p.269/272); finskit writes zeros there and skips it on load.
+inline constexpr std::size_t data_file_header_size = 48;
+// Directories below the root: 5 levels counting the root (CJ2SW p.271).
+inline constexpr std::size_t max_file_directories = 4;
+
+class FileMemory {
+  public:
+    explicit FileMemory(const Profile& profile);
+    ~FileMemory();
+    FileMemory(const FileMemory&) = delete;
+    FileMemory& operator=(const FileMemory&) = delete;
+
+    // Keeps the devices under `root` (created if missing) and removes temp files a
+    // killed finsd left behind. Without attach(), the first file access creates a
+    // private temporary root that the destructor removes.
+    Result<void> attach(const std::filesystem::path& root);
+    [[nodiscard]] std::filesystem::path root() const { return root_; }
+
+    // The memory card: inserted with a capacity, or not (2301).
+    [[nodiscard]] bool card_inserted() const noexcept { return card_kbytes_ != 0; }
+    [[nodiscard]] std::uint32_t card_kbytes() const noexcept { return card_kbytes_; }
+    void insert_card(std::uint32_t kbytes) noexcept { card_kbytes_ = kbytes; }
+    void remove_card() noexcept { card_kbytes_ = 0; }
+    // The first EM bank that is file memory; nullopt (or >= the profile's banks): none.
+    [[nodiscard]] std::optional<std::uint8_t> em_file_bank() const noexcept { return em_bank_; }
+    void set_em_file_bank(std::optional<std::uint8_t> bank) noexcept;
+    // 05 01 "EM non-file memory size": banks before the file banks.
+    [[nodiscard]] std::uint8_t em_non_file_banks() const noexcept;
+
+    // The commands (validated in full before anything changes). `now` is the CPU Unit's
+    // clock, recorded as the date of what they create (5-3-34, 5-3-39 .. 5-3-42).
+    Result<FileNameReadResponse> list(const FileNameRead& command);
+    Result<SingleFileReadResponse> read(const SingleFileRead& command);
+    EndCode write(const SingleFileWrite& command, CivilSeconds now);
+    // 22 04. `current_em_bank`: 1101 when EM is formatted while the current bank is a
+    // file bank other than EM0 (5-3-35 note).
+    EndCode format(std::uint16_t disk, std::uint8_t current_em_bank, CivilSeconds now);
+    Result<std::uint16_t> remove(const FileDelete& command);
+    EndCode copy(const FileCopy& command);
+    EndCode rename(const FileNameChange& command);
+    EndCode directory(const DirectoryCreateDelete& command, CivilSeconds now);
+
+    // Whole files for 22 0A .. 22 0C: load (2006 missing) and create (2107 exists, 1104 full).
+    Result<std::vector<std::uint8_t>> load(std::uint16_t disk, const FileName& file,
+                                           const std::string& directory);
+    EndCode create(std::uint16_t disk, const FileName& file, const std::string& directory,
+                   Bytes content, CivilSeconds now);
+
+    // Name rules on text ("NAME.EXT"): the canonical upper-case host name, or nullopt.
+    static std::optional<std::string> canonical_name(std::string_view text);
+    // Name rules on the 12 wire bytes (padding included).
+    static std::optional<std::string> canonical_name(const FileName& name);
+    // Path rules: "\A\B" gives {"A", "B"} (canonical), "" and "\" the root; nullopt
+    // when the path breaks them. visible(): a host entry FINS may see (canonical as is).
+    static std::optional<std::vector<std::string>> parse_directory(std::string_view path);
+    static bool visible(std::string_view name);
+
+    struct Device;
+
+  private:
+    Result<Device> open_device(std::uint16_t disk);
+    Result<void> ensure_root();
+    void close_devices() noexcept;
+    // File bytes on the device: counted at first use, then tracked by every change made
+    // here (recounted after 22 04 / 22 05); temp files of a replace in progress excluded.
+    std::uint64_t bytes_in_use(const Device& d);
+
+    const Profile& profile_;
+    std::filesystem::path root_;
+    int root_fd_ = -1;
+    bool own_root_ = false;
+    std::uint32_t card_kbytes_ = 0;
+    std::optional<std::uint8_t> em_bank_;
+    unsigned temp_counter_ = 0;
+    int device_fds_[2] = {-1, -1};  // card, em
+    std::optional<std::uint64_t> used_[2];
+};
+
+}  // namespace fins::plc

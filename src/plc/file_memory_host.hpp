@@ -1,0 +1,73 @@
+// Private to plc::FileMemory: the host side of the file devices. Every helper works on
+// directory file descriptors and single, already-checked name components; none takes
+// a path with a separator, and none follows a symlink (O_NOFOLLOW, AT_SYMLINK_NOFOLLOW).
+#pragma once
+
+#include <sys/stat.h>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "fins/byte_io.hpp"
+#include "fins/error.hpp"
+
+namespace fins::plc::host {
+
+// An owned file descriptor.
+class Fd {
+  public:
+    Fd() = default;
+    explicit Fd(int fd) noexcept : fd_(fd) {}
+    ~Fd();
+    Fd(Fd&& other) noexcept : fd_(other.release()) {}
+    Fd& operator=(Fd&& other) noexcept;
+    Fd(const Fd&) = delete;
+    Fd& operator=(const Fd&) = delete;
+    [[nodiscard]] int get() const noexcept { return fd_; }
+    [[nodiscard]] bool valid() const noexcept { return fd_ >= 0; }
+    int release() noexcept {
+        const int fd = fd_;
+        fd_ = -1;
+        return fd;
+    }
+
+  private:
+    int fd_ = -1;
+};
+
+enum class Kind : std::uint8_t { missing, file, directory, other };
+
+struct Entry {
+    std::string name;
+    Kind kind = Kind::other;
+    struct stat info {};
+};
+
+// lstat-like, relative to `dir`.
+Kind kind_of(int dir, const std::string& name, struct stat* info = nullptr) noexcept;
+// Opens the sub-directory `name` of `dir` (O_DIRECTORY | O_NOFOLLOW); invalid when absent.
+Fd open_directory(int dir, const std::string& name) noexcept;
+// Walks `components` from `dir`; invalid when one is missing or not a directory.
+Fd open_path(int dir, const std::vector<std::string>& components) noexcept;
+// The entries of `dir` whose names `visible` accepts, sorted by name.
+std::vector<Entry> entries(int dir, bool (*visible)(std::string_view name));
+// Bytes of regular files below `dir` (hidden names included: temp files take room too).
+std::uint64_t used_bytes(int dir, int depth = 0) noexcept;
+// Removes everything below `dir`; with `only_temps`, only entries named ".tmp-*".
+bool clear(int dir, bool only_temps, int depth = 0) noexcept;
+// Whole regular file `name` (nullopt: missing or not a regular file, or unreadable).
+std::optional<std::vector<std::uint8_t>> read_all(int dir, const std::string& name);
+// Writes `content` to a new temp file in `dir`, fsyncs it, dates it `mtime`, renames it
+// to `name` (replacing) and fsyncs `dir`. False on any host error (the temp is removed).
+bool replace(int dir, const std::string& name, Bytes content, std::int64_t mtime,
+             unsigned& counter) noexcept;
+// pwrite of `data` at `offset` into the existing regular file `name`, then dates it.
+bool write_at(int dir, const std::string& name, std::uint64_t offset, Bytes data,
+              std::int64_t mtime) noexcept;
+// Sets the modification time of `name` (not following symlinks).
+bool set_mtime(int dir, const char* name, std::int64_t mtime) noexcept;
+
+}  // namespace fins::plc::host

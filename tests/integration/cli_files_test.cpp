@@ -1,0 +1,174 @@
+// `fins files` against a real finsd (W342 5-3-32 .. 5-3-42): a file copied from the
+// card to the host and back is byte-identical, every verb's output, JSON and exit code
+// (0 ok, 2 usage, 4 end code); and a file being replaced by 22 03 while finsd is
+// SIGKILLed holds the old or the new content, never a mix.
+#include <signal.h>
+
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "fins/commands/file_memory.hpp"
+#include "finsd_run.hpp"
+
+namespace fins::test {
+namespace {
+
+const std::string fins_bin = std::string(FINS_BIN_DIR) + "/fins";
+
+RunResult fins(const Finsd& d, std::vector<std::string> args) {
+    std::vector<std::string> argv{fins_bin, "--port", std::to_string(d.port()), "--timeout", "5"};
+    argv.insert(argv.end(), args.begin(), args.end());
+    return run(argv);
+}
+
+std::string slurp(const std::filesystem::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), {}};
+}
+
+std::string random_bytes(std::size_t n, unsigned seed) {
+    std::mt19937 gen(seed);
+    std::string s(n, '\0');
+    for (auto& c : s)
+        c = static_cast<char>(gen());
+    return s;
+}
+
+TEST(CliFiles, W342_5_3_33_PutGetRoundTripIsByteIdentical) {
+    ScratchDir dir("cli-files");
+    Finsd d({"--data-dir", (dir.path() / "data").string()});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    const std::string content = random_bytes(100'000, 7);
+    const auto local = dir.write("in.bin", content);
+    auto r = fins(d, {"files", "put", local, "/DATA.BIN"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(r.out, "put DATA.BIN (100000 bytes)\n");
+    const auto back = (dir.path() / "back.bin").string();
+    r = fins(d, {"files", "get", "card:\\data.bin", back});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(slurp(back), content);
+    // The device directory holds the same bytes.
+    EXPECT_EQ(slurp(dir.path() / "data/card/DATA.BIN"), content);
+    // Put again without --force: 2107, exit 4; with --force it replaces.
+    r = fins(d, {"files", "put", local, "/DATA.BIN"});
+    EXPECT_EQ(r.exit_code, 4);
+    EXPECT_NE(r.err.find("2107"), std::string::npos) << r.err;
+    const auto small = dir.write("small.bin", "small");
+    EXPECT_EQ(fins(d, {"files", "put", "--force", small, "/DATA.BIN"}).exit_code, 0);
+    EXPECT_EQ(slurp(dir.path() / "data/card/DATA.BIN"), "small");
+}
+
+TEST(CliFiles, W342_5_3_32_EveryVerbWithJsonAndExitCodes) {
+    ScratchDir dir("cli-files-verbs");
+    Finsd d({"--data-dir", (dir.path() / "data").string()});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    EXPECT_EQ(fins(d, {"files", "mkdir", "/LOGS"}).exit_code, 0);
+    const auto local = dir.write("a.txt", "hello");
+    EXPECT_EQ(fins(d, {"files", "put", local, "/LOGS/A.TXT"}).exit_code, 0);
+    auto r = fins(d, {"--json", "files", "ls", "/LOGS"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    auto j = nlohmann::json::parse(r.out);
+    ASSERT_EQ(j["files"].size(), 3U);  // ".", "..", A.TXT
+    EXPECT_EQ(j["files"][2]["name"], "A.TXT");
+    EXPECT_EQ(j["files"][2]["size"], 5);
+    EXPECT_EQ(j["volume"], "MEMCARD");
+    EXPECT_EQ(fins(d, {"files", "cp", "/LOGS/A.TXT", "/B.TXT"}).exit_code, 0);
+    EXPECT_EQ(fins(d, {"files", "mv", "/B.TXT", "C.TXT"}).exit_code, 0);
+    r = fins(d, {"--json", "files", "rm", "/C.TXT", "/NONE.TXT"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["deleted"], 1);
+    EXPECT_EQ(fins(d, {"files", "rmdir", "/LOGS"}).exit_code, 4);  // not empty: 2108
+    EXPECT_EQ(fins(d, {"files", "rm", "/LOGS/A.TXT"}).exit_code, 0);
+    EXPECT_EQ(fins(d, {"files", "rmdir", "/LOGS"}).exit_code, 0);
+    // save / compare / load of I/O memory, parameter area and program.
+    EXPECT_EQ(fins(d, {"files", "save", "D0", "/D.IOM", "10"}).exit_code, 0);
+    r = fins(d, {"--json", "files", "compare", "/D.IOM", "D0", "10"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["count"], 10);
+    EXPECT_EQ(fins(d, {"files", "save", "plc-setup", "/P.STD"}).exit_code, 0);
+    EXPECT_EQ(fins(d, {"files", "load", "/P.STD", "plc-setup"}).exit_code, 4);  // RUN: 2206
+    EXPECT_EQ(fins(d, {"files", "save", "program", "/P.OBJ"}).exit_code, 0);
+    // Usage errors exit 2 before anything is sent.
+    EXPECT_EQ(fins(d, {"files", "put", local, "/TOOLONGNAME.TXT"}).exit_code, 2);
+    EXPECT_EQ(fins(d, {"files", "save", "XYZ", "/Q.IOM", "1"}).exit_code, 2);
+    EXPECT_EQ(fins(d, {"files", "format", "card"}).exit_code, 2);  // needs --yes
+    // A missing file and a missing device: end codes, exit 4.
+    r = fins(d, {"files", "get", "/NONE.TXT", (dir.path() / "x").string()});
+    EXPECT_EQ(r.exit_code, 4);
+    EXPECT_NE(r.err.find("2006"), std::string::npos) << r.err;
+    EXPECT_EQ(fins(d, {"files", "ls", "em:"}).exit_code, 4);  // 2301
+    EXPECT_EQ(fins(d, {"files", "format", "card", "--yes"}).exit_code, 0);
+    r = fins(d, {"--json", "files", "ls"});
+    ASSERT_EQ(r.exit_code, 0);
+    EXPECT_TRUE(nlohmann::json::parse(r.out)["files"].empty());
+}
+
+// Content number i: 1,900 bytes, the first two i, the rest i mod 251.
+std::string version(std::size_t i) {
+    std::string s(1900, static_cast<char>(i % 251));
+    s[0] = static_cast<char>(i >> 8);
+    s[1] = static_cast<char>(i & 0xFF);
+    return s;
+}
+
+// W342 5-3-34 + the durability rule: 22 03 (0001) replacing a file while finsd
+// is SIGKILLed leaves one whole version, never a mix, and never one older than the
+// last acknowledged write.
+TEST(CliFiles, W342_5_3_34_SigkillDuringReplaceLeavesOldOrNew) {
+    ScratchDir dir("files-sigkill");
+    const auto data = (dir.path() / "data").string();
+    const auto name = *FileName::from("R.BIN");
+    constexpr std::size_t requests = 200;
+    std::vector<std::vector<std::uint8_t>> versions;
+    for (std::size_t i = 0; i < requests; ++i) {
+        const auto v = version(i);
+        versions.emplace_back(v.begin(), v.end());
+    }
+    for (std::size_t round = 0; round < 3; ++round) {
+        Finsd d({"--data-dir", data});
+        ASSERT_TRUE(d.started()) << d.result().err;
+        auto client = d.client();
+        ASSERT_TRUE(client);
+        std::size_t acknowledged = 0;
+        std::optional<std::size_t> last;
+        const std::size_t kill_after = 20 + round * 40;
+        // All in flight at once; the kill goes out from a completion while the rest are
+        // queued or being written, at a point the test does not choose.
+        for (std::size_t i = 0; i < requests; ++i)
+            client->async_send(SingleFileWrite{disk_memory_card, 1, name, 0, versions[i], ""},
+                               [&, i](Result<EmptyResponse> r) {
+                                   if (!r) return;
+                                   last = std::max(last.value_or(0), i);
+                                   if (++acknowledged == kill_after) ::kill(d.pid(), SIGKILL);
+                               });
+        client->run();
+        d.stop(SIGKILL);
+        ASSERT_TRUE(last.has_value());
+        const std::string on_disk = slurp(dir.path() / "data/card/R.BIN");
+        ASSERT_EQ(on_disk.size(), 1900U) << "round " << round;
+        const auto n = (static_cast<std::size_t>(static_cast<unsigned char>(on_disk[0])) << 8) |
+                       static_cast<unsigned char>(on_disk[1]);
+        ASSERT_LT(n, requests);
+        EXPECT_EQ(on_disk, version(n)) << "round " << round << ": a mix of versions";
+        EXPECT_GE(n, *last) << "round " << round << ": an acknowledged write was lost";
+    }
+    // A restarted finsd serves the file and leaves no temp file behind.
+    Finsd d({"--data-dir", data});
+    ASSERT_TRUE(d.started());
+    auto client = d.client();
+    const auto r = client->send(SingleFileRead{disk_memory_card, name, 0, 1900, ""});
+    ASSERT_TRUE(r) << r.error().message();
+    EXPECT_EQ(r->data.size(), 1900U);
+    for (const auto& e : std::filesystem::directory_iterator(dir.path() / "data/card"))
+        EXPECT_FALSE(e.path().filename().string().starts_with(".tmp-")) << e.path();
+}
+
+}  // namespace
+}  // namespace fins::test
