@@ -90,3 +90,4 @@ if(FINS_DOCS)
     COMPONENT dev)
 endif()
 
+include(${CMAKE_CURRENT_LIST_DIR}/FinsCPack.cmake)
