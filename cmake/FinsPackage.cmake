@@ -90,4 +90,18 @@ if(FINS_DOCS)
     COMPONENT dev)
 endif()
 
+# The finskit Python module (python/): on by default when pybind11 and the Python
+# headers are found, off in sanitizer and fuzz builds (an instrumented extension cannot
+# be loaded into an uninstrumented interpreter).
+find_package(Python3 3.9 QUIET COMPONENTS Interpreter Development.Module)
+find_package(pybind11 CONFIG QUIET)
+set(fins_python_default OFF)
+if(Python3_FOUND AND pybind11_FOUND AND NOT FINS_SANITIZE AND NOT FINS_FUZZ)
+  set(fins_python_default ON)
+endif()
+option(FINS_PYTHON "Build the finskit Python module (pybind11)" ${fins_python_default})
+if(FINS_PYTHON)
+  add_subdirectory(${PROJECT_SOURCE_DIR}/python ${PROJECT_BINARY_DIR}/python)
+endif()
+
 include(${CMAKE_CURRENT_LIST_DIR}/FinsCPack.cmake)
