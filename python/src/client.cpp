@@ -13,6 +13,7 @@
 
 #include "errors.hpp"
 #include "fins/client.hpp"
+#include "fins/commands/clock.hpp"
 #include "fins/commands/diagnostics.hpp"
 #include "fins/commands/memory_area.hpp"
 #include "fins/commands/operating_mode.hpp"
@@ -178,6 +179,33 @@ class Client {
         return value_or_throw(c().send(fins::CpuUnitStatusRead{}), "06 01 CPU UNIT STATUS READ");
     }
 
+    // 07 01 CLOCK READ: the PLC's local time as a naive datetime.datetime.
+    py::object clock() {
+        fins::ClockTime t;
+        {
+            py::gil_scoped_release unlocked;
+            t = value_or_throw(c().send(fins::ClockRead{}), "07 01 CLOCK READ").time;
+        }
+        return py::module_::import("datetime")
+            .attr("datetime")(fins::full_year(t.year), t.month, t.day, t.hour, t.minute, t.second);
+    }
+    // 07 02 CLOCK WRITE (years 1998-2097, W342 5-3-19), day of week from the date.
+    void set_clock(const py::object& when) {
+        const int year = when.attr("year").cast<int>();
+        if (year < 1998 || year > 2097) throw BadArgument("the PLC clock holds years 1998-2097");
+        fins::ClockWrite w;
+        w.year = static_cast<std::uint8_t>(year % 100);
+        w.month = when.attr("month").cast<std::uint8_t>();
+        w.day = when.attr("day").cast<std::uint8_t>();
+        w.hour = when.attr("hour").cast<std::uint8_t>();
+        w.minute = when.attr("minute").cast<std::uint8_t>();
+        w.second = when.attr("second").cast<std::uint8_t>();
+        // Python: Monday 0 .. Sunday 6; FINS: Sunday 0 .. Saturday 6.
+        w.day_of_week = static_cast<std::uint8_t>((when.attr("weekday")().cast<int>() + 1) % 7);
+        py::gil_scoped_release unlocked;
+        value_or_throw(c().send(w), "07 02 CLOCK WRITE");
+    }
+
   private:
     std::unique_ptr<fins::Client> client_;
 };
@@ -241,7 +269,10 @@ void register_client(py::module_& m) {
              "The end code is returned, not raised.")
         .def("run", &Client::run, py::arg("monitor") = false, release(), "04 01 RUN.")
         .def("stop", &Client::stop, release(), "04 02 STOP (PROGRAM mode).")
-        .def("status", &Client::status, release(), "06 01 CPU UNIT STATUS READ.");
+        .def("status", &Client::status, release(), "06 01 CPU UNIT STATUS READ.")
+        .def("clock", &Client::clock, "07 01 CLOCK READ: a naive datetime (PLC local time).")
+        .def("set_clock", &Client::set_clock, py::arg("when"),
+             "07 02 CLOCK WRITE from a datetime (seconds and day of week included).");
 }
 
 }  // namespace finskit

@@ -94,6 +94,17 @@ def test_controller_commands(client):
     assert status.mode == "run" and status.running
 
 
+def test_clock_write_then_read(client):
+    import datetime
+    client.set_clock(datetime.datetime(2031, 5, 17, 8, 30, 12))
+    now = client.clock()
+    # The virtual clock keeps running from what was written.
+    assert datetime.datetime(2031, 5, 17, 8, 30, 12) <= now
+    assert now - datetime.datetime(2031, 5, 17, 8, 30, 12) < datetime.timedelta(seconds=30)
+    with pytest.raises(ValueError):
+        client.set_clock(datetime.datetime(2100, 1, 1))
+
+
 def test_timeout_raises_timeout_error():
     # A bound UDP socket that never answers: each attempt waits 50 ms.
     import socket
