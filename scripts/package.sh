@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds the installable finskit (Release tree build-pkg, prefix /usr): libfins, finsd,
 # fins, the examples and the finskit Python module, then the Debian package with CPack.
-# Usage: scripts/package.sh            build + .deb (build-pkg/finskit_<version>_<arch>.deb)
+# Usage: scripts/package.sh            build + the .debs in build-pkg: finskit, libfins0.1,
+#                                      libfins-dev, python3-finskit
 #        scripts/package.sh --install-test
 #            also installs the .deb with apt, starts finsd from the installed files with
 #            the unit's ExecStart line (no systemd needed), reads and writes through the
@@ -16,8 +17,9 @@ if [[ -x /usr/bin/python3 ]]; then args+=(-DPython3_EXECUTABLE=/usr/bin/python3)
 if command -v ccache >/dev/null; then args+=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
 cmake -S "$root" -B "$build" -G Ninja "${args[@]}" >/dev/null
 ninja -C "$build" -j "$jobs"
+rm -f "$build"/*.deb
 (cd "$build" && cpack -G DEB >/dev/null)
-deb=$(ls "$build"/finskit_*.deb)
-echo "package: $deb"
+debs=("$build"/*.deb)
+printf 'package: %s\n' "${debs[@]}"
 [[ "${1:-}" == --install-test ]] || exit 0
-"$root/scripts/package_test.sh" "$deb"
+"$root/scripts/package_test.sh" "${debs[@]}"

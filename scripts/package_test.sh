@@ -1,12 +1,15 @@
 #!/usr/bin/env bash
-# Installs the finskit .deb on this machine (root: CI), exercises what it installed and
-# purges it. No systemd needed: finsd is started with the unit's own ExecStart line
+# Installs the finskit .debs on this machine (root: CI), exercises what they installed
+# and purges them. No systemd needed: finsd is started with the unit's own ExecStart line
 # (plus --port 0, so a finsd already on 9600 does not matter), as systemd would after
-# creating the StateDirectory. Usage: scripts/package_test.sh PATH/finskit_*.deb
+# creating the StateDirectory. Usage: scripts/package_test.sh build-pkg/*.deb
 # Prints "package: N checks passed" last; exits non-zero on the first failure.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-deb=$(realpath "$1")
+debs=()
+for deb in "$@"; do debs+=("$(realpath "$deb")"); done
+packages=()
+for deb in "${debs[@]}"; do packages+=("$(dpkg-deb -f "$deb" Package)"); done
 source "$root/scripts/finsd_start.sh"
 sudo=""
 if [[ $(id -u) -ne 0 ]]; then sudo="sudo"; fi
@@ -15,11 +18,13 @@ check() { echo "  ok: $1"; passed=$((passed + 1)); }
 fail() { echo "FAILED: $1" >&2; exit 1; }
 
 export DEBIAN_FRONTEND=noninteractive
-if dpkg-query -W -f='${Status}' finskit 2>/dev/null | grep -q "install ok installed"; then
-  echo "finskit is already installed: refusing to replace it" >&2; exit 1
-fi
-$sudo apt-get install -y -qq --no-install-recommends "$deb" >/dev/null
-cleanup() { $sudo apt-get purge -y -qq finskit >/dev/null 2>&1 || true; }
+for package in "${packages[@]}"; do
+  if dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep "install ok installed" >/dev/null; then
+    echo "$package is already installed: refusing to replace it" >&2; exit 1
+  fi
+done
+$sudo apt-get install -y -qq --no-install-recommends "${debs[@]}" >/dev/null
+cleanup() { $sudo apt-get purge -y -qq "${packages[@]}" >/dev/null 2>&1 || true; }
 trap cleanup EXIT
 dpkg -L finskit | grep '^/usr/bin/finsd$' >/dev/null || fail "finsd installed"
 check "finsd installed"
@@ -74,10 +79,18 @@ PY
 fi
 pkg-config --exists fins && test -f /usr/lib/*/cmake/fins/finsConfig.cmake >/dev/null || fail "dev files"
 check "dev files"
+tmp=$(mktemp -d)
+# shellcheck disable=SC2046
+g++ $(pkg-config --cflags fins) "$root/examples/typed_command.cpp" -o "$tmp/typed_command" \
+  $(pkg-config --libs fins) || fail "build against the installed libfins-dev"
+ldd "$tmp/typed_command" | grep -E "libfins\.so\.[0-9.]+ => (/usr)?/lib/" >/dev/null || fail "libfins0.1 used"
+rm -rf "$tmp"
+check "a program builds against libfins-dev and runs on libfins0.1's SONAME"
 
-$sudo apt-get purge -y -qq finskit >/dev/null
+$sudo apt-get purge -y -qq "${packages[@]}" >/dev/null
 trap - EXIT
-for path in /usr/bin/finsd /usr/bin/fins "$unit" /etc/finskit /var/lib/finsd /usr/include/fins; do
+for path in /usr/bin/finsd /usr/bin/fins "$unit" /etc/finskit /var/lib/finsd /usr/include/fins \
+    /usr/lib/*/libfins.so* /usr/lib/python3/dist-packages/finskit; do
   if [[ -e "$path" ]]; then echo "left behind after purge: $path" >&2; exit 1; fi
 done
 check "purged cleanly"

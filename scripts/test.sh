@@ -67,7 +67,7 @@ n=$(grep -Eo '[0-9]+ passed' "$log" | tail -n 1 | grep -Eo '[0-9]+')
 summary+=("python: $n passed"); package_passed=$((package_passed + n))
 if [[ $(id -u) -eq 0 ]]; then
   echo "== package: install, run and purge the .deb"
-  "$root/scripts/package_test.sh" "$(ls "$root"/build-pkg/finskit_*.deb)" | tee "$log"
+  "$root/scripts/package_test.sh" "$root"/build-pkg/*.deb | tee "$log"
   n=$(grep -Eo 'package: [0-9]+ checks passed' "$log" | grep -Eo '[0-9]+')
   summary+=("deb: $n checks passed"); package_passed=$((package_passed + n))
 else
