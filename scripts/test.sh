@@ -59,7 +59,36 @@ for target in fuzz_frame fuzz_tcp fuzz_address fuzz_dispatch fuzz_session fuzz_f
 done
 summary+=("fuzz: $fuzz_ok targets ran clean")
 
+# ---- issue 11: the installable package. A Release tree (build-pkg, prefix /usr) with
+# libfins, finsd, fins, the examples, the finskit Python module and the API reference
+# (Doxygen, warnings as errors); consumers built against it installed in a temporary
+# prefix (CMake and pkg-config); the Python tests; the .deb installed, exercised and
+# purged (root only, as on CI).
+echo "== package: Release build, API reference, .deb"
+"$root/scripts/package.sh"
+package_passed=0
+echo "== package: consumers against the installed libfins"
+log=$(mktemp)
+"$root/scripts/consumers.sh" "$root/build-pkg" | tee "$log"
+n=$(grep -Eo 'consumers: [0-9]+ checks passed' "$log" | grep -Eo '[0-9]+')
+summary+=("consumers: $n checks passed"); package_passed=$((package_passed + n))
+echo "== package: Python tests (pytest)"
+python=$(sed -n 's/^Python3_EXECUTABLE:[A-Z]*=//p' "$root/build-pkg/CMakeCache.txt")
+PYTHONDONTWRITEBYTECODE=1 PYTHONPATH="$root/build-pkg/python" "${python:-python3}" -m pytest -q -p no:cacheprovider \
+  "$root/python/tests" | tee "$log"
+n=$(grep -Eo '[0-9]+ passed' "$log" | tail -n 1 | grep -Eo '[0-9]+')
+summary+=("python: $n passed"); package_passed=$((package_passed + n))
+if [[ $(id -u) -eq 0 ]]; then
+  echo "== package: install, run and purge the .deb"
+  "$root/scripts/package_test.sh" "$root"/build-pkg/*.deb | tee "$log"
+  n=$(grep -Eo 'package: [0-9]+ checks passed' "$log" | grep -Eo '[0-9]+')
+  summary+=("deb: $n checks passed"); package_passed=$((package_passed + n))
+else
+  summary+=("deb: not installed (needs root, as on CI)")
+fi
+rm -f "$log"
+
 echo "== summary"
 printf '%s\n' "${summary[@]}"
 asan_total=$(ctest --test-dir build-asan -N | grep -Eo 'Total Tests: [0-9]+' | grep -Eo '[0-9]+')
-echo "$((asan_total + soak_ok + fuzz_ok)) passed, 0 failed"
+echo "$((asan_total + soak_ok + fuzz_ok + ${package_passed:-0})) passed, 0 failed"

@@ -11,10 +11,10 @@
 #include <asio/ip/udp.hpp>
 #include <asio/steady_timer.hpp>
 
+#include "fins/node_address.hpp"
 #include "server/dispatcher.hpp"
 #include "server/tcp_session.hpp"
 #include "server/udp_session.hpp"
-#include "transport/transport.hpp"
 
 namespace fins::server {
 
@@ -22,7 +22,9 @@ std::uint8_t derive_node(const std::string& bind_address) noexcept {
     std::error_code ec;
     const auto ip = asio::ip::make_address(bind_address, ec);
     if (ec || ip.is_unspecified()) return 1;
-    const auto node = transport::node_from_address(ip);
+    // The same rule as the client's default destination (fins/node_address.hpp).
+    const auto node =
+        ip.is_v4() ? node_from_ip(ip.to_v4().to_bytes()) : node_from_ip(ip.to_v6().to_bytes());
     // .0 and .255 are not host numbers; a FINS node must be 1-254.
     return (node == 0 || node == 255) ? 1 : node;
 }

@@ -84,8 +84,7 @@ class Transport {
     CloseHandler on_error_;
 };
 
-// The FINS node number an IP address implies (frames section 2, automatic generation):
-// loopback -> 1; IPv4 (or IPv4-mapped IPv6) -> last octet; other IPv6 -> last byte.
+// fins::node_from_ip (fins/node_address.hpp, frames section 2) for an Asio address.
 std::uint8_t node_from_address(const asio::ip::address& address) noexcept;
 
 }  // namespace fins::transport

@@ -1,0 +1,107 @@
+# The installable libfins and everything `cmake --install` / CPack ship.
+#
+# libfins is the client side of finskit: the codec (include/fins/*, src/codec), the
+# transports and the client. It is built once, from the same objects the tests link,
+# as a shared library (fins::fins, SONAME libfins.so.<major>[.<minor> while 0.x]) and a
+# static one (fins::fins_static), both versioned by the one project(... VERSION). The
+# virtual PLC and its server (src/plc, src/server) stay internal: their API is not
+# stable yet; users get them as the finsd program and as finskit.VirtualPlc.
+include(GNUInstallDirs)
+include(CMakePackageConfigHelpers)
+
+set(fins_parts fins_codec fins_transport fins_client)
+set(fins_objects)
+foreach(part ${fins_parts})
+  set_target_properties(${part} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  list(APPEND fins_objects $<TARGET_OBJECTS:${part}>)
+endforeach()
+
+# 0.x releases break the ABI at every minor version, so the SONAME carries it.
+if(PROJECT_VERSION_MAJOR EQUAL 0)
+  set(FINS_SOVERSION ${PROJECT_VERSION_MAJOR}.${PROJECT_VERSION_MINOR})
+else()
+  set(FINS_SOVERSION ${PROJECT_VERSION_MAJOR})
+endif()
+
+add_library(fins_shared SHARED ${fins_objects})
+add_library(fins_static STATIC ${fins_objects})
+set_target_properties(fins_shared PROPERTIES OUTPUT_NAME fins EXPORT_NAME fins
+  VERSION ${PROJECT_VERSION} SOVERSION ${FINS_SOVERSION} LINKER_LANGUAGE CXX)
+set_target_properties(fins_static PROPERTIES OUTPUT_NAME fins EXPORT_NAME fins_static
+  LINKER_LANGUAGE CXX)
+foreach(lib fins_shared fins_static)
+  target_include_directories(${lib} PUBLIC
+    $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/include>
+    $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
+  target_compile_features(${lib} PUBLIC cxx_std_20)
+  # The public headers use tl::expected (fins::Result); fmt and threads are used inside.
+  target_link_libraries(${lib} PUBLIC tl::expected PRIVATE fmt::fmt Threads::Threads)
+endforeach()
+add_library(fins::fins ALIAS fins_shared)
+add_library(fins::fins_static ALIAS fins_static)
+
+set(FINS_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/fins)
+install(TARGETS fins_shared fins_static EXPORT finsTargets
+  LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT lib NAMELINK_COMPONENT dev
+  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT dev)
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/fins
+  DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} COMPONENT dev)
+install(EXPORT finsTargets NAMESPACE fins:: DESTINATION ${FINS_CMAKE_DIR} COMPONENT dev)
+configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/finsConfig.cmake.in
+  ${PROJECT_BINARY_DIR}/finsConfig.cmake INSTALL_DESTINATION ${FINS_CMAKE_DIR})
+# 0.x: only the same minor version is compatible (see FINS_SOVERSION).
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/finsConfigVersion.cmake
+  COMPATIBILITY SameMinorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/finsConfig.cmake ${PROJECT_BINARY_DIR}/finsConfigVersion.cmake
+  DESTINATION ${FINS_CMAKE_DIR} COMPONENT dev)
+
+# pkg-config: `pkg-config --cflags --libs fins` (add --static for libfins.a).
+file(RELATIVE_PATH FINS_PC_TO_PREFIX /prefix/${CMAKE_INSTALL_LIBDIR}/pkgconfig /prefix)
+configure_file(${PROJECT_SOURCE_DIR}/cmake/fins.pc.in ${PROJECT_BINARY_DIR}/fins.pc @ONLY)
+install(FILES ${PROJECT_BINARY_DIR}/fins.pc
+  DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig COMPONENT dev)
+
+install(TARGETS finsd fins RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
+install(FILES ${PROJECT_SOURCE_DIR}/README.md ${PROJECT_SOURCE_DIR}/docs/architecture.md
+  ${PROJECT_SOURCE_DIR}/docs/benchmarks.md DESTINATION ${CMAKE_INSTALL_DOCDIR} COMPONENT runtime)
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/examples/ DESTINATION ${CMAKE_INSTALL_DOCDIR}/examples
+  COMPONENT dev FILES_MATCHING PATTERN "*.cpp" PATTERN "*.toml" PATTERN "CMakeLists.txt")
+
+# The API reference (Doxygen, docs/api): `fins_docs`, built by default when Doxygen is
+# found (FINS_DOCS), installed with the docs.
+find_package(Doxygen QUIET)
+set(fins_docs_default OFF)
+if(DOXYGEN_FOUND AND NOT FINS_FUZZ)
+  set(fins_docs_default ON)
+endif()
+option(FINS_DOCS "Build the Doxygen API reference" ${fins_docs_default})
+if(FINS_DOCS)
+  find_package(Doxygen REQUIRED)
+  configure_file(${PROJECT_SOURCE_DIR}/cmake/Doxyfile.in ${PROJECT_BINARY_DIR}/Doxyfile @ONLY)
+  file(GLOB_RECURSE fins_public_headers CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/include/fins/*)
+  add_custom_command(OUTPUT ${PROJECT_BINARY_DIR}/api/html/index.html
+    COMMAND ${CMAKE_COMMAND} -E rm -rf ${PROJECT_BINARY_DIR}/api
+    COMMAND Doxygen::doxygen ${PROJECT_BINARY_DIR}/Doxyfile
+    DEPENDS ${fins_public_headers} ${PROJECT_SOURCE_DIR}/cmake/Doxyfile.in
+            ${PROJECT_SOURCE_DIR}/cmake/doxygen-filter.sh ${PROJECT_SOURCE_DIR}/docs/api/mainpage.md
+    COMMENT "Doxygen: libfins API reference" VERBATIM)
+  add_custom_target(fins_docs ALL DEPENDS ${PROJECT_BINARY_DIR}/api/html/index.html)
+  install(DIRECTORY ${PROJECT_BINARY_DIR}/api/html/ DESTINATION ${CMAKE_INSTALL_DOCDIR}/api
+    COMPONENT dev)
+endif()
+
+# The finskit Python module (python/): on by default when pybind11 and the Python
+# headers are found, off in sanitizer and fuzz builds (an instrumented extension cannot
+# be loaded into an uninstrumented interpreter).
+find_package(Python3 3.9 QUIET COMPONENTS Interpreter Development.Module)
+find_package(pybind11 CONFIG QUIET)
+set(fins_python_default OFF)
+if(Python3_FOUND AND pybind11_FOUND AND NOT FINS_SANITIZE AND NOT FINS_FUZZ)
+  set(fins_python_default ON)
+endif()
+option(FINS_PYTHON "Build the finskit Python module (pybind11)" ${fins_python_default})
+if(FINS_PYTHON)
+  add_subdirectory(${PROJECT_SOURCE_DIR}/python ${PROJECT_BINARY_DIR}/python)
+endif()
+
+include(${CMAKE_CURRENT_LIST_DIR}/FinsCPack.cmake)

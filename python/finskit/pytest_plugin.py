@@ -1,0 +1,28 @@
+"""pytest plugin: the `virtual_plc` fixture, a running finskit.VirtualPlc per test.
+
+Registered automatically when finskit is installed (entry point pytest11), or with
+`pytest_plugins = ["finskit.pytest_plugin"]`. Options come from a marker:
+
+    @pytest.mark.virtual_plc(profile="cj1m", mode="program")
+    def test_x(virtual_plc): ...
+
+The PLC listens on 127.0.0.1, port 0 (a free port: virtual_plc.port), with its data
+directory in the test's tmp_path, and is stopped after the test.
+"""
+import pytest
+
+from finskit import VirtualPlc
+
+
+def pytest_configure(config):
+    config.addinivalue_line(
+        "markers", "virtual_plc(**kwargs): arguments of finskit.VirtualPlc for the fixture")
+
+
+@pytest.fixture
+def virtual_plc(request, tmp_path):
+    marker = request.node.get_closest_marker("virtual_plc")
+    kwargs = dict(marker.kwargs) if marker else {}
+    kwargs.setdefault("data_dir", str(tmp_path / "virtual_plc"))
+    with VirtualPlc(**kwargs) as plc:
+        yield plc

@@ -1,0 +1,97 @@
+#!/usr/bin/env bash
+# Installs the finskit .debs on this machine (root: CI), exercises what they installed
+# and purges them. No systemd needed: finsd is started with the unit's own ExecStart line
+# (plus --port 0, so a finsd already on 9600 does not matter), as systemd would after
+# creating the StateDirectory. Usage: scripts/package_test.sh build-pkg/*.deb
+# Prints "package: N checks passed" last; exits non-zero on the first failure.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+debs=()
+for deb in "$@"; do debs+=("$(realpath "$deb")"); done
+packages=()
+for deb in "${debs[@]}"; do packages+=("$(dpkg-deb -f "$deb" Package)"); done
+source "$root/scripts/finsd_start.sh"
+sudo=""
+if [[ $(id -u) -ne 0 ]]; then sudo="sudo"; fi
+passed=0
+check() { echo "  ok: $1"; passed=$((passed + 1)); }
+fail() { echo "FAILED: $1" >&2; exit 1; }
+
+export DEBIAN_FRONTEND=noninteractive
+for package in "${packages[@]}"; do
+  if dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep "install ok installed" >/dev/null; then
+    echo "$package is already installed: refusing to replace it" >&2; exit 1
+  fi
+done
+$sudo apt-get install -y -qq --no-install-recommends "${debs[@]}" >/dev/null
+cleanup() { $sudo apt-get purge -y -qq "${packages[@]}" >/dev/null 2>&1 || true; }
+trap cleanup EXIT
+dpkg -L finskit | grep '^/usr/bin/finsd$' >/dev/null || fail "finsd installed"
+check "finsd installed"
+unit=$(dpkg -L finskit | grep "/systemd/system/finsd.service$")
+for option in NoNewPrivileges=yes PrivateTmp=yes ProtectSystem=strict DynamicUser=yes \
+    StateDirectory=finsd; do
+  grep -qx "$option" "$unit"
+done
+check "unit hardening options"
+grep '^bind = "127.0.0.1"' /etc/finskit/finsd.toml >/dev/null || fail "config binds 127.0.0.1"
+check "config binds 127.0.0.1"
+dpkg-query -W -f='${Conffiles}' finskit | grep /etc/finskit/finsd.toml >/dev/null || fail "config is a conffile"
+check "config is a conffile"
+
+# The unit's command line, run as systemd would (it creates the StateDirectory).
+read -r -a exec_start <<<"$(sed -n 's/^ExecStart=//p' "$unit")"
+$sudo mkdir -p /var/lib/finsd
+finsd_start $sudo "${exec_start[@]}"
+check "finsd started from the unit's ExecStart on port $finsd_port"
+fins=(/usr/bin/fins --port "$finsd_port")
+"${fins[@]}" write D100 11 22 33 >/dev/null
+"${fins[@]}" read D100 3 | grep "D102 *33" >/dev/null || fail "installed fins writes and reads (UDP)"
+check "installed fins writes and reads (UDP)"
+"${fins[@]}" --tcp read D100 1 --json | grep 11 >/dev/null || fail "installed fins over TCP"
+check "installed fins over TCP"
+finsd_stop
+ls /var/lib/finsd | grep . >/dev/null || fail "state kept in the StateDirectory"
+check "state kept in the StateDirectory"
+if /usr/bin/python3 -c "import finskit" 2>/dev/null; then
+  /usr/bin/python3 - <<'PY'
+import finskit
+with finskit.VirtualPlc() as plc, finskit.Client(plc.host, plc.port) as c:
+    c.write_words("D0", [1, 2])
+    assert c.read_words("D0", 2) == [1, 2]
+PY
+  check "installed Python module"
+  # The pytest plugin comes with the package (pytest11 entry point): no conftest needed.
+  tests=$(mktemp -d)
+  cat >"$tests/test_user.py" <<'PY'
+import finskit
+def test_user_code(virtual_plc):
+    with finskit.Client(virtual_plc.host, virtual_plc.port, protocol="tcp") as c:
+        c.write_float("D0", 2.5)
+        assert c.read_float("D0") == 2.5
+PY
+  if /usr/bin/python3 -c "import pytest" 2>/dev/null; then
+    (cd "$tests" && PYTHONDONTWRITEBYTECODE=1 /usr/bin/python3 -m pytest -q -p no:cacheprovider \
+      test_user.py >/dev/null) || fail "virtual_plc fixture from the installed plugin"
+    check "virtual_plc fixture from the installed plugin"
+  fi
+  rm -rf "$tests"
+fi
+pkg-config --exists fins && test -f /usr/lib/*/cmake/fins/finsConfig.cmake >/dev/null || fail "dev files"
+check "dev files"
+tmp=$(mktemp -d)
+# shellcheck disable=SC2046
+g++ $(pkg-config --cflags fins) "$root/examples/typed_command.cpp" -o "$tmp/typed_command" \
+  $(pkg-config --libs fins) || fail "build against the installed libfins-dev"
+ldd "$tmp/typed_command" | grep -E "libfins\.so\.[0-9.]+ => (/usr)?/lib/" >/dev/null || fail "libfins0.1 used"
+rm -rf "$tmp"
+check "a program builds against libfins-dev and runs on libfins0.1's SONAME"
+
+$sudo apt-get purge -y -qq "${packages[@]}" >/dev/null
+trap - EXIT
+for path in /usr/bin/finsd /usr/bin/fins "$unit" /etc/finskit /var/lib/finsd /usr/include/fins \
+    /usr/lib/*/libfins.so* /usr/lib/python3/dist-packages/finskit; do
+  if [[ -e "$path" ]]; then echo "left behind after purge: $path" >&2; exit 1; fi
+done
+check "purged cleanly"
+echo "package: $passed checks passed"
