@@ -1,4 +1,4 @@
-// Private helpers shared by the command codecs (src/codec/*_commands.cpp): the error
+// Private helpers shared by the command codecs (src/codec/commands/*.cpp): the error
 // values every decoder returns and the fixed-length check of W342 5-1-3 (1002 command
 // too short, 1001 command too long).
 #pragma once
