@@ -128,7 +128,7 @@ TEST(Profiles, W342_5_3_15_MemoryCardTypeAndSizeAgree) {
         EXPECT_EQ(p.memory_card_type == 0x00, p.memory_card_kbytes == 0);
         EXPECT_EQ(p.has_memory_card(), p.memory_card_kbytes != 0);
     }
-    EXPECT_FALSE(get("cj2h").has_memory_card());
+    EXPECT_TRUE(get("cj2h").has_memory_card());  // issue 8: inserted, so 22 xx works
     EXPECT_TRUE(get("cs1h").has_memory_card());
     EXPECT_FALSE(get("cp1h").has_memory_card());  // a Memory Cassette, not a card
 }

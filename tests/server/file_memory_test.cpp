@@ -182,7 +182,7 @@ TEST(FileMemoryHandlers, W342_5_3_15_CpuUnitDataFollowsTheCardAndEmFileBanks) {
     EXPECT_EQ(to_hex(Bytes(d).subspan(89, 3)), "04 78 00");  // 30,720 KB
     h.plc.files().remove_card();
     d = h.send("0501").data();
-    EXPECT_EQ(to_hex(Bytes(d).subspan(89, 3)), "04 00 00");
+    EXPECT_EQ(to_hex(Bytes(d).subspan(89, 3)), "00 00 00");
     h.plc.files().insert_card(0x800);
     d = h.send("0501").data();
     EXPECT_EQ(to_hex(Bytes(d).subspan(89, 3)), "04 08 00");
