@@ -1,4 +1,4 @@
-// Fuzzes the 22 xx request decoders (W342 5-3-32 .. 5-3-42): the first byte picks the
+// Fuzzes the 22 xx request decoders (W342 5-3-32 .. 5-3-43): the first byte picks the
 // command, the rest are its parameters. A decoder either refuses with the end code the
 // server answers (1001/1002) or yields a command that encodes back to exactly the
 // input: names and paths are framed, never interpreted, here.
@@ -9,6 +9,7 @@
 
 #include "fins/byte_io.hpp"
 #include "fins/commands/file_memory.hpp"
+#include "fins/commands/memory_cassette.hpp"
 #include "fins/frame.hpp"
 
 namespace {
@@ -39,7 +40,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     using namespace fins;
     if (size == 0 || size > max_parameter_size + 1) return 0;
     const Bytes parameters(data + 1, size - 1);
-    switch (data[0] % 11) {
+    switch (data[0] % 12) {
         case 0:
             round_trip<FileNameRead>(parameters);
             break;
@@ -69,6 +70,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             break;
         case 9:
             round_trip<ProgramAreaFileTransfer>(parameters);
+            break;
+        case 10:
+            round_trip<MemoryCassetteTransfer>(parameters);
             break;
         default:
             round_trip<DirectoryCreateDelete>(parameters);

@@ -67,7 +67,9 @@ struct FileMemory::Device {
 // ---- devices ----
 
 FileMemory::FileMemory(const Profile& profile)
-    : profile_(profile), card_kbytes_(profile.memory_card_kbytes) {
+    : profile_(profile),
+      card_kbytes_(profile.memory_card_kbytes),
+      cassette_mounted_(profile.memory_cassette) {
     if (profile.em_file_bank < profile.em_banks) em_bank_ = profile.em_file_bank;
 }
 
@@ -99,7 +101,7 @@ Result<void> FileMemory::attach(const std::filesystem::path& root) {
     root_fd_ = fd;
     root_ = root;
     own_root_ = false;
-    for (const char* device : {"card", "em"}) {
+    for (const char* device : {"card", "em", "cassette"}) {
         const Fd dir = host::open_directory(root_fd_, device);
         if (dir.valid()) host::clear(dir.get(), true);
     }
@@ -160,6 +162,8 @@ void FileMemory::close_devices() noexcept {
         device_fds_[i] = -1;
         used_[i].reset();
     }
+    if (cassette_fd_ >= 0) ::close(cassette_fd_);
+    cassette_fd_ = -1;
 }
 
 std::uint64_t FileMemory::bytes_in_use(const Device& d) {

@@ -1,7 +1,8 @@
 // The file memory of a CS/CJ CPU Unit (W342 5-3-32 .. 5-3-42, frames-serial-files 4):
 // the memory card (disk 8000) and EM file memory (disk 8001), each a directory under
 // one root on the host (finsd: the data directory, else a private temporary directory
-// removed at exit): <root>/card and <root>/em.
+// removed at exit): <root>/card and <root>/em. A CP1H's Memory Cassette (disk 8003,
+// 22 20, W342 5-3-43) is <root>/cassette (file_memory_cassette.cpp).
 //
 // Safety: every name and path is checked against the CPU Unit's rules (8.3 names of
 // letters, digits and ! & $ # ' { } - ^ ( ) _ ~; no "~~" start, no 00/E5 first byte, no
@@ -74,6 +75,17 @@ class FileMemory {
     // 05 01 "EM non-file memory size": banks before the file banks.
     [[nodiscard]] std::uint8_t em_non_file_banks() const noexcept;
 
+    // The Memory Cassette of a CP1H (disk 8003, 22 20 only; W342 5-3-43): mounted when
+    // the profile has one, else 2301. It holds named items, one host file each in
+    // <root>/cassette, each replaced whole (temp file, fsync, rename): the 22 20 handler
+    // (server/handlers/memory_cassette.cpp) decides what they contain.
+    [[nodiscard]] bool cassette_mounted() const noexcept { return cassette_mounted_; }
+    void mount_cassette(bool mounted) noexcept { cassette_mounted_ = mounted; }
+    // The item's bytes, or nullopt when the cassette does not hold it.
+    Result<std::optional<std::vector<std::uint8_t>>> cassette_item(const std::string& name);
+    EndCode store_cassette_item(const std::string& name, Bytes content, CivilSeconds now);
+    EndCode initialize_cassette();
+
     // The commands (validated in full before anything changes). `now` is the CPU Unit's
     // clock, recorded as the date of what they create (5-3-34, 5-3-39 .. 5-3-42).
     Result<FileNameReadResponse> list(const FileNameRead& command);
@@ -107,6 +119,8 @@ class FileMemory {
   private:
     Result<Device> open_device(std::uint16_t disk);
     Result<void> ensure_root();
+    // The cassette's host directory (created and kept open), or an end code.
+    Result<int> cassette_directory();
     void close_devices() noexcept;
     // File bytes on the device: counted at first use, then tracked by every change made
     // here (recounted after 22 04 / 22 05); temp files of a replace in progress excluded.
@@ -121,6 +135,8 @@ class FileMemory {
     unsigned temp_counter_ = 0;
     int device_fds_[2] = {-1, -1};  // card, em
     std::optional<std::uint64_t> used_[2];
+    bool cassette_mounted_ = false;
+    int cassette_fd_ = -1;
 };
 
 }  // namespace fins::plc

@@ -136,7 +136,7 @@ Profile make_cj1m() {
 // CP1H-XA40DR-A: "CP1H_XA40DR-A", 20K steps -> 40 K words (0028), no EM [LF]. It has a
 // Memory Cassette rather than a Memory Card: 05 01 reports no card (type 00, 0000).
 // Choices: version "01.00"; a CJ1W-ETN21 through the CP1W-EXT01 CJ Unit Adapter at
-// unit 0; CS/CJ-mode codes only (no CV-mode codes).
+// unit 0; CS/CJ-mode codes only (no CV-mode codes); a Memory Cassette mounted (22 20).
 Profile make_cp1h() {
     Profile p;
     p.name = "cp1h";
@@ -148,6 +148,7 @@ Profile make_cp1h() {
     p.cv_mode_codes = false;
     p.memory_card_type = 0x00;
     p.memory_card_kbytes = 0;
+    p.memory_cassette = true;
     p.units = {UnitInfo{0x10, "CJ1W-ETN21", 0, "V1.20"}};
     return p;
 }
@@ -206,6 +207,7 @@ bool Profile::accepts(const MemoryAreaSegment& segment) const noexcept {
 }
 
 bool Profile::supports(CommandCode code) const noexcept {
+    if (code == CommandCode{0x22, 0x20} && !memory_cassette) return false;
     if (commands.empty()) return true;
     for (auto c : commands)
         if (c == code.value()) return true;

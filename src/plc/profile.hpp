@@ -55,6 +55,9 @@ struct Profile {
     // size 0000, W342 5-3-15); otherwise its type (04 flash memory) and size in K bytes.
     std::uint8_t memory_card_type = 0x00;
     std::uint16_t memory_card_kbytes = 0;
+    // A Memory Cassette (disk 8003) is mounted: the model answers 22 20 MEMORY CASSETTE
+    // TRANSFER (W342 5-1-1: CP1H and CP1L only); other models answer it 0401.
+    bool memory_cassette = false;
     std::uint8_t racks = 1;       // CPU Rack + expansion racks
     bool battery = true;          // 06 01 status bit 2
     std::vector<UnitInfo> units;  // mounted units, ascending unit address

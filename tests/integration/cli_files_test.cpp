@@ -170,5 +170,53 @@ TEST(CliFiles, W342_5_3_34_SigkillDuringReplaceLeavesOldOrNew) {
         EXPECT_FALSE(e.path().filename().string().starts_with(".tmp-")) << e.path();
 }
 
+// `fins files cassette` on a CP1H (W342 5-3-43): save, type, verify, load, init, in
+// PROGRAM mode only (2206 in RUN, exit 4); a difference is 2007 (exit 4); an unknown
+// area is a usage error (exit 2); the cassette lives under the data directory.
+TEST(CliFiles, W342_5_3_43_CassetteSaveVerifyLoadOnCp1h) {
+    ScratchDir dir("cli-cassette");
+    Finsd d({"--profile", "cp1h", "--data-dir", (dir.path() / "data").string()});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    auto r = fins(d, {"files", "cassette", "save"});
+    EXPECT_EQ(r.exit_code, 4);
+    EXPECT_NE(r.err.find("2206"), std::string::npos) << r.err;
+    ASSERT_EQ(fins(d, {"stop"}).exit_code, 0);
+    ASSERT_EQ(fins(d, {"write", "D100", "0x12AB"}).exit_code, 0);
+    r = fins(d, {"files", "cassette", "save", "dm", "parameters"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(r.out, "files cassette: done\n");
+    EXPECT_TRUE(std::filesystem::exists(dir.path() / "data/cassette/AUTOEXEC.IOM"));
+    r = fins(d, {"files", "cassette", "type"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(r.out, "parameters dm\n");
+    r = fins(d, {"--json", "files", "cassette", "type"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["bits"], "0044");
+    EXPECT_EQ(fins(d, {"files", "cassette", "verify", "dm"}).exit_code, 0);
+    ASSERT_EQ(fins(d, {"write", "D100", "0"}).exit_code, 0);
+    r = fins(d, {"files", "cassette", "verify"});
+    EXPECT_EQ(r.exit_code, 4);
+    EXPECT_NE(r.err.find("2007"), std::string::npos) << r.err;
+    EXPECT_EQ(fins(d, {"files", "cassette", "load", "program"}).exit_code, 4);  // 2006
+    ASSERT_EQ(fins(d, {"files", "cassette", "load"}).exit_code, 0);
+    r = fins(d, {"read", "D100"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("4779"), std::string::npos) << r.out;  // 0x12AB
+    EXPECT_EQ(fins(d, {"files", "cassette", "save", "nonsense"}).exit_code, 2);
+    ASSERT_EQ(fins(d, {"files", "cassette", "init"}).exit_code, 0);
+    r = fins(d, {"files", "cassette", "type"});
+    EXPECT_EQ(r.out, "(empty)\n");
+}
+
+// Only the CP1H has a cassette: the default CJ2H answers 0401 (exit 4).
+TEST(CliFiles, W342_5_3_43_CassetteUndefinedOnCj2h) {
+    Finsd d({});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    ASSERT_EQ(fins(d, {"stop"}).exit_code, 0);
+    const auto r = fins(d, {"files", "cassette", "type"});
+    EXPECT_EQ(r.exit_code, 4);
+    EXPECT_NE(r.err.find("0401"), std::string::npos) << r.err;
+}
+
 }  // namespace
 }  // namespace fins::test

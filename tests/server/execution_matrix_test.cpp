@@ -95,6 +95,8 @@ TEST(ExecutionMatrix, W342_5_1_2_EveryCommandEveryModeEveryCondition) {
             profile = *plc::find_profile("cs1h-lcb");
             fields.destination.unit = inner_board_unit;
         }
+        // The Memory Cassette command exists on the CP1H only (5-1-1).
+        if (entry.code == CommandCode{0x22, 0x20}) profile = *plc::find_profile("cp1h");
         for (const auto& c : cases) {
             SCOPED_TRACE(fmt::format("{:04X} {} / {}", entry.code.value(), info->name, c.name));
             Harness h{profile};

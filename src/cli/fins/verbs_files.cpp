@@ -10,6 +10,7 @@
 //   files save WHAT PLCFILE [COUNT]     22 0A/0B/0C area -> file
 //   files load PLCFILE WHAT [COUNT]     file -> area
 //   files compare PLCFILE WHAT [COUNT]  compare (exit 4 with 2007 on a difference)
+//   files cassette save|load|verify|init|type   22 20 (verbs_cassette.cpp)
 // PLC paths: [card:|em:][/]DIR/.../NAME.EXT ("\" works too); card is the default.
 // WHAT: a word address (D100, E3_0, W10 ...), a parameter area (plc-setup, io-table,
 // routing, cpu-bus) or "program". Exit codes as every verb: 0, 2, 3, 4.
@@ -32,6 +33,8 @@
 #include "fins/commands/parameter_area.hpp"
 
 namespace fins::cli {
+
+void add_cassette_verbs(CLI::App& files, const GlobalOptions& g, int& exit_code);  // 22 20
 
 namespace {
 
@@ -393,6 +396,7 @@ void add_file_verbs(CLI::App& app, const GlobalOptions& g, int& exit_code) {
         if (t.run != &run_save) c->add_option("what", a->what, what_help)->required();
         c->add_option("count", a->count, "Words (word addresses only)");
     }
+    add_cassette_verbs(*files, g, exit_code);
 }
 
 }  // namespace fins::cli

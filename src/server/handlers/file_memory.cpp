@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "fins/commands/file_memory.hpp"
+#include "fins/commands/memory_cassette.hpp"
 #include "fins/commands/parameter_area.hpp"
 #include "fins/commands/program_area.hpp"
 #include "plc/plc.hpp"
@@ -31,6 +32,8 @@ EndCode execute(HandlerContext& context, const MemoryAreaFileTransfer& command, 
 EndCode execute(HandlerContext& context, const ParameterAreaFileTransfer& command, ByteWriter& out);
 EndCode execute(HandlerContext& context, const ProgramAreaFileTransfer& command, ByteWriter& out);
 EndCode execute(HandlerContext& context, const DirectoryCreateDelete& command, ByteWriter& out);
+// 22 20: memory_cassette.cpp.
+EndCode execute(HandlerContext& context, const MemoryCassetteTransfer& command, ByteWriter& out);
 
 namespace {
 
@@ -297,6 +300,7 @@ constexpr HandlerEntry file_memory_table[] = {
     entry<ParameterAreaFileTransfer>(),
     entry<ProgramAreaFileTransfer>(),
     entry<DirectoryCreateDelete>(),
+    entry<MemoryCassetteTransfer>(),
 };
 
 }  // namespace

@@ -1,0 +1,67 @@
+// plc::FileMemory: the Memory Cassette of a CP1H (disk 8003, W342 5-3-43). Items are
+// host files in <root>/cassette, reached like the file devices: one directory fd opened
+// with O_NOFOLLOW, names that are single components chosen by finsd (never by a request).
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "plc/file_memory.hpp"
+#include "plc/file_memory_host.hpp"
+
+namespace fins::plc {
+
+using host::Kind;
+
+namespace {
+
+Unexpected fail(EndCode code) {
+    return Unexpected(make_error_code(code));
+}
+
+}  // namespace
+
+Result<int> FileMemory::cassette_directory() {
+    if (!cassette_mounted_) return fail(EndCode::file_device_missing);
+    if (!ensure_root()) return fail(EndCode::memory_error);
+    if (cassette_fd_ < 0) {
+        if (::mkdirat(root_fd_, "cassette", 0755) != 0 && errno != EEXIST)
+            return fail(EndCode::memory_error);
+        cassette_fd_ = host::open_directory(root_fd_, "cassette").release();
+        if (cassette_fd_ < 0) return fail(EndCode::memory_error);
+    }
+    return cassette_fd_;
+}
+
+Result<std::optional<std::vector<std::uint8_t>>> FileMemory::cassette_item(
+    const std::string& name) {
+    const auto dir = cassette_directory();
+    if (!dir) return Unexpected(dir.error());
+    switch (host::kind_of(*dir, name)) {
+        case Kind::missing:
+            return std::optional<std::vector<std::uint8_t>>{};
+        case Kind::file:
+            if (auto content = host::read_all(*dir, name)) return content;
+            return fail(EndCode::memory_error);
+        default:  // something finsd did not put there: the cassette's data is broken
+            return fail(EndCode::memory_error);
+    }
+}
+
+EndCode FileMemory::store_cassette_item(const std::string& name, Bytes content, CivilSeconds now) {
+    const auto dir = cassette_directory();
+    if (!dir) return EndCode{static_cast<std::uint16_t>(dir.error().value())};
+    const auto kind = host::kind_of(*dir, name);
+    if (kind != Kind::missing && kind != Kind::file) return EndCode::memory_error;
+    return host::replace(*dir, name, content, now, temp_counter_) ? EndCode::normal_completion
+                                                                  : EndCode::memory_error;
+}
+
+EndCode FileMemory::initialize_cassette() {
+    const auto dir = cassette_directory();
+    if (!dir) return EndCode{static_cast<std::uint16_t>(dir.error().value())};
+    if (!host::clear(*dir, false)) return EndCode::memory_error;
+    ::fsync(*dir);
+    return EndCode::normal_completion;
+}
+
+}  // namespace fins::plc
