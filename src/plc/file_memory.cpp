@@ -83,6 +83,7 @@ FileMemory::~FileMemory() {
 }
 
 void FileMemory::set_em_file_bank(std::optional<std::uint8_t> bank) noexcept {
+    forget_open_files(1);
     em_bank_ = bank && *bank < profile_.em_banks ? bank : std::nullopt;
 }
 
@@ -157,6 +158,7 @@ Result<FileMemory::Device> FileMemory::open_device(std::uint16_t disk) {
 }
 
 void FileMemory::close_devices() noexcept {
+    forget_open_files();
     for (std::size_t i = 0; i < 2; ++i) {
         if (device_fds_[i] >= 0) ::close(device_fds_[i]);
         device_fds_[i] = -1;
@@ -258,10 +260,34 @@ EndCode FileMemory::write(const SingleFileWrite& c, CivilSeconds now) {
     if (mode != FileWriteMode::overwrite && c.position != 0) return EndCode::parameter_error;
     auto device = open_device(c.disk);
     if (!device) return EndCode{static_cast<std::uint16_t>(device.error().value())};
-    const Fd dir = host::open_path(device->fd, *path);
-    if (!dir.valid()) return EndCode::write_file_missing;
+    close_idle_files(now);
+    // The chunks of one transfer: the directory and file stay open while the name still
+    // names the same regular file (no walk, no open); anything else takes the walk.
+    std::string key;
+    for (const auto& component : *path)
+        key += "\\" + component;
+    key += "\\" + *name;
     struct stat st {};
-    const auto kind = host::kind_of(dir.get(), *name, &st);
+    auto kind = Kind::missing;
+    int dir_fd = -1;
+    Fd walked;
+    OpenFile* cached = find_open_file(device->index, key);
+    if (cached != nullptr) {
+        kind = host::kind_of(cached->directory, *name, &st);
+        if (kind == Kind::file && static_cast<std::uint64_t>(st.st_ino) == cached->inode &&
+            static_cast<std::uint64_t>(st.st_dev) == cached->host_device) {
+            dir_fd = cached->directory;
+        } else {
+            close_open_file(cached);
+            cached = nullptr;
+        }
+    }
+    if (dir_fd < 0) {
+        walked = host::open_path(device->fd, *path);
+        if (!walked.valid()) return EndCode::write_file_missing;
+        dir_fd = walked.get();
+        kind = host::kind_of(dir_fd, *name, &st);
+    }
     if (kind != Kind::missing && kind != Kind::file) return EndCode::file_name_exists;
     const bool exists = kind == Kind::file;
     const std::uint64_t old_size = exists ? static_cast<std::uint64_t>(st.st_size) : 0;
@@ -293,18 +319,32 @@ EndCode FileMemory::write(const SingleFileWrite& c, CivilSeconds now) {
         return EndCode::address_range_exceeded;
 
     bool ok = false;
-    if (replacing) {
-        ok = host::replace(dir.get(), *name, c.data, now, temp_counter_);
-    } else if (offset == old_size) {
+    if (offset == old_size && !replacing) {
         // Only adds bytes: nothing already in the file can be half-changed.
-        ok = host::write_at(dir.get(), *name, offset, c.data, now);
+        if (cached == nullptr && walked.valid()) {
+            cached = keep_open(device->index, key, walked.get(), *name);
+            if (cached != nullptr) static_cast<void>(walked.release());
+        }
+        ok = cached != nullptr ? host::write_fd(cached->fd, offset, c.data, now)
+                               : host::write_at(dir_fd, *name, offset, c.data, now);
+        if (cached != nullptr) cached->last_write = now;
     } else {
-        auto content = host::read_all(dir.get(), *name);
-        if (!content) return EndCode::memory_error;
-        content->resize(static_cast<std::size_t>(new_size));
-        std::copy(c.data.begin(), c.data.end(),
-                  content->begin() + static_cast<std::ptrdiff_t>(offset));
-        ok = host::replace(dir.get(), *name, *content, now, temp_counter_);
+        // A new inode replaces the file: the kept descriptor would write to the old one.
+        if (cached != nullptr) close_open_file(cached);
+        if (!walked.valid()) {
+            walked = host::open_path(device->fd, *path);
+            if (!walked.valid()) return EndCode::write_file_missing;
+        }
+        if (replacing) {
+            ok = host::replace(walked.get(), *name, c.data, now, temp_counter_);
+        } else {
+            auto content = host::read_all(walked.get(), *name);
+            if (!content) return EndCode::memory_error;
+            content->resize(static_cast<std::size_t>(new_size));
+            std::copy(c.data.begin(), c.data.end(),
+                      content->begin() + static_cast<std::ptrdiff_t>(offset));
+            ok = host::replace(walked.get(), *name, *content, now, temp_counter_);
+        }
     }
     if (!ok) return EndCode::memory_error;
     used_[device->index] = (used >= old_size ? used - old_size : 0) + new_size;
@@ -318,6 +358,7 @@ EndCode FileMemory::format(std::uint16_t disk, std::uint8_t current_em_bank, Civ
         return EndCode::area_classification_missing;
     auto device = open_device(disk);
     if (!device) return EndCode{static_cast<std::uint16_t>(device.error().value())};
+    forget_open_files(device->index);
     used_[device->index].reset();
     if (!host::clear(device->fd, false)) return EndCode::memory_error;
     const Fd v(
@@ -341,6 +382,7 @@ Result<std::uint16_t> FileMemory::remove(const FileDelete& c) {
     if (!device) return Unexpected(device.error());
     const Fd dir = host::open_path(device->fd, *path);
     if (!dir.valid()) return fail(EndCode::write_file_missing);
+    forget_open_files(device->index);
     used_[device->index].reset();
     std::uint16_t deleted = 0;
     // 5-3-36: names that do not exist are ignored; so are directories (22 15 removes those).
@@ -363,6 +405,7 @@ EndCode FileMemory::copy(const FileCopy& c) {
     if (!source) return EndCode{static_cast<std::uint16_t>(source.error().value())};
     auto target = open_device(c.destination_disk);
     if (!target) return EndCode{static_cast<std::uint16_t>(target.error().value())};
+    forget_open_files(target->index);
     const Fd from_dir = host::open_path(source->fd, *from_path);
     struct stat st {};
     if (!from_dir.valid() || host::kind_of(from_dir.get(), *from, &st) != Kind::file)
@@ -390,6 +433,7 @@ EndCode FileMemory::rename(const FileNameChange& c) {
     if (!from || !to || !path) return EndCode::parameter_error;
     auto device = open_device(c.disk);
     if (!device) return EndCode{static_cast<std::uint16_t>(device.error().value())};
+    forget_open_files(device->index);
     const Fd dir = host::open_path(device->fd, *path);
     if (!dir.valid()) return EndCode::write_file_missing;
     const auto kind = host::kind_of(dir.get(), *from);
@@ -412,6 +456,7 @@ EndCode FileMemory::directory(const DirectoryCreateDelete& c, CivilSeconds now) 
         return EndCode::parameter_error;
     auto device = open_device(c.disk);
     if (!device) return EndCode{static_cast<std::uint16_t>(device.error().value())};
+    forget_open_files(device->index);
     const Fd dir = host::open_path(device->fd, *path);
     if (!dir.valid()) return EndCode::write_file_missing;
     const auto kind = host::kind_of(dir.get(), *name);
@@ -453,6 +498,7 @@ EndCode FileMemory::create(std::uint16_t disk, const FileName& file, const std::
     if (!name || !path) return EndCode::parameter_error;
     auto device = open_device(disk);
     if (!device) return EndCode{static_cast<std::uint16_t>(device.error().value())};
+    forget_open_files(device->index);
     const Fd dir = host::open_path(device->fd, *path);
     if (!dir.valid()) return EndCode::write_file_missing;
     if (host::kind_of(dir.get(), *name) != Kind::missing) return EndCode::file_name_exists;

@@ -17,9 +17,10 @@
 // the same directory, is fsync'ed and renamed over the old one (directory fsync'ed): old
 // or new content, never a mix. A write that only extends a file (append, or 0003 at the
 // file's end) is one pwrite into the page cache, so an acknowledged write survives
-// SIGKILL of finsd. Capacity is the device's size (card: kilobytes from the profile or
-// config; EM: 64 KiB per file bank); the file bytes in use are counted, and a write that
-// would exceed it answers 1104 and changes nothing.
+// SIGKILL of finsd. Extending writes of one transfer reuse an open descriptor (see
+// OpenFile below): a chunk costs fstatat + pwrite + futimens. Capacity is the device's size (card:
+// kilobytes from the profile or config; EM: 64 KiB per file bank); the file bytes in use are
+// counted, and a write that would exceed it answers 1104 and changes nothing.
 //
 // End codes (choices where the seed only names the code, pinned by tests/plc and
 // tests/server file_memory tests): 110C bad name, path, disk number, mode or count;
@@ -68,7 +69,10 @@ class FileMemory {
     [[nodiscard]] bool card_inserted() const noexcept { return card_kbytes_ != 0; }
     [[nodiscard]] std::uint32_t card_kbytes() const noexcept { return card_kbytes_; }
     void insert_card(std::uint32_t kbytes) noexcept { card_kbytes_ = kbytes; }
-    void remove_card() noexcept { card_kbytes_ = 0; }
+    void remove_card() noexcept {
+        card_kbytes_ = 0;
+        forget_open_files(0);
+    }
     // The first EM bank that is file memory; nullopt (or >= the profile's banks): none.
     [[nodiscard]] std::optional<std::uint8_t> em_file_bank() const noexcept { return em_bank_; }
     void set_em_file_bank(std::optional<std::uint8_t> bank) noexcept;
@@ -116,7 +120,40 @@ class FileMemory {
 
     struct Device;
 
+    // Descriptors kept open between the chunks of a transfer (for tests and the README).
+    static constexpr std::size_t max_open_files = 4;
+    // An open file unused for longer (CPU clock seconds, either way) is closed at the
+    // next 22 03.
+    static constexpr CivilSeconds open_file_idle_seconds = 2;
+    [[nodiscard]] std::size_t open_files() const noexcept { return open_files_.size(); }
+
   private:
+    // A file that 22 03 extended, kept open with its directory so that the next chunk
+    // skips the path walk and the open: found by device and "\DIR\NAME" key, used only
+    // while fstatat(dir, name, AT_SYMLINK_NOFOLLOW) still names the same regular file
+    // (a host-side rename, delete or symlink swap falls back to the checked walk).
+    // Dropped by every 22 xx change other than 22 03 on that device, card removal, EM
+    // reconfiguration, attach(); the least recently used goes first past
+    // max_open_files; closed at destruction.
+    struct OpenFile {
+        std::size_t device = 0;
+        std::string key;
+        int directory = -1;
+        int fd = -1;
+        std::uint64_t host_device = 0;
+        std::uint64_t inode = 0;
+        CivilSeconds last_write = 0;
+        std::uint64_t last_use = 0;  // LRU order
+    };
+    OpenFile* find_open_file(std::size_t device, const std::string& key) noexcept;
+    // Takes ownership of `directory` on success; nullptr when `name` cannot be opened.
+    OpenFile* keep_open(std::size_t device, std::string key, int directory,
+                        const std::string& name);
+    void close_open_file(OpenFile* file) noexcept;
+    // Closes the cached descriptors of `device` (all when nullopt).
+    void forget_open_files(std::optional<std::size_t> device = std::nullopt) noexcept;
+    void close_idle_files(CivilSeconds now) noexcept;
+
     Result<Device> open_device(std::uint16_t disk);
     Result<void> ensure_root();
     // The cassette's host directory (created and kept open), or an end code.
@@ -137,6 +174,8 @@ class FileMemory {
     std::optional<std::uint64_t> used_[2];
     bool cassette_mounted_ = false;
     int cassette_fd_ = -1;
+    std::vector<OpenFile> open_files_;
+    std::uint64_t use_counter_ = 0;
 };
 
 }  // namespace fins::plc

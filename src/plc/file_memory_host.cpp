@@ -185,10 +185,12 @@ bool replace(int dir, const std::string& name, Bytes content, std::int64_t mtime
 bool write_at(int dir, const std::string& name, std::uint64_t offset, Bytes data,
               std::int64_t mtime) noexcept {
     const Fd fd(::openat(dir, name.c_str(), O_WRONLY | O_NOFOLLOW | O_CLOEXEC));
-    if (!fd.valid()) return false;
+    return fd.valid() && write_fd(fd.get(), offset, data, mtime);
+}
+
+bool write_fd(int fd, std::uint64_t offset, Bytes data, std::int64_t mtime) noexcept {
     const timespec times[2] = {at(mtime), at(mtime)};
-    return write_fully(fd.get(), data, static_cast<off_t>(offset)) &&
-           ::futimens(fd.get(), times) == 0;
+    return write_fully(fd, data, static_cast<off_t>(offset)) && ::futimens(fd, times) == 0;
 }
 
 }  // namespace fins::plc::host

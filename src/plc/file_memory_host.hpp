@@ -67,6 +67,8 @@ bool replace(int dir, const std::string& name, Bytes content, std::int64_t mtime
 // pwrite of `data` at `offset` into the existing regular file `name`, then dates it.
 bool write_at(int dir, const std::string& name, std::uint64_t offset, Bytes data,
               std::int64_t mtime) noexcept;
+// The same on an open descriptor of a regular file.
+bool write_fd(int fd, std::uint64_t offset, Bytes data, std::int64_t mtime) noexcept;
 // Sets the modification time of `name` (not following symlinks).
 bool set_mtime(int dir, const char* name, std::int64_t mtime) noexcept;
 

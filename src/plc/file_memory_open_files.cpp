@@ -1,0 +1,69 @@
+// plc::FileMemory: descriptors kept open between the chunks of one 22 03 transfer (see
+// FileMemory::OpenFile in file_memory.hpp).
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+
+#include "plc/file_memory.hpp"
+
+namespace fins::plc {
+
+FileMemory::OpenFile* FileMemory::find_open_file(std::size_t device,
+                                                 const std::string& key) noexcept {
+    for (auto& f : open_files_)
+        if (f.device == device && f.key == key) {
+            f.last_use = ++use_counter_;
+            return &f;
+        }
+    return nullptr;
+}
+
+FileMemory::OpenFile* FileMemory::keep_open(std::size_t device, std::string key, int directory,
+                                            const std::string& name) {
+    const int fd = ::openat(directory, name.c_str(), O_WRONLY | O_NOFOLLOW | O_CLOEXEC);
+    struct stat st {};
+    if (fd < 0 || ::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        if (fd >= 0) ::close(fd);
+        return nullptr;
+    }
+    if (open_files_.size() >= max_open_files) {
+        const auto oldest = std::min_element(
+            open_files_.begin(), open_files_.end(),
+            [](const OpenFile& a, const OpenFile& b) { return a.last_use < b.last_use; });
+        close_open_file(&*oldest);
+    }
+    OpenFile f;
+    f.device = device;
+    f.key = std::move(key);
+    f.directory = directory;
+    f.fd = fd;
+    f.host_device = static_cast<std::uint64_t>(st.st_dev);
+    f.inode = static_cast<std::uint64_t>(st.st_ino);
+    f.last_use = ++use_counter_;
+    open_files_.push_back(std::move(f));
+    return &open_files_.back();
+}
+
+void FileMemory::close_open_file(OpenFile* file) noexcept {
+    ::close(file->fd);
+    ::close(file->directory);
+    const auto index = static_cast<std::ptrdiff_t>(file - open_files_.data());
+    open_files_.erase(open_files_.begin() + index);
+}
+
+void FileMemory::forget_open_files(std::optional<std::size_t> device) noexcept {
+    for (std::size_t i = open_files_.size(); i-- > 0;)
+        if (!device || open_files_[i].device == *device) close_open_file(&open_files_[i]);
+}
+
+void FileMemory::close_idle_files(CivilSeconds now) noexcept {
+    for (std::size_t i = open_files_.size(); i-- > 0;) {
+        const auto idle = now - open_files_[i].last_write;
+        if (idle > open_file_idle_seconds || idle < -open_file_idle_seconds)
+            close_open_file(&open_files_[i]);
+    }
+}
+
+}  // namespace fins::plc

@@ -1,0 +1,172 @@
+// plc::FileMemory keeps a transfer's file open between 22 03 chunks (W342 5-3-34;
+// FileMemory::OpenFile): appends reuse one descriptor, and every change that could make
+// it stale (22 05 delete, 22 08 rename, 22 04 format, card removal, a replacing write,
+// a host-side swap of the file or a symlink planted in its place) drops it, so a chunk
+// never lands in a file that is no longer the one the name gives, and never outside the
+// device directory. Bounded (max_open_files), closed when idle and at destruction.
+#include <gtest/gtest.h>
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "plc/file_memory.hpp"
+
+namespace fins::plc {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string slurp(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), {}};
+}
+
+std::size_t open_descriptors() {
+    std::size_t n = 0;
+    for ([[maybe_unused]] const auto& e : fs::directory_iterator("/proc/self/fd"))
+        ++n;
+    return n;
+}
+
+class OpenFilesTest : public ::testing::Test {
+  protected:
+    OpenFilesTest() : files(profile) {
+        std::string pattern = (fs::temp_directory_path() / "fins-open-files-XXXXXX").string();
+        dir = ::mkdtemp(pattern.data());
+        EXPECT_TRUE(files.attach(dir / "root"));
+    }
+    ~OpenFilesTest() override { fs::remove_all(dir); }
+
+    EndCode write(std::string_view file, std::string_view content, FileWriteMode mode,
+                  CivilSeconds now = 1'700'000'000, std::uint32_t position = 0) {
+        const std::vector<std::uint8_t> data(content.begin(), content.end());
+        return files.write({disk_memory_card, static_cast<std::uint16_t>(mode),
+                            *FileName::from(file), position, data, ""},
+                           now);
+    }
+    EndCode append(std::string_view file, std::string_view content,
+                   CivilSeconds now = 1'700'000'000) {
+        return write(file, content, FileWriteMode::append, now);
+    }
+    fs::path card() const { return dir / "root/card"; }
+
+    Profile profile = cj2h();
+    fs::path dir;
+    FileMemory files;
+};
+
+TEST_F(OpenFilesTest, W342_5_3_34_AppendsReuseOneDescriptor) {
+    ASSERT_EQ(write("A.BIN", "0", FileWriteMode::create), EndCode::normal_completion);
+    EXPECT_EQ(files.open_files(), 0U);  // a replacing write keeps nothing open
+    for (const char* chunk : {"1", "2", "3"})
+        ASSERT_EQ(append("A.BIN", chunk), EndCode::normal_completion);
+    EXPECT_EQ(files.open_files(), 1U);
+    EXPECT_EQ(slurp(card() / "A.BIN"), "0123");
+    // 0003 at the file's end extends through the same descriptor.
+    ASSERT_EQ(write("A.BIN", "4", FileWriteMode::overwrite, 1'700'000'000, 4),
+              EndCode::normal_completion);
+    EXPECT_EQ(files.open_files(), 1U);
+    // 0003 inside the file replaces it (new inode): the descriptor goes, and later
+    // appends reach the new file.
+    ASSERT_EQ(write("A.BIN", "X", FileWriteMode::overwrite, 1'700'000'000, 0),
+              EndCode::normal_completion);
+    EXPECT_EQ(files.open_files(), 0U);
+    ASSERT_EQ(append("A.BIN", "5"), EndCode::normal_completion);
+    EXPECT_EQ(slurp(card() / "A.BIN"), "X12345");
+    // The date is the CPU clock of the last chunk.
+    ASSERT_EQ(append("A.BIN", "6", 1'700'000'001), EndCode::normal_completion);
+    struct stat st {};
+    ASSERT_EQ(::stat((card() / "A.BIN").c_str(), &st), 0);
+    EXPECT_EQ(st.st_mtime, 1'700'000'001);
+}
+
+TEST_F(OpenFilesTest, W342_5_3_36_DeleteRenameFormatAndCardRemovalDropIt) {
+    ASSERT_EQ(write("A.BIN", "a", FileWriteMode::create), EndCode::normal_completion);
+    ASSERT_EQ(append("A.BIN", "b"), EndCode::normal_completion);
+    ASSERT_EQ(files.open_files(), 1U);
+    ASSERT_TRUE(files.remove({disk_memory_card, {*FileName::from("A.BIN")}, ""}));
+    EXPECT_EQ(files.open_files(), 0U);
+    EXPECT_EQ(append("A.BIN", "c"), EndCode::write_file_missing);  // not the unlinked inode
+
+    ASSERT_EQ(write("B.BIN", "b", FileWriteMode::create), EndCode::normal_completion);
+    ASSERT_EQ(append("B.BIN", "b"), EndCode::normal_completion);
+    ASSERT_EQ(
+        files.rename({disk_memory_card, *FileName::from("B.BIN"), *FileName::from("C.BIN"), ""}),
+        EndCode::normal_completion);
+    EXPECT_EQ(files.open_files(), 0U);
+    EXPECT_EQ(append("B.BIN", "x"), EndCode::write_file_missing);
+    ASSERT_EQ(append("C.BIN", "c"), EndCode::normal_completion);
+    EXPECT_EQ(slurp(card() / "C.BIN"), "bbc");
+
+    EXPECT_EQ(files.open_files(), 1U);
+    files.remove_card();
+    EXPECT_EQ(files.open_files(), 0U);
+    EXPECT_EQ(append("C.BIN", "x"), EndCode::file_device_missing);
+    files.insert_card(1024);
+    ASSERT_EQ(append("C.BIN", "d"), EndCode::normal_completion);
+    EXPECT_EQ(files.open_files(), 1U);
+    ASSERT_EQ(files.format(disk_memory_card, 0, 0), EndCode::normal_completion);
+    EXPECT_EQ(files.open_files(), 0U);
+    EXPECT_FALSE(fs::exists(card() / "C.BIN"));
+}
+
+// Behind finsd's back: the name given to another file, or to a symlink pointing out of
+// the device: the next chunk follows the name's checks, never the stale descriptor.
+TEST_F(OpenFilesTest, FrameSerialFiles_4_1_HostSwapsAreNotFollowed) {
+    ASSERT_EQ(write("A.BIN", "a", FileWriteMode::create), EndCode::normal_completion);
+    ASSERT_EQ(append("A.BIN", "b"), EndCode::normal_completion);
+    fs::remove(card() / "A.BIN");
+    { std::ofstream(card() / "A.BIN") << "new"; }
+    ASSERT_EQ(append("A.BIN", "!"), EndCode::normal_completion);
+    EXPECT_EQ(slurp(card() / "A.BIN"), "new!");
+
+    const auto outside = dir / "outside.txt";
+    { std::ofstream(outside) << "keep"; }
+    fs::remove(card() / "A.BIN");
+    fs::create_symlink(outside, card() / "A.BIN");
+    EXPECT_EQ(append("A.BIN", "evil"), EndCode::file_name_exists);
+    EXPECT_EQ(slurp(outside), "keep");
+    EXPECT_EQ(files.open_files(), 0U);
+}
+
+TEST_F(OpenFilesTest, W342_5_3_34_BoundedIdleClosedAndReleasedAtDestruction) {
+    const auto before = open_descriptors();
+    {
+        FileMemory other(profile);
+        ASSERT_TRUE(other.attach(dir / "other"));
+        const std::vector<std::uint8_t> zero{0};
+        // The device directory stays open from the first request on: not counted.
+        ASSERT_EQ(other.write({disk_memory_card, 1, *FileName::from("INIT"), 0, zero, ""}, 100),
+                  EndCode::normal_completion);
+        const auto baseline = open_descriptors();
+        for (int i = 0; i < 6; ++i) {
+            const std::string n = "F" + std::to_string(i) + ".BIN";
+            const std::vector<std::uint8_t> one{1};
+            ASSERT_EQ(other.write({disk_memory_card, 1, *FileName::from(n), 0, one, ""}, 100),
+                      EndCode::normal_completion);
+            ASSERT_EQ(other.write({disk_memory_card, 2, *FileName::from(n), 0, one, ""}, 100),
+                      EndCode::normal_completion);
+        }
+        EXPECT_EQ(other.open_files(), FileMemory::max_open_files);
+        EXPECT_EQ(open_descriptors(), baseline + 2 * FileMemory::max_open_files);
+        // Idle for longer than open_file_idle_seconds (CPU clock): closed at the next 22 03.
+        const std::vector<std::uint8_t> one{1};
+        ASSERT_EQ(other.write({disk_memory_card, 1, *FileName::from("G.BIN"), 0, one, ""},
+                              100 + FileMemory::open_file_idle_seconds + 1),
+                  EndCode::normal_completion);
+        EXPECT_EQ(other.open_files(), 0U);
+        EXPECT_EQ(open_descriptors(), baseline);
+        ASSERT_EQ(other.write({disk_memory_card, 2, *FileName::from("G.BIN"), 0, one, ""}, 200),
+                  EndCode::normal_completion);
+        EXPECT_EQ(other.open_files(), 1U);
+    }
+    EXPECT_EQ(open_descriptors(), before);
+}
+
+}  // namespace
+}  // namespace fins::plc
