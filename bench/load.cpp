@@ -329,8 +329,8 @@ int main(int argc, char** argv) {
     const auto frame = read_frame(1);
     const std::size_t fins_response = fins::header_size + 2 + 2 + 2;  // header, cmd, end, 1 word
     if (client_mode) {
-        const int rc = run_client_mode(
-            (*server)->tcp_port(), seconds, json, [&](bool tcp, unsigned depth) {
+        const int rc =
+            run_client_mode((*server)->tcp_port(), seconds, json, [&](bool tcp, unsigned depth) {
                 Frames f{frame, fins_response};
                 if (tcp) {
                     std::array<std::uint8_t, 16> env{};

@@ -35,33 +35,38 @@ struct Pipeline {
 
     void issue() {
         const auto sent = Clock::now();
-        client.async_send(fins::MemoryAreaRead{{0x82, 0, 0}, 1},
-                          [this, sent](fins::Result<fins::MemoryAreaReadResponse> r) {
-                              const auto now = Clock::now();
-                              if (r)
-                                  latencies.push_back(
-                                      std::chrono::duration<double, std::micro>(now - sent).count());
-                              else
-                                  ++errors;
-                              if (now < end) issue();
-                          });
+        client.async_send(
+            fins::MemoryAreaRead{{0x82, 0, 0}, 1},
+            [this, sent](fins::Result<fins::MemoryAreaReadResponse> r) {
+                const auto now = Clock::now();
+                if (r)
+                    latencies.push_back(
+                        std::chrono::duration<double, std::micro>(now - sent).count());
+                else
+                    ++errors;
+                if (now < end) issue();
+            });
     }
 };
 
 ClientStatsLine drive_client(bool tcp, std::uint16_t port, unsigned depth, double seconds) {
     fins::ClientOptions options;
     options.port = port;
-    options.protocol = tcp ? fins::ClientOptions::Protocol::tcp : fins::ClientOptions::Protocol::udp;
+    options.protocol =
+        tcp ? fins::ClientOptions::Protocol::tcp : fins::ClientOptions::Protocol::udp;
     options.timeout = std::chrono::milliseconds(1000);
     auto client = fins::Client::connect(options);
     if (!client) {
-        std::fprintf(stderr, "fins_load: %s\n", fins::describe_error(options, client.error()).c_str());
+        std::fprintf(stderr, "fins_load: %s\n",
+                     fins::describe_error(options, client.error()).c_str());
         return {};
     }
     const auto start = Clock::now();
-    Pipeline p{**client, start + std::chrono::duration_cast<Clock::duration>(
-                                     std::chrono::duration<double>(seconds)),
-               {}, 0};
+    Pipeline p{
+        **client,
+        start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds)),
+        {},
+        0};
     p.latencies.reserve(1 << 21);
     for (unsigned i = 0; i < depth; ++i)
         p.issue();

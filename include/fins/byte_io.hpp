@@ -19,7 +19,7 @@ using Bytes = std::span<const std::uint8_t>;
 using MutableBytes = std::span<std::uint8_t>;
 
 class ByteReader {
-public:
+  public:
     constexpr explicit ByteReader(Bytes data) noexcept : data_(data) {}
 
     constexpr std::uint8_t u8() noexcept {
@@ -70,7 +70,7 @@ public:
         return !truncated_ && pos_ == data_.size();
     }
 
-private:
+  private:
     constexpr bool need(std::size_t n) noexcept {
         if (truncated_ || data_.size() - pos_ < n) {
             truncated_ = true;
@@ -85,7 +85,7 @@ private:
 };
 
 class ByteWriter {
-public:
+  public:
     constexpr explicit ByteWriter(MutableBytes out) noexcept : out_(out) {}
 
     constexpr void u8(std::uint8_t v) noexcept {
@@ -139,7 +139,7 @@ public:
         overflowed_ = false;
     }
 
-private:
+  private:
     constexpr bool room(std::size_t n) noexcept {
         if (overflowed_ || out_.size() - pos_ < n) {
             overflowed_ = true;

@@ -81,16 +81,16 @@ struct RelayErrorSource {
 };
 
 enum class ClientError : int {
-    timeout = 1,          // no response within the timeout after every retry
-    malformed_response,   // response too short, wrong length for the request, bad header
-    unexpected_response,  // command code or addresses do not match the request
-    connection_closed,    // transport closed or failed while the request was in flight
-    too_many_in_flight,   // all 256 service IDs are in use
-    request_too_long,     // encoded command longer than the 2,012-byte frame limit
-    not_connected,        // transport not open
-    canceled,             // client destroyed or request canceled
-    handshake_failed,     // FINS/TCP node-address exchange did not complete
-    invalid_argument,     // caller passed a value the command cannot carry
+    timeout = 1,           // no response within the timeout after every retry
+    malformed_response,    // response too short, wrong length for the request, bad header
+    unexpected_response,   // command code or addresses do not match the request
+    connection_closed,     // transport closed or failed while the request was in flight
+    too_many_in_flight,    // all 256 service IDs are in use
+    request_too_long,      // encoded command longer than the 2,012-byte frame limit
+    not_connected,         // transport not open
+    canceled,              // client destroyed or request canceled
+    handshake_failed,      // FINS/TCP node-address exchange did not complete
+    invalid_argument,      // caller passed a value the command cannot carry
     called_from_callback,  // a synchronous Client call made inside a completion callback
 };
 const std::error_category& client_category() noexcept;

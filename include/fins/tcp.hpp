@@ -37,9 +37,9 @@ struct TcpPacket {
 struct TcpParse {
     enum class Status { need_more, packet, error };
     Status status = Status::need_more;
-    std::size_t consumed = 0;      // bytes of the buffer the packet (or error) used
-    TcpPacket packet;              // valid when status == packet
-    TcpError error{};              // valid when status == error: what to send in command 3
+    std::size_t consumed = 0;  // bytes of the buffer the packet (or error) used
+    TcpPacket packet;          // valid when status == packet
+    TcpError error{};          // valid when status == error: what to send in command 3
 };
 
 // Looks at the start of `buffer`. Errors: bad magic -> not_fins_header; length field
@@ -54,8 +54,8 @@ void write_tcp_header(ByteWriter& w, TcpCommand command, std::size_t data_size,
 // Whole packets for the handshake and errors (sizes 20, 24 and 16 bytes).
 void write_node_address_request(ByteWriter& w, std::uint8_t client_node) noexcept;
 // `client_node` is echoed whole in a refusal (e.g. 00000105 answered with 0x23).
-void write_node_address_response(ByteWriter& w, std::uint32_t client_node,
-                                 std::uint8_t server_node, std::uint32_t error = 0) noexcept;
+void write_node_address_response(ByteWriter& w, std::uint32_t client_node, std::uint8_t server_node,
+                                 std::uint32_t error = 0) noexcept;
 void write_tcp_error(ByteWriter& w, TcpCommand command, TcpError error) noexcept;
 
 struct NodeAddressResponse {

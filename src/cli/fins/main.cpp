@@ -72,7 +72,8 @@ int main(int argc, char** argv) {
     c_raw->add_flag("--no-response", raw.no_response,
                     "Set the ICF no-response bit and do not wait");
 
-    app.add_subcommand("probe", "Show which FINS node answers at --host/--port (and the --dest to use)");
+    app.add_subcommand("probe",
+                       "Show which FINS node answers at --host/--port (and the --dest to use)");
 
     int group_rc = -1;
     add_plc_data_verbs(app, g, group_rc);

@@ -95,12 +95,12 @@ int run_cpu_data(const GlobalOptions& g, Output& out, const std::string& section
         doc["dip_switch"] = r->dip_switch;
         doc["largest_em_bank"] = r->largest_em_bank;
         doc["area_data"] = {{"program_kwords", a.program_kwords},
-                       {"iom_kbytes", a.iom_kbytes},
-                       {"dm_words", a.dm_words},
-                       {"timer_counter_kwords", a.timer_counter_kwords},
-                       {"em_non_file_banks", a.em_non_file_banks},
-                       {"memory_card_type", a.memory_card_type},
-                       {"memory_card_kbytes", a.memory_card_kbytes}};
+                            {"iom_kbytes", a.iom_kbytes},
+                            {"dm_words", a.dm_words},
+                            {"timer_counter_kwords", a.timer_counter_kwords},
+                            {"em_non_file_banks", a.em_non_file_banks},
+                            {"memory_card_type", a.memory_card_type},
+                            {"memory_card_kbytes", a.memory_card_kbytes}};
         const char* card = a.memory_card_type == 0x00   ? "none"
                            : a.memory_card_type == 0x04 ? "flash"
                                                         : "other";

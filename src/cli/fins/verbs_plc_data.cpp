@@ -212,8 +212,9 @@ int run_param_clear(const GlobalOptions& g, const ParamArgs& a, Output& out) {
     if (!client) return rc;
     if (auto r = client->send(ParameterAreaClear{area->code, 0, area->words, false, 0}); !r)
         return out.failure(r.error(), fmt::format("param-clear {}", area->id));
-    out.print({{"area", fmt::format("{:04X}", area->code)}, {"cleared", true}, {"count", area->words}},
-              fmt::format("cleared {} ({:04X}), {} words\n", area->name, area->code, area->words));
+    out.print(
+        {{"area", fmt::format("{:04X}", area->code)}, {"cleared", true}, {"count", area->words}},
+        fmt::format("cleared {} ({:04X}), {} words\n", area->name, area->code, area->words));
     return exit_ok;
 }
 

@@ -272,17 +272,18 @@ class Loader {
                                                      const toml::table& t) const {
         static constexpr std::string_view types =
             "int16, uint16, int32, uint32, float, double, bcd, bcd32 or string";
-        if (t.size() != 1)
-            return fail(key, p, fmt::format("a typed value is one key: {}", types));
+        if (t.size() != 1) return fail(key, p, fmt::format("a typed value is one key: {}", types));
         const auto first = t.begin();  // its pair refers into the iterator: keep it alive
         const std::string type(first->first.str());
         const toml::node& value = first->second;
-        static constexpr std::string_view known[] = {"int16", "uint16", "int32",  "uint32", "float",
-                                                     "double", "bcd",   "bcd32", "string"};
+        static constexpr std::string_view known[] = {"int16",  "uint16", "int32", "uint32", "float",
+                                                     "double", "bcd",    "bcd32", "string"};
         if (std::find(std::begin(known), std::end(known), type) == std::end(known))
             return fail(key, p, fmt::format("'{}' is not a value type: {}", type, types));
         std::vector<std::uint32_t> out;
-        const auto add = [&out](const auto& words) { out.insert(out.end(), words.begin(), words.end()); };
+        const auto add = [&out](const auto& words) {
+            out.insert(out.end(), words.begin(), words.end());
+        };
         const auto one = [&](const toml::node& n) -> Expected<void> {
             const auto bad = [&](std::string_view what) {
                 return fail(key, p + "." + type, fmt::format("{}", what));
