@@ -19,7 +19,11 @@ namespace fins::test {
 
 class ServerThread {
   public:
-    explicit ServerThread(server::ServerOptions options = {}) {
+    // `mode`: the operating mode before the first request (03 07, 03 08 and the file
+    // transfers to the program area refuse RUN).
+    explicit ServerThread(server::ServerOptions options = {},
+                          plc::OperatingMode mode = plc::OperatingMode::run) {
+        plc_.set_mode(mode);
         if (options.port == 9600) options.port = 0;
         auto s = server::Server::start(io_, plc_, options);
         if (!s) throw std::runtime_error("server start: " + s.error().message());

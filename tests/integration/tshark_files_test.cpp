@@ -20,6 +20,7 @@
 #include "plc/plc.hpp"
 #include "process.hpp"
 #include "server/server.hpp"
+#include "server_fixture.hpp"
 #include "tshark_support.hpp"
 
 namespace fins::test {
@@ -27,42 +28,6 @@ namespace {
 
 using tshark::severity_warning;
 using tshark::split;
-
-class FileServer {
-  public:
-    FileServer() {
-        plc_.set_mode(plc::OperatingMode::program);
-        server::ServerOptions options;
-        options.port = 0;
-        auto s = server::Server::start(io_, plc_, options);
-        if (!s) throw std::runtime_error("server start: " + s.error().message());
-        server_ = std::move(*s);
-        port_ = server_->tcp_port() != 0 ? server_->tcp_port() : server_->udp_port();
-        thread_ = std::thread([this] { io_.run(); });
-    }
-    ~FileServer() {
-        asio::post(io_, [this] {
-            server_->stop();
-            io_.stop();
-        });
-        thread_.join();
-    }
-    [[nodiscard]] std::uint16_t port() const { return port_; }
-    std::unique_ptr<Client> client(bool tcp) {
-        ClientOptions o;
-        o.port = port_;
-        o.protocol = tcp ? ClientOptions::Protocol::tcp : ClientOptions::Protocol::udp;
-        auto c = Client::connect(o);
-        return c ? std::move(*c) : nullptr;
-    }
-
-  private:
-    asio::io_context io_{1};
-    plc::Plc plc_;
-    std::unique_ptr<server::Server> server_;
-    std::uint16_t port_ = 0;
-    std::thread thread_;
-};
 
 const std::vector<std::string> fields = {"omron.command", "omron.disk_no", "omron.response.code",
                                          "_ws.malformed", "_ws.expert.severity"};
@@ -72,7 +37,7 @@ FileName name(std::string_view text) {
 }
 
 TEST(TsharkFiles, DissectorReadsFileMemoryTraffic) {
-    FileServer server;
+    ServerThread server{{}, plc::OperatingMode::program};
     tshark::Capture capture(server.port(), "files");
     if (!capture.ready())
         GTEST_SKIP() << "tshark missing, or no permission to capture on lo (root or wireshark)";

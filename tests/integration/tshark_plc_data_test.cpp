@@ -23,6 +23,7 @@
 #include "plc/plc.hpp"
 #include "process.hpp"
 #include "server/server.hpp"
+#include "server_fixture.hpp"
 #include "tshark_support.hpp"
 
 namespace fins::test {
@@ -30,43 +31,6 @@ namespace {
 
 using tshark::severity_warning;
 using tshark::split;
-
-// finsd in this process, in PROGRAM mode (03 07 and 03 08 refuse RUN).
-class ProgramModeServer {
-  public:
-    ProgramModeServer() {
-        plc_.set_mode(plc::OperatingMode::program);
-        server::ServerOptions options;
-        options.port = 0;
-        auto s = server::Server::start(io_, plc_, options);
-        if (!s) throw std::runtime_error("server start: " + s.error().message());
-        server_ = std::move(*s);
-        port_ = server_->tcp_port() != 0 ? server_->tcp_port() : server_->udp_port();
-        thread_ = std::thread([this] { io_.run(); });
-    }
-    ~ProgramModeServer() {
-        asio::post(io_, [this] {
-            server_->stop();
-            io_.stop();
-        });
-        thread_.join();
-    }
-    [[nodiscard]] std::uint16_t port() const { return port_; }
-    std::unique_ptr<Client> client(bool tcp) {
-        ClientOptions o;
-        o.port = port_;
-        o.protocol = tcp ? ClientOptions::Protocol::tcp : ClientOptions::Protocol::udp;
-        auto c = Client::connect(o);
-        return c ? std::move(*c) : nullptr;
-    }
-
-  private:
-    asio::io_context io_{1};
-    plc::Plc plc_;
-    std::unique_ptr<server::Server> server_;
-    std::uint16_t port_ = 0;
-    std::thread thread_;
-};
 
 const std::vector<std::string> fields = {
     "omron.command",        "omron.parameter_area_code", "omron.word",      "omron.numwords",
@@ -87,7 +51,7 @@ std::vector<std::vector<std::string>> parse_rows(const std::string& out) {
 }
 
 TEST(TsharkPlcData, DissectorReadsParameterAndProgramAreaTrafficWithoutComplaint) {
-    ProgramModeServer server;
+    ServerThread server{{}, plc::OperatingMode::program};
     tshark::Capture capture(server.port(), "plc-data");
     if (!capture.ready())
         GTEST_SKIP() << "tshark missing, or no permission to capture on lo (root or wireshark)";
