@@ -17,6 +17,8 @@
 //   {"cmd":"release_access_right"}                  as 0C 03 from any node
 //   {"cmd":"card","inserted":true,"kbytes":30720}   inserts (capacity in KB, default the
 //                                                   profile's or 30720) or removes the card
+//   {"cmd":"cassette","inserted":false}             removes (or mounts) the CP1H Memory
+//                                                   Cassette; other profiles: an error
 // Anything else answers {"error":"..."} and the connection stays open. A line longer
 // than max_line_size answers an error and closes the connection; at most
 // max_connections clients at once (others get an error and are closed). Every handler
@@ -153,7 +155,8 @@ Json status(plc::Plc& plc) {
                 {"access_right_holder", holder},
                 {"network_write_protection", plc.network_write_protection()},
                 {"um_read_protection", plc.um_read_protection()},
-                {"memory_card_kbytes", plc.files().card_kbytes()}};
+                {"memory_card_kbytes", plc.files().card_kbytes()},
+                {"memory_cassette", plc.files().cassette_mounted()}};
 }
 
 Json raise_fal(plc::Plc& plc, const Json& j, bool fals, plc::ErrorState::TimePoint now) {
@@ -251,6 +254,13 @@ Json handle(plc::Plc& plc, const Json& j) {
             plc.files().insert_card(kb ? static_cast<std::uint32_t>(*kb)
                                        : (profile_kb != 0 ? profile_kb : 30720U));
         }
+    } else if (cmd == "cassette") {
+        // CP1H Memory Cassette (22 20 disk 8003): its files stay on the host while it is out.
+        const auto on = flag(j, "inserted");
+        if (!on) return fail("\"inserted\" must be true or false");
+        if (!plc.profile().memory_cassette)
+            return fail("the " + plc.profile().name + " has no Memory Cassette slot");
+        plc.files().mount_cassette(*on);
     } else {
         return fail("unknown cmd \"" + cmd + "\"");
     }

@@ -218,5 +218,43 @@ TEST(CliFiles, W342_5_3_43_CassetteUndefinedOnCj2h) {
     EXPECT_NE(r.err.find("0401"), std::string::npos) << r.err;
 }
 
+// The cassette comes out and goes back at run time (finsd ctl cassette) and can be
+// absent from the start ([files] cassette = false): without it 22 20 answers 2301 (W342
+// 5-3-43 / 5-1-3 "file device missing"), exit 4; the CJ2H has no slot (ctl error).
+TEST(CliFiles, W342_5_3_43_CassetteRemovedAndInsertedAtRunTime) {
+    ScratchDir dir("cli-cassette-ctl");
+    const auto socket = (dir.path() / "ctl.sock").string();
+    Finsd d({"--profile", "cp1h", "--mode", "program", "--control", socket});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    auto ctl = [&](std::string action) {
+        return run({finsd_path, "ctl", "--socket", socket, "cassette", action});
+    };
+    ASSERT_EQ(fins(d, {"files", "cassette", "type"}).exit_code, 0);
+    auto r = ctl("remove");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    r = fins(d, {"files", "cassette", "type"});
+    EXPECT_EQ(r.exit_code, 4);
+    EXPECT_NE(r.err.find("2301"), std::string::npos) << r.err;
+    r = run({finsd_path, "ctl", "--socket", socket, "status"});
+    EXPECT_NE(r.out.find("\"memory_cassette\":false"), std::string::npos) << r.out;
+    ASSERT_EQ(ctl("insert").exit_code, 0);
+    EXPECT_EQ(fins(d, {"files", "cassette", "type"}).exit_code, 0);
+
+    const auto config =
+        dir.write("no-cassette.toml", "profile = \"cp1h\"\n[files]\ncassette = false\n");
+    Finsd without({"--config", config, "--mode", "program"});
+    ASSERT_TRUE(without.started()) << without.result().err;
+    r = fins(without, {"files", "cassette", "type"});
+    EXPECT_EQ(r.exit_code, 4);
+    EXPECT_NE(r.err.find("2301"), std::string::npos) << r.err;
+
+    const auto socket2 = (dir.path() / "ctl2.sock").string();
+    Finsd cj2h({"--control", socket2});
+    ASSERT_TRUE(cj2h.started()) << cj2h.result().err;
+    r = run({finsd_path, "ctl", "--socket", socket2, "cassette", "remove"});
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_NE(r.out.find("no Memory Cassette slot"), std::string::npos) << r.out << r.err;
+}
+
 }  // namespace
 }  // namespace fins::test

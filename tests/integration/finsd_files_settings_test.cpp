@@ -45,5 +45,20 @@ TEST(FinsdFilesSettings, BadValuesNameTheKey) {
     EXPECT_NE(v.error().find("files.em_file_bank"), std::string::npos) << v.error();
 }
 
+TEST(FinsdFilesSettings, CassetteOnlyWhereTheProfileHasASlot) {
+    auto s = load("profile = \"cp1h\"\n[files]\ncassette = false\n");
+    ASSERT_TRUE(s) << s.error();
+    EXPECT_EQ(s->cassette, false);
+    EXPECT_TRUE(validate(*s));
+    s = load("[files]\ncassette = true\n");  // the default CJ2H
+    ASSERT_TRUE(s) << s.error();
+    const auto v = validate(*s);
+    ASSERT_FALSE(v);
+    EXPECT_NE(v.error().find("files.cassette"), std::string::npos) << v.error();
+    s = load("[files]\ncassette = 1\n");
+    ASSERT_FALSE(s);
+    EXPECT_NE(s.error().find("files.cassette"), std::string::npos) << s.error();
+}
+
 }  // namespace
 }  // namespace fins::cli::finsd

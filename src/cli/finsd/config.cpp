@@ -185,7 +185,8 @@ class Loader {
         return {};
     }
 
-    // [files] card = true/false, card_kbytes = 1-4194303, em_file_bank = 0-24.
+    // [files] card = true/false, card_kbytes = 1-4194303, em_file_bank = 0-24,
+    // cassette = true/false.
     Expected<void> files(const toml::key& key, const toml::node& node, const std::string& p) {
         const std::string_view k = key.str();
         if (k == "card") {
@@ -201,6 +202,12 @@ class Loader {
             const auto v = integer(key, node, p, 1, 4194303);
             if (!v) return tl::unexpected(v.error());
             if (s_.card_kbytes != 0u) s_.card_kbytes = static_cast<std::uint32_t>(*v);
+            return {};
+        }
+        if (k == "cassette") {
+            bool mounted = true;
+            if (auto r = flag(key, node, p, mounted); !r) return r;
+            s_.cassette = mounted;
             return {};
         }
         if (k == "em_file_bank") {

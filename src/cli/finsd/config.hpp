@@ -69,6 +69,9 @@ struct Settings {
     // EM bank of EM file memory. Unset: the profile's.
     std::optional<std::uint32_t> card_kbytes;
     std::optional<std::uint8_t> em_file_bank;
+    // [files] cassette: a Memory Cassette mounted at start (22 20; only profiles that
+    // have one, the CP1H). Unset: the profile's.
+    std::optional<bool> cassette;
 
     std::vector<MemoryInit> memory;  // [memory]
     plc::Injections inject;          // [inject]

@@ -13,6 +13,7 @@
 //   mode program|monitor|run        operating mode
 //   release-access                  drops the access right (as 0C 03)
 //   card insert [KB] | card remove  inserts (capacity in KB) or removes the memory card
+//   cassette insert | cassette remove  the CP1H Memory Cassette (22 20)
 //   send JSON                       any request line as is
 //
 // Exit codes: 0 the server answered "ok"; 2 usage error or the server refused the
@@ -175,6 +176,15 @@ int run_ctl(int argc, char** argv) {
     c_card->callback([&] {
         request = {{"cmd", "card"}, {"inserted", card_action == "insert"}};
         if (card_kbytes != 0) request["kbytes"] = card_kbytes;
+    });
+    std::string cassette_action;
+    auto* c_cassette =
+        app.add_subcommand("cassette", "Insert or remove the Memory Cassette (CP1H, 22 20)");
+    c_cassette->add_option("action", cassette_action, "insert or remove")
+        ->required()
+        ->check(CLI::IsMember({"insert", "remove"}));
+    c_cassette->callback([&] {
+        request = {{"cmd", "cassette"}, {"inserted", cassette_action == "insert"}};
     });
     auto* c_mode = app.add_subcommand("mode", "Set the operating mode");
     c_mode->add_option("mode", mode, "program, monitor or run")

@@ -21,9 +21,9 @@
 #include <string>
 #include <string_view>
 
+#include <fmt/format.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
-#include <fmt/format.h>
 #include <CLI/CLI.hpp>
 #include <asio/io_context.hpp>
 #include <asio/signal_set.hpp>
@@ -148,7 +148,7 @@ int configure(int argc, char** argv, Settings& settings) {
         app.add_option("--network-write-protection", protection,
                        "off, all, listed or all-except-listed (W342 5-1-2 note 5)");
     auto* o_nodes = app.add_option("--protect-node", o.protect_nodes,
-                   "A listed node, network.node (repeatable; node * = any)");
+                                   "A listed node, network.node (repeatable; node * = any)");
     auto* o_um = app.add_flag("--um-read-protection", um_read, "UM read protection set");
     auto* o_dip = app.add_flag("--dip-write-protection", dip_write,
                                "DIP switch pin 1 ON (UM write-protected)");
@@ -198,16 +198,17 @@ int configure(int argc, char** argv, Settings& settings) {
     // let someone believe those nodes are refused (or, under "all", the only ones).
     const auto write_mode = settings.network_write_protection.mode;
     using fins::plc::NetworkWriteProtection;
-    if (o_nodes->count() > 0 && (write_mode == NetworkWriteProtection::off ||
-                                 write_mode == NetworkWriteProtection::all))
+    if (o_nodes->count() > 0 &&
+        (write_mode == NetworkWriteProtection::off || write_mode == NetworkWriteProtection::all))
         return fail(2, fmt::format("--protect-node has no effect with network write protection "
                                    "'{}': add --network-write-protection listed (refuse those "
                                    "nodes) or all-except-listed (accept only those)",
                                    write_mode == NetworkWriteProtection::off ? "off" : "all"));
     if (!settings.network_write_protection.nodes.empty() &&
         write_mode == NetworkWriteProtection::off)
-        spdlog::warn("finsd: protection.nodes is set but protection.network_write is \"off\": "
-                     "no node is refused");
+        spdlog::warn(
+            "finsd: protection.nodes is set but protection.network_write is \"off\": "
+            "no node is refused");
     return -1;
 }
 
@@ -295,6 +296,7 @@ int serve(const Settings& s) {
             plc.files().insert_card(*s.card_kbytes);
     }
     if (s.em_file_bank) plc.files().set_em_file_bank(*s.em_file_bank);
+    if (s.cassette) plc.files().mount_cassette(*s.cassette);
     if (s.data_dir)
         if (auto r = plc.files().attach(*s.data_dir); !r)
             return fail(3, "file memory in " + s.data_dir->string() + ": " + r.error().message());
