@@ -182,6 +182,7 @@ Result<FileNameReadResponse> FileMemory::list(const FileNameRead& c) {
     if (!path) return fail(EndCode::parameter_error);
     auto device = open_device(c.disk);
     if (!device) return Unexpected(device.error());
+    date_open_files();
     const Fd dir = host::open_path(device->fd, *path);
     if (!dir.valid()) return fail(EndCode::read_file_missing);
 
@@ -273,7 +274,7 @@ EndCode FileMemory::write(const SingleFileWrite& c, CivilSeconds now) {
     Fd walked;
     OpenFile* cached = find_open_file(device->index, key);
     if (cached != nullptr) {
-        kind = host::kind_of(cached->directory, *name, &st);
+        kind = host::identity_of(cached->directory, *name, &st);
         if (kind == Kind::file && static_cast<std::uint64_t>(st.st_ino) == cached->inode &&
             static_cast<std::uint64_t>(st.st_dev) == cached->host_device) {
             dir_fd = cached->directory;
@@ -325,9 +326,13 @@ EndCode FileMemory::write(const SingleFileWrite& c, CivilSeconds now) {
             cached = keep_open(device->index, key, walked.get(), *name);
             if (cached != nullptr) static_cast<void>(walked.release());
         }
-        ok = cached != nullptr ? host::write_fd(cached->fd, offset, c.data, now)
-                               : host::write_at(dir_fd, *name, offset, c.data, now);
-        if (cached != nullptr) cached->last_write = now;
+        if (cached != nullptr) {
+            ok = host::write_undated(cached->fd, offset, c.data);
+            cached->last_write = now;
+            cached->undated = true;
+        } else {
+            ok = host::write_at(dir_fd, *name, offset, c.data, now);
+        }
     } else {
         // A new inode replaces the file: the kept descriptor would write to the old one.
         if (cached != nullptr) close_open_file(cached);
@@ -406,6 +411,7 @@ EndCode FileMemory::copy(const FileCopy& c) {
     auto target = open_device(c.destination_disk);
     if (!target) return EndCode{static_cast<std::uint16_t>(target.error().value())};
     forget_open_files(target->index);
+    date_open_files();  // the copy takes the source's date
     const Fd from_dir = host::open_path(source->fd, *from_path);
     struct stat st {};
     if (!from_dir.valid() || host::kind_of(from_dir.get(), *from, &st) != Kind::file)

@@ -130,8 +130,10 @@ class FileMemory {
   private:
     // A file that 22 03 extended, kept open with its directory so that the next chunk
     // skips the path walk and the open: found by device and "\DIR\NAME" key, used only
-    // while fstatat(dir, name, AT_SYMLINK_NOFOLLOW) still names the same regular file
-    // (a host-side rename, delete or symlink swap falls back to the checked walk).
+    // while statx(dir, name, AT_SYMLINK_NOFOLLOW) still names the same regular file
+    // (a host-side rename, delete or symlink swap falls back to the checked walk). Its
+    // chunks are written undated; the file gets its CPU clock date when it is closed
+    // or before 22 01 / 22 07 / a load reads dates (date_open_files()).
     // Dropped by every 22 xx change other than 22 03 on that device, card removal, EM
     // reconfiguration, attach(); the least recently used goes first past
     // max_open_files; closed at destruction.
@@ -144,6 +146,7 @@ class FileMemory {
         std::uint64_t inode = 0;
         CivilSeconds last_write = 0;
         std::uint64_t last_use = 0;  // LRU order
+        bool undated = false;        // written since last dated: date it last_write
     };
     OpenFile* find_open_file(std::size_t device, const std::string& key) noexcept;
     // Takes ownership of `directory` on success; nullptr when `name` cannot be opened.
@@ -152,6 +155,9 @@ class FileMemory {
     void close_open_file(OpenFile* file) noexcept;
     // Closes the cached descriptors of `device` (all when nullopt).
     void forget_open_files(std::optional<std::size_t> device = std::nullopt) noexcept;
+    // Gives the open files written since they were last dated their CPU clock date
+    // (futimens once, not once per chunk): before anything reads file dates.
+    void date_open_files() noexcept;
     void close_idle_files(CivilSeconds now) noexcept;
 
     Result<Device> open_device(std::uint16_t disk);

@@ -3,6 +3,7 @@
 
 #include <dirent.h>
 #include <fcntl.h>
+#include <sys/sysmacros.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -54,6 +55,23 @@ Kind kind_of(int dir, const std::string& name, struct stat* info) noexcept {
     if (info != nullptr) *info = st;
     if (S_ISREG(st.st_mode)) return Kind::file;
     if (S_ISDIR(st.st_mode)) return Kind::directory;
+    return Kind::other;
+}
+
+Kind identity_of(int dir, const std::string& name, struct stat* info) noexcept {
+    struct statx sx {};
+    if (::statx(dir, name.c_str(), AT_SYMLINK_NOFOLLOW,
+                STATX_TYPE | STATX_MODE | STATX_INO | STATX_SIZE, &sx) != 0)
+        return Kind::missing;
+    if (info != nullptr) {
+        *info = {};
+        info->st_mode = sx.stx_mode;
+        info->st_ino = sx.stx_ino;
+        info->st_dev = makedev(sx.stx_dev_major, sx.stx_dev_minor);
+        info->st_size = static_cast<off_t>(sx.stx_size);
+    }
+    if (S_ISREG(sx.stx_mode)) return Kind::file;
+    if (S_ISDIR(sx.stx_mode)) return Kind::directory;
     return Kind::other;
 }
 
@@ -186,6 +204,15 @@ bool write_at(int dir, const std::string& name, std::uint64_t offset, Bytes data
               std::int64_t mtime) noexcept {
     const Fd fd(::openat(dir, name.c_str(), O_WRONLY | O_NOFOLLOW | O_CLOEXEC));
     return fd.valid() && write_fd(fd.get(), offset, data, mtime);
+}
+
+bool write_undated(int fd, std::uint64_t offset, Bytes data) noexcept {
+    return write_fully(fd, data, static_cast<off_t>(offset));
+}
+
+bool set_mtime_fd(int fd, std::int64_t mtime) noexcept {
+    const timespec times[2] = {at(mtime), at(mtime)};
+    return ::futimens(fd, times) == 0;
 }
 
 bool write_fd(int fd, std::uint64_t offset, Bytes data, std::int64_t mtime) noexcept {

@@ -48,6 +48,11 @@ struct Entry {
 
 // lstat-like, relative to `dir`.
 Kind kind_of(int dir, const std::string& name, struct stat* info = nullptr) noexcept;
+// What kind_of() says, without asking for the file's times: on Linux 6.13+ (multigrain
+// timestamps) a stat that reads mtime makes the next write stamp a fine-grained time,
+// which dirties the inode and journals it: about 15 us per 22 03 chunk instead of 2.
+// st_mode, st_ino, st_dev and st_size of `info` are filled, nothing else.
+Kind identity_of(int dir, const std::string& name, struct stat* info) noexcept;
 // Opens the sub-directory `name` of `dir` (O_DIRECTORY | O_NOFOLLOW); invalid when absent.
 Fd open_directory(int dir, const std::string& name) noexcept;
 // Walks `components` from `dir`; invalid when one is missing or not a directory.
@@ -69,6 +74,10 @@ bool write_at(int dir, const std::string& name, std::uint64_t offset, Bytes data
               std::int64_t mtime) noexcept;
 // The same on an open descriptor of a regular file.
 bool write_fd(int fd, std::uint64_t offset, Bytes data, std::int64_t mtime) noexcept;
+// pwrite of `data` at `offset`, all of it or false; the caller dates the file later.
+bool write_undated(int fd, std::uint64_t offset, Bytes data) noexcept;
+// Sets the modification time of an open file.
+bool set_mtime_fd(int fd, std::int64_t mtime) noexcept;
 // Sets the modification time of `name` (not following symlinks).
 bool set_mtime(int dir, const char* name, std::int64_t mtime) noexcept;
 

@@ -7,6 +7,7 @@
 #include <algorithm>
 
 #include "plc/file_memory.hpp"
+#include "plc/file_memory_host.hpp"
 
 namespace fins::plc {
 
@@ -47,6 +48,7 @@ FileMemory::OpenFile* FileMemory::keep_open(std::size_t device, std::string key,
 }
 
 void FileMemory::close_open_file(OpenFile* file) noexcept {
+    if (file->undated) host::set_mtime_fd(file->fd, file->last_write);
     ::close(file->fd);
     ::close(file->directory);
     const auto index = static_cast<std::ptrdiff_t>(file - open_files_.data());
@@ -56,6 +58,14 @@ void FileMemory::close_open_file(OpenFile* file) noexcept {
 void FileMemory::forget_open_files(std::optional<std::size_t> device) noexcept {
     for (std::size_t i = open_files_.size(); i-- > 0;)
         if (!device || open_files_[i].device == *device) close_open_file(&open_files_[i]);
+}
+
+void FileMemory::date_open_files() noexcept {
+    for (auto& f : open_files_)
+        if (f.undated) {
+            host::set_mtime_fd(f.fd, f.last_write);
+            f.undated = false;
+        }
 }
 
 void FileMemory::close_idle_files(CivilSeconds now) noexcept {

@@ -78,11 +78,20 @@ TEST_F(OpenFilesTest, W342_5_3_34_AppendsReuseOneDescriptor) {
     EXPECT_EQ(files.open_files(), 0U);
     ASSERT_EQ(append("A.BIN", "5"), EndCode::normal_completion);
     EXPECT_EQ(slurp(card() / "A.BIN"), "X12345");
-    // The date is the CPU clock of the last chunk.
+    // The date is the CPU clock of the last chunk, given once rather than per chunk
+    // (FileMemory::date_open_files): before 22 01 reads dates ...
     ASSERT_EQ(append("A.BIN", "6", 1'700'000'001), EndCode::normal_completion);
+    ASSERT_TRUE(files.list({disk_memory_card, 0, 20, ""}));
     struct stat st {};
     ASSERT_EQ(::stat((card() / "A.BIN").c_str(), &st), 0);
     EXPECT_EQ(st.st_mtime, 1'700'000'001);
+    EXPECT_EQ(files.open_files(), 1U);  // still open for the next chunk
+    // ... and when the descriptor is closed (here: the card comes out).
+    ASSERT_EQ(append("A.BIN", "7", 1'700'000'009), EndCode::normal_completion);
+    files.remove_card();
+    EXPECT_EQ(files.open_files(), 0U);
+    ASSERT_EQ(::stat((card() / "A.BIN").c_str(), &st), 0);
+    EXPECT_EQ(st.st_mtime, 1'700'000'009);
 }
 
 TEST_F(OpenFilesTest, W342_5_3_36_DeleteRenameFormatAndCardRemovalDropIt) {
