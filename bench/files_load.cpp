@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <random>
+#include <span>
 #include <thread>
 #include <vector>
 
@@ -74,31 +75,90 @@ class Echo {
     std::thread thread_;
 };
 
-// `count` requests of `request_size` bytes, `window` in flight, to the echo: seconds.
-double drive_echo(std::size_t request_size, std::size_t reply_size, std::size_t count,
-                  std::size_t window) {
-    Echo echo(reply_size);
+int connect_udp(std::uint16_t port) {
     const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
     sockaddr_in a{};
     a.sin_family = AF_INET;
     a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    a.sin_port = htons(echo.port());
+    a.sin_port = htons(port);
     ::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
-    std::vector<std::uint8_t> request(request_size, 0x80);
+    // A lost datagram ends the run (reported as a failure), never hangs it.
+    timeval tv{2, 0};
+    setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+    return fd;
+}
+
+// The same blocking generator for the echo and for finsd: `frame(i)` is request i,
+// `window` in flight. Seconds, or a negative value when an answer is missing or (for
+// finsd, `check`) carries an end code other than 0000.
+template <class FrameOf>
+double drive(std::uint16_t port, std::size_t count, std::size_t window, FrameOf frame, bool check) {
+    const int fd = connect_udp(port);
     std::array<std::uint8_t, 4096> buf{};
     const auto start = Clock::now();
     std::size_t sent = 0;
     std::size_t received = 0;
-    while (received < count) {
+    bool ok = true;
+    while (received < count && ok) {
         while (sent < count && sent - received < window) {
+            const auto request = frame(sent);
             ::send(fd, request.data(), request.size(), 0);
             ++sent;
         }
-        if (::recv(fd, buf.data(), buf.size(), 0) > 0) ++received;
+        const auto n = ::recv(fd, buf.data(), buf.size(), 0);
+        if (n <= 0) ok = false;
+        // The end code follows the 10-byte header and the 2-byte command code.
+        if (check && (n < 14 || buf[12] != 0 || (buf[13] & 0x3F) != 0)) ok = false;
+        ++received;
     }
     const double s = std::chrono::duration<double>(Clock::now() - start).count();
     ::close(fd);
-    return s;
+    return ok ? s : -1;
+}
+
+// `count` requests of `request_size` bytes, `window` in flight, to the echo: seconds.
+double drive_echo(std::size_t request_size, std::size_t reply_size, std::size_t count,
+                  std::size_t window) {
+    Echo echo(reply_size);
+    const std::vector<std::uint8_t> request(request_size, 0x80);
+    return drive(
+        echo.port(), count, window, [&](std::size_t) { return fins::Bytes{request}; }, false);
+}
+
+// Pre-encoded 22 03 (put: the first chunk 0001, the rest 0002 append) and 22 02 (get)
+// frames, as put_file/get_file send them, for the raw generator.
+std::vector<std::vector<std::uint8_t>> encode_frames(std::span<const std::uint8_t> data,
+                                                     const fins::FileName& name, bool put) {
+    std::vector<std::vector<std::uint8_t>> frames;
+    const std::size_t chunk = put ? fins::max_parameter_size - 24 : fins::max_file_read_bytes;
+    for (std::size_t offset = 0, i = 0; offset < data.size(); offset += chunk, ++i) {
+        const std::size_t n = std::min(chunk, data.size() - offset);
+        std::array<std::uint8_t, fins::max_parameter_size> params{};
+        fins::ByteWriter w{params};
+        if (put) {
+            fins::SingleFileWrite c;
+            c.mode = static_cast<std::uint16_t>(i == 0 ? fins::FileWriteMode::create_or_replace
+                                                       : fins::FileWriteMode::append);
+            c.file = name;
+            c.data = data.subspan(offset, n);
+            c.encode(w);
+        } else {
+            fins::SingleFileRead c;
+            c.file = name;
+            c.position = static_cast<std::uint32_t>(offset);
+            c.length = static_cast<std::uint16_t>(n);
+            c.encode(w);
+        }
+        fins::Header h;
+        h.destination = {0, 1, 0};
+        h.source = {0, 200, 0};
+        h.service_id = static_cast<std::uint8_t>(i);
+        std::vector<std::uint8_t> out(fins::max_frame_size);
+        const auto code = put ? fins::SingleFileWrite::code : fins::SingleFileRead::code;
+        out.resize(fins::encode_request(h, code, w.written(), out).value_or(0));
+        frames.push_back(std::move(out));
+    }
+    return frames;
 }
 
 }  // namespace
@@ -146,6 +206,8 @@ int main(int argc, char** argv) {
         (bytes + fins::max_file_read_bytes - 1) / fins::max_file_read_bytes;
     const double mb = static_cast<double>(bytes) / 1e6;
 
+    const auto put_frames = encode_frames(data, name, true);
+    const auto get_frames = encode_frames(data, name, false);
     for (unsigned round = 0; round < rounds; ++round) {
         auto t0 = Clock::now();
         auto put =
@@ -158,20 +220,37 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "fins_files_load: transfer failed\n");
             return 1;
         }
+        // The raw generator against finsd: the same frames put_file/get_file send, from
+        // the echo's blocking loop, so the ratio to the echo is finsd's own cost.
+        const double raw_put =
+            drive((*server)->udp_port(), put_frames.size(), window,
+                  [&](std::size_t i) { return fins::Bytes{put_frames[i]}; }, true);
+        const double raw_get =
+            drive((*server)->udp_port(), get_frames.size(), window,
+                  [&](std::size_t i) { return fins::Bytes{get_frames[i]}; }, true);
+        if (raw_put < 0 || raw_get < 0) {
+            std::fprintf(stderr, "fins_files_load: a raw 22 02/22 03 frame failed\n");
+            return 1;
+        }
         const double echo_put = drive_echo(put_request, put_reply, put_count, window);
         const double echo_get = drive_echo(get_request, get_reply, get_count, window);
         if (json)
             fmt::print(
-                "{{\"round\":{},\"put_mbps\":{:.2f},\"echo_put_mbps\":{:.2f},\"put_ratio\":{:.2f},"
-                "\"get_mbps\":{:.2f},\"echo_get_mbps\":{:.2f},\"get_ratio\":{:.2f}}}\n",
-                round, mb / put_s, mb / echo_put, echo_put / put_s, mb / get_s, mb / echo_get,
-                echo_get / get_s);
+                "{{\"round\":{},\"put_mbps\":{:.2f},\"raw_put_mbps\":{:.2f},"
+                "\"echo_put_mbps\":{:.2f},\"put_ratio\":{:.2f},\"raw_put_ratio\":{:.2f},"
+                "\"get_mbps\":{:.2f},\"raw_get_mbps\":{:.2f},\"echo_get_mbps\":{:.2f},"
+                "\"get_ratio\":{:.2f},\"raw_get_ratio\":{:.2f}}}\n",
+                round, mb / put_s, mb / raw_put, mb / echo_put, echo_put / put_s,
+                echo_put / raw_put, mb / get_s, mb / raw_get, mb / echo_get, echo_get / get_s,
+                echo_get / raw_get);
         else
             fmt::print(
-                "round {}: put {:6.2f} MB/s (echo {:6.2f}, ratio {:.2f}) | get {:6.2f} MB/s "
-                "(echo {:6.2f}, ratio {:.2f})\n",
-                round, mb / put_s, mb / echo_put, echo_put / put_s, mb / get_s, mb / echo_get,
-                echo_get / get_s);
+                "round {}: put {:6.1f} MB/s libfins (ratio {:.2f}), {:6.1f} raw (ratio {:.2f}), "
+                "echo {:6.1f} | get {:6.1f} libfins (ratio {:.2f}), {:6.1f} raw (ratio {:.2f}), "
+                "echo {:6.1f}\n",
+                round, mb / put_s, echo_put / put_s, mb / raw_put, echo_put / raw_put,
+                mb / echo_put, mb / get_s, echo_get / get_s, mb / raw_get, echo_get / raw_get,
+                mb / echo_get);
     }
     (*server)->stop();
     io.stop();

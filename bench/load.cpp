@@ -215,6 +215,24 @@ struct Stats {
     }
 };
 
+// Each field's median over the runs (rate, p50, p99 and CPU per request separately).
+Stats median_stats(std::vector<Stats> runs) {
+    auto median = [&](auto field) {
+        std::vector<double> v;
+        for (const auto& r : runs)
+            v.push_back(field(r));
+        std::sort(v.begin(), v.end());
+        return v[v.size() / 2];
+    };
+    Stats s;
+    s.rate = median([](const Stats& r) { return r.rate; });
+    s.p50_us = median([](const Stats& r) { return r.p50_us; });
+    s.p99_us = median([](const Stats& r) { return r.p99_us; });
+    s.count = 1'000'000;
+    s.cpu_us = median([](const Stats& r) { return r.cpu_per_request_us(); }) * 1e6;
+    return s;
+}
+
 int connect_to(bool tcp, std::uint16_t port, bool nodelay = true) {
     const int fd = ::socket(AF_INET, tcp ? SOCK_STREAM : SOCK_DGRAM, 0);
     sockaddr_in a{};
@@ -308,6 +326,12 @@ int main(int argc, char** argv) {
                    "The UDP echo: batched (recvmmsg/sendmmsg) or per-datagram (recvfrom/sendto)")
         ->check(CLI::IsMember({"batched", "per-datagram"}))
         ->capture_default_str();
+    unsigned rounds = 1;
+    app.add_option("--rounds", rounds,
+                   "Alternate finsd and the echo this many times per case (each seconds/rounds); "
+                   "medians are printed")
+        ->capture_default_str()
+        ->check(CLI::Range(1u, 101u));
     bool client_mode = false;
     app.add_flag("--client", client_mode,
                  "Drive finsd through fins::Client (32 in flight) next to the raw generator");
@@ -369,41 +393,65 @@ int main(int argc, char** argv) {
         const auto shapes = tcp ? std::vector<Shape>{{1, false}, {32, false}, {1, true}}
                                 : std::vector<Shape>{{1, false}, {32, false}};
         for (const auto [depth, split] : shapes) {
+            EchoServer echo(tcp, f.request.size(), f.response_size,
+                            {.udp_batched = udp_echo == "batched", .quickack = split});
+            // Rounds alternate which side goes first, so a load that rises or falls during
+            // the case weighs on both alike; the medians are reported.
+            const double slice = seconds / rounds;
             const int fd = connect_to(tcp, (*server)->tcp_port(), !split);
             if (fd < 0 || (tcp && !tcp_handshake(fd))) {
                 std::fprintf(stderr, "fins_load: cannot reach finsd\n");
                 return 1;
             }
-            const double finsd_cpu_before = cpu_seconds(server_thread);
-            Stats finsd = drive(fd, tcp, f, depth, seconds, split);
-            finsd.cpu_us = (cpu_seconds(server_thread) - finsd_cpu_before) * 1e6;
-            ::close(fd);
-
-            EchoServer echo(tcp, f.request.size(), f.response_size,
-                            {.udp_batched = udp_echo == "batched", .quickack = split});
             const int efd = connect_to(tcp, echo.port(), !split);
-            const double echo_cpu_before = echo.cpu();
-            Stats raw = drive(efd, tcp, f, depth, seconds, split);
-            raw.cpu_us = (echo.cpu() - echo_cpu_before) * 1e6;
+            std::vector<Stats> finsd_runs, echo_runs;
+            std::vector<double> ratios;
+            for (unsigned round = 0; round < rounds; ++round) {
+                Stats one_finsd, one_echo;
+                auto run_finsd = [&] {
+                    const double before = cpu_seconds(server_thread);
+                    one_finsd = drive(fd, tcp, f, depth, slice, split);
+                    one_finsd.cpu_us = (cpu_seconds(server_thread) - before) * 1e6;
+                };
+                auto run_echo = [&] {
+                    const double before = echo.cpu();
+                    one_echo = drive(efd, tcp, f, depth, slice, split);
+                    one_echo.cpu_us = (echo.cpu() - before) * 1e6;
+                };
+                if (round % 2 == 1) run_echo();
+                run_finsd();
+                if (round % 2 == 0) run_echo();
+                finsd_runs.push_back(one_finsd);
+                echo_runs.push_back(one_echo);
+                ratios.push_back(one_echo.rate > 0 ? one_finsd.rate / one_echo.rate : 0);
+            }
+            ::close(fd);
             ::close(efd);
-
-            const double ratio = raw.rate > 0 ? finsd.rate / raw.rate : 0;
+            const Stats finsd = median_stats(finsd_runs);
+            const Stats raw = median_stats(echo_runs);
+            std::sort(ratios.begin(), ratios.end());
+            const double ratio = ratios[ratios.size() / 2];
+            const double p99_ratio = raw.p99_us > 0 ? finsd.p99_us / raw.p99_us : 0;
             const char* proto = !tcp ? "udp" : split ? "tcp-split" : "tcp";
             if (json) {
                 fmt::print(
                     "{{\"transport\":\"{}\",\"in_flight\":{},\"finsd_rps\":{:.0f},"
                     "\"finsd_p50_us\":{:.1f},\"finsd_p99_us\":{:.1f},\"echo_rps\":{:.0f},"
                     "\"echo_p50_us\":{:.1f},\"echo_p99_us\":{:.1f},\"ratio\":{:.2f},"
-                    "\"finsd_cpu_us_per_request\":{:.2f},\"echo_cpu_us_per_request\":{:.2f}}}\n",
+                    "\"finsd_cpu_us_per_request\":{:.2f},\"echo_cpu_us_per_request\":{:.2f},"
+                    "\"p99_ratio\":{:.2f},\"rounds\":{}}}\n",
                     proto, depth, finsd.rate, finsd.p50_us, finsd.p99_us, raw.rate, raw.p50_us,
-                    raw.p99_us, ratio, finsd.cpu_per_request_us(), raw.cpu_per_request_us());
+                    raw.p99_us, ratio, finsd.cpu_per_request_us(), raw.cpu_per_request_us(),
+                    p99_ratio, rounds);
             } else {
                 fmt::print(
                     "{:<9} in-flight {:>2}: finsd {:>8.0f} req/s p50 {:>6.1f} us p99 {:>6.1f} us | "
-                    "echo {:>8.0f} req/s p50 {:>6.1f} us p99 {:>6.1f} us | ratio {:.2f} | "
+                    "echo {:>8.0f} req/s p50 {:>6.1f} us p99 {:>6.1f} us | ratio {:.2f} p99 "
+                    "x{:.2f} | "
                     "cpu/req finsd {:.2f} us echo {:.2f} us\n",
                     proto, depth, finsd.rate, finsd.p50_us, finsd.p99_us, raw.rate, raw.p50_us,
-                    raw.p99_us, ratio, finsd.cpu_per_request_us(), raw.cpu_per_request_us());
+                    raw.p99_us, ratio, p99_ratio, finsd.cpu_per_request_us(),
+                    raw.cpu_per_request_us());
             }
             std::fflush(stdout);
         }
