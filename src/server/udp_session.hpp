@@ -6,7 +6,9 @@
 //   wait until readable -> recvmmsg() up to `batch_size` datagrams (MSG_DONTWAIT) ->
 //   Dispatcher::handle each into its own reply slot -> one sendmmsg() for the replies ->
 //   again until recvmmsg finds nothing (at most `rounds_per_turn` batches, then the
-//   turn goes back to the other sessions and continues after them), then wait.
+//   turn goes back to the other sessions and continues after them), then wait. A turn
+//   that starts with a lone datagram waits at once (a client with one request in flight
+//   sends its next only after this reply: the extra recvmmsg would find nothing).
 // All buffers live in the session, allocated once: the path allocates nothing per
 // datagram.
 //
