@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <ctime>
 
+#include "plc/file_memory_device.hpp"
 #include "plc/file_memory_host.hpp"
 
 namespace fins::plc {
@@ -20,10 +21,6 @@ using host::Kind;
 namespace {
 
 constexpr std::uint32_t card_volume_date_fallback = 0;
-
-Unexpected fail(EndCode code) {
-    return Unexpected(make_error_code(code));
-}
 
 std::uint32_t date_of(std::int64_t mtime) noexcept {
     const auto t = static_cast<std::time_t>(mtime);
@@ -56,13 +53,6 @@ FileEntry dot_entry(std::string_view dots, const struct stat& st) {
 constexpr const char* volume_file = ".volume";
 
 }  // namespace
-
-struct FileMemory::Device {
-    int fd = -1;  // kept open in device_fds_
-    std::size_t index = 0;
-    std::uint64_t capacity = 0;
-    std::string_view label;
-};
 
 // ---- devices ----
 
@@ -214,146 +204,6 @@ Result<FileNameReadResponse> FileMemory::list(const FileNameRead& c) {
                    all.begin() + static_cast<std::ptrdiff_t>(end));
     r.last = end == all.size() && c.count != 0;
     return r;
-}
-
-// ---- 22 02 ----
-
-Result<SingleFileReadResponse> FileMemory::read(const SingleFileRead& c) {
-    const auto name = canonical_name(c.file);
-    const auto path = parse_directory(c.directory);
-    if (!name || !path || c.length > max_file_read_bytes) return fail(EndCode::parameter_error);
-    auto device = open_device(c.disk);
-    if (!device) return Unexpected(device.error());
-    const Fd dir = host::open_path(device->fd, *path);
-    if (!dir.valid()) return fail(EndCode::read_file_missing);
-    const Fd fd(::openat(dir.get(), name->c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC));
-    struct stat st {};
-    if (!fd.valid() || ::fstat(fd.get(), &st) != 0 || !S_ISREG(st.st_mode))
-        return fail(EndCode::read_file_missing);
-    const auto size = static_cast<std::uint64_t>(st.st_size);
-    if (c.position > size) return fail(EndCode::address_range_error);
-    const auto n = static_cast<std::size_t>(std::min<std::uint64_t>(c.length, size - c.position));
-    SingleFileReadResponse r;
-    r.file_size = static_cast<std::uint32_t>(std::min<std::uint64_t>(size, 0xFFFFFFFF));
-    r.position = c.position;
-    r.data.resize(n);
-    std::size_t done = 0;
-    while (done < n) {
-        const auto got = ::pread(fd.get(), r.data.data() + done, n - done,
-                                 static_cast<off_t>(c.position + done));
-        if (got < 0 && errno == EINTR) continue;
-        if (got <= 0) return fail(EndCode::memory_error);
-        done += static_cast<std::size_t>(got);
-    }
-    r.last = c.position + n == size;
-    return r;
-}
-
-// ---- 22 03 ----
-
-EndCode FileMemory::write(const SingleFileWrite& c, CivilSeconds now) {
-    const auto name = canonical_name(c.file);
-    const auto path = parse_directory(c.directory);
-    if (!name || !path || c.mode > static_cast<std::uint16_t>(FileWriteMode::overwrite))
-        return EndCode::parameter_error;
-    const auto mode = static_cast<FileWriteMode>(c.mode);
-    // 5-3-34: "To create a new file or add data to an existing file, specify 00000000".
-    if (mode != FileWriteMode::overwrite && c.position != 0) return EndCode::parameter_error;
-    auto device = open_device(c.disk);
-    if (!device) return EndCode{static_cast<std::uint16_t>(device.error().value())};
-    close_idle_files(now);
-    // The chunks of one transfer: the directory and file stay open while the name still
-    // names the same regular file (no walk, no open); anything else takes the walk.
-    std::string key;
-    for (const auto& component : *path)
-        key += "\\" + component;
-    key += "\\" + *name;
-    struct stat st {};
-    auto kind = Kind::missing;
-    int dir_fd = -1;
-    Fd walked;
-    OpenFile* cached = find_open_file(device->index, key);
-    if (cached != nullptr) {
-        kind = host::identity_of(cached->directory, *name, &st);
-        if (kind == Kind::file && static_cast<std::uint64_t>(st.st_ino) == cached->inode &&
-            static_cast<std::uint64_t>(st.st_dev) == cached->host_device) {
-            dir_fd = cached->directory;
-        } else {
-            close_open_file(cached);
-            cached = nullptr;
-        }
-    }
-    if (dir_fd < 0) {
-        walked = host::open_path(device->fd, *path);
-        if (!walked.valid()) return EndCode::write_file_missing;
-        dir_fd = walked.get();
-        kind = host::kind_of(dir_fd, *name, &st);
-    }
-    if (kind != Kind::missing && kind != Kind::file) return EndCode::file_name_exists;
-    const bool exists = kind == Kind::file;
-    const std::uint64_t old_size = exists ? static_cast<std::uint64_t>(st.st_size) : 0;
-
-    std::uint64_t offset = 0;
-    switch (mode) {
-        case FileWriteMode::create:
-            if (exists) return EndCode::file_name_exists;
-            break;
-        case FileWriteMode::create_or_replace:
-            break;
-        case FileWriteMode::append:
-            if (!exists) return EndCode::write_file_missing;
-            offset = old_size;
-            break;
-        case FileWriteMode::overwrite:
-            if (!exists) return EndCode::write_file_missing;
-            if (c.position > old_size) return EndCode::address_range_error;
-            offset = c.position;
-            break;
-    }
-    const bool replacing =
-        mode == FileWriteMode::create || mode == FileWriteMode::create_or_replace;
-    const std::uint64_t end = offset + c.data.size();
-    if (end > 0xFFFFFFFF) return EndCode::address_range_exceeded;
-    const std::uint64_t new_size = replacing ? c.data.size() : std::max(old_size, end);
-    const auto used = bytes_in_use(*device);
-    if (new_size > old_size && used + (new_size - old_size) > device->capacity)
-        return EndCode::address_range_exceeded;
-
-    bool ok = false;
-    if (offset == old_size && !replacing) {
-        // Only adds bytes: nothing already in the file can be half-changed.
-        if (cached == nullptr && walked.valid()) {
-            cached = keep_open(device->index, key, walked.get(), *name);
-            if (cached != nullptr) static_cast<void>(walked.release());
-        }
-        if (cached != nullptr) {
-            ok = host::write_undated(cached->fd, offset, c.data);
-            cached->last_write = now;
-            cached->undated = true;
-        } else {
-            ok = host::write_at(dir_fd, *name, offset, c.data, now);
-        }
-    } else {
-        // A new inode replaces the file: the kept descriptor would write to the old one.
-        if (cached != nullptr) close_open_file(cached);
-        if (!walked.valid()) {
-            walked = host::open_path(device->fd, *path);
-            if (!walked.valid()) return EndCode::write_file_missing;
-        }
-        if (replacing) {
-            ok = host::replace(walked.get(), *name, c.data, now, temp_counter_);
-        } else {
-            auto content = host::read_all(walked.get(), *name);
-            if (!content) return EndCode::memory_error;
-            content->resize(static_cast<std::size_t>(new_size));
-            std::copy(c.data.begin(), c.data.end(),
-                      content->begin() + static_cast<std::ptrdiff_t>(offset));
-            ok = host::replace(walked.get(), *name, *content, now, temp_counter_);
-        }
-    }
-    if (!ok) return EndCode::memory_error;
-    used_[device->index] = (used >= old_size ? used - old_size : 0) + new_size;
-    return EndCode::normal_completion;
 }
 
 // ---- 22 04 ----

@@ -6,19 +6,12 @@
 #include <unistd.h>
 
 #include "plc/file_memory.hpp"
+#include "plc/file_memory_device.hpp"
 #include "plc/file_memory_host.hpp"
 
 namespace fins::plc {
 
 using host::Kind;
-
-namespace {
-
-Unexpected fail(EndCode code) {
-    return Unexpected(make_error_code(code));
-}
-
-}  // namespace
 
 Result<int> FileMemory::cassette_directory() {
     if (!cassette_mounted_) return fail(EndCode::file_device_missing);
