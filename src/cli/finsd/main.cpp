@@ -28,6 +28,7 @@
 #include <asio/io_context.hpp>
 #include <asio/signal_set.hpp>
 
+#include "cli/finsd/serial_ports.hpp"
 #include "cli/finsd/config.hpp"
 #include "cli/finsd/ctl.hpp"
 #include "plc/plc.hpp"
@@ -328,6 +329,9 @@ int serve(const Settings& s) {
                                started.error().message());
         control = std::move(*started);
     }
+    fins::cli::finsd::SerialPorts serial;
+    if (auto r = start_serial_ports(io, (*server)->dispatcher(), s.serial, serial); !r)
+        return fail(2, r.error());
     // Before "listening": a SIGTERM right after that line still stops finsd cleanly.
     asio::signal_set signals{io, SIGINT, SIGTERM};
     const auto self = (*server)->address();
@@ -344,6 +348,7 @@ int serve(const Settings& s) {
         spdlog::info("finsd: signal {}, shutting down", signal);
         (*server)->stop();
         if (control) control->stop();
+        serial.stop();
         plc.storage().flush();
         io.stop();
     });
