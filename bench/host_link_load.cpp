@@ -18,6 +18,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <string>
 #include <thread>
@@ -82,6 +83,11 @@ class LineEmulator {
                 free = std::max(free, Clock::now()) +
                        std::chrono::duration_cast<Clock::duration>(char_time_ * n);
                 std::this_thread::sleep_until(free);
+                // Time the emulator held the bytes beyond the line's own time: its wake-up
+                // latency on a busy machine, which a UART does not have.
+                late_ns_ +=
+                    std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - free)
+                        .count();
                 const int to = 1 - from;
                 for (ssize_t done = 0; done < n;) {
                     const auto w =
@@ -93,6 +99,11 @@ class LineEmulator {
         }
     }
 
+  public:
+    [[nodiscard]] double late_seconds() const { return static_cast<double>(late_ns_) * 1e-9; }
+
+  private:
+    std::atomic<std::int64_t> late_ns_{0};
     int fds_[2];
     std::chrono::duration<double> char_time_;
     std::atomic<bool> stop_{false};
@@ -105,7 +116,9 @@ struct Result {
 };
 
 // Sequential reads (Host Link is half duplex: one on the line at a time) for `seconds`.
-Result measure(const std::string& device, unsigned baud, unsigned words, double seconds) {
+// `started` runs after the warm-up, when the measured time begins.
+Result measure(const std::string& device, unsigned baud, unsigned words, double seconds,
+               const std::function<void()>& started = {}) {
     fins::ClientOptions o;
     o.protocol = fins::ClientOptions::Protocol::serial;
     o.serial.device = device;
@@ -121,6 +134,7 @@ Result measure(const std::string& device, unsigned baud, unsigned words, double 
     for (int i = 0; i < 20; ++i)  // warm-up
         (void)(*client)->send(read);
     Result r;
+    if (started) started();
     const auto start = Clock::now();
     const auto end = start + std::chrono::duration<double>(seconds);
     while (Clock::now() < end) {
@@ -192,12 +206,23 @@ int main(int argc, char** argv) {
     // 2. Through the line emulator: client_pair.a <-> [b ... server_pair.a] <-> server.
     {
         LineEmulator line(client_pair.b(), server_pair.a(), static_cast<double>(bits) / baud);
-        const auto paced = measure(client_pair.a(), baud, words, seconds);
+        double late_before = 0;
+        const auto paced = measure(client_pair.a(), baud, words, seconds,
+                                   [&] { late_before = line.late_seconds(); });
+        const double late = line.late_seconds() - late_before;
         const double rate = static_cast<double>(paced.requests) / paced.seconds;
         fmt::print(
             "paced at {} bit/s: {:.1f} requests/s ({:.0f} us per request) = {:.2f} of the "
             "line limit\n",
             baud, rate, 1e6 / rate, rate / limit);
+        // Without the emulator's own lateness, which the measured time includes.
+        const double corrected =
+            static_cast<double>(paced.requests) / std::max(paced.seconds - late, 1e-9);
+        fmt::print(
+            "  emulator lateness {:.0f} us per request; without it {:.1f} requests/s = "
+            "{:.2f} of the line limit\n",
+            paced.requests > 0 ? late / static_cast<double>(paced.requests) * 1e6 : 0.0, corrected,
+            corrected / limit);
     }
     guard.reset();
     asio::post(io, [&] { session->close(); });
