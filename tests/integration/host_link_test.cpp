@@ -8,6 +8,8 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <thread>
 #include <vector>
@@ -155,6 +157,19 @@ TEST_F(HostLink, CliRunsVerbsOverSerial) {
     EXPECT_NE(probe.out.find("over Host Link"), std::string::npos) << probe.out;
     auto status = run({fins_bin, "--serial", dev, "status"});
     EXPECT_EQ(status.exit_code, 0) << status.err;
+    // File memory in chunks that fit Host Link frames (22 03 / 22 02).
+    ScratchDir dir("hostlink");
+    std::string content;
+    for (int i = 0; i < 3000; ++i)
+        content += static_cast<char>('A' + i % 26);
+    const auto source = dir.write("src.bin", content);
+    const auto target = (dir.path() / "dst.bin").string();
+    auto put = run({fins_bin, "--serial", dev, "files", "put", source, "HL.BIN"});
+    EXPECT_EQ(put.exit_code, 0) << put.err;
+    auto get = run({fins_bin, "--serial", dev, "files", "get", "HL.BIN", target});
+    EXPECT_EQ(get.exit_code, 0) << get.err;
+    std::ifstream in(target, std::ios::binary);
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), content);
     // End code from the PLC: exit 4 as over Ethernet.
     auto bad = run({fins_bin, "--serial", dev, "raw", "0101", "82FFFF000001"});
     EXPECT_EQ(bad.exit_code, 4) << bad.out << bad.err;
