@@ -30,6 +30,8 @@ class Plc;
 
 namespace fins::server {
 
+class Dispatcher;
+
 struct ServerOptions {
     std::string bind_address = "127.0.0.1";
     std::uint16_t port = 9600;  // 0 picks a free port (tests)
@@ -64,6 +66,8 @@ class Server {
     [[nodiscard]] std::uint16_t tcp_port() const noexcept;
     [[nodiscard]] NodeAddress address() const noexcept;
     [[nodiscard]] std::size_t tcp_connections() const noexcept;
+    // The one dispatcher every session uses (serial sessions attach to it too).
+    [[nodiscard]] Dispatcher& dispatcher() noexcept;
 
     // Closes the sockets and every TCP session; pending handlers finish on `io`.
     void stop();

@@ -17,6 +17,7 @@
 
 #include <tl/expected.hpp>
 
+#include "cli/finsd/config_serial.hpp"
 #include "fins/address.hpp"
 #include "plc/injections.hpp"
 #include "plc/io_memory.hpp"
@@ -73,8 +74,9 @@ struct Settings {
     // have one, the CP1H). Unset: the profile's.
     std::optional<bool> cassette;
 
-    std::vector<MemoryInit> memory;  // [memory]
-    plc::Injections inject;          // [inject]
+    std::vector<MemoryInit> memory;        // [memory]
+    plc::Injections inject;                // [inject]
+    std::vector<SerialPortConfig> serial;  // [serial], --serial (config_serial.hpp)
 };
 
 // Command-line values; a set optional overrides the file.
@@ -92,6 +94,7 @@ struct Overrides {
     std::optional<bool> um_read_protection, dip_write_protection;
     std::optional<std::string> durability;
     bool reset_state = false;
+    std::vector<std::string> serial;  // --serial NAME=DEVICE[,...], in order
 };
 
 using Error = std::string;

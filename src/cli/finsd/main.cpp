@@ -28,6 +28,7 @@
 #include <asio/io_context.hpp>
 #include <asio/signal_set.hpp>
 
+#include "cli/finsd/serial_ports.hpp"
 #include "cli/finsd/config.hpp"
 #include "cli/finsd/ctl.hpp"
 #include "plc/plc.hpp"
@@ -157,6 +158,9 @@ int configure(int argc, char** argv, Settings& settings) {
                        "What an acknowledged write survives: process (SIGKILL) or power "
                        "(fdatasync before each write's answer)")
             ->check(CLI::IsMember({"process", "power"}));
+    app.add_option("--serial", o.serial,
+                   "Serial port NAME=DEVICE[,baud=9600,parity=even,data=7,stop=2,unit=0,mode=..."
+                   ",timeout=5]; NAME cpu, scuN.P or board.P (repeatable; README Host Link)");
     app.add_flag("--reset-state", o.reset_state,
                  "Move a refused state file aside (never deleted) and start with a new one");
     try {
@@ -327,6 +331,9 @@ int serve(const Settings& s) {
                                started.error().message());
         control = std::move(*started);
     }
+    fins::cli::finsd::SerialPorts serial;
+    if (auto r = start_serial_ports(io, (*server)->dispatcher(), s.serial, serial); !r)
+        return fail(2, r.error());
     // Before "listening": a SIGTERM right after that line still stops finsd cleanly.
     asio::signal_set signals{io, SIGINT, SIGTERM};
     const auto self = (*server)->address();
@@ -343,6 +350,7 @@ int serve(const Settings& s) {
         spdlog::info("finsd: signal {}, shutting down", signal);
         (*server)->stop();
         if (control) control->stop();
+        serial.stop();
         plc.storage().flush();
         io.stop();
     });
