@@ -8,7 +8,7 @@
 //   command, network form (ICF "80", the whole 10-byte FINS header):
 //     "@" UU "FA" W  ICF RSV GCT DNA DA1 DA2 SNA SA1 SA2 SID  MRC SRC  text  FCS "*" CR
 //   response (direct: ICF "40" DA2 SA2 SID; network: ICF "C0" and the whole header):
-//     "@" UU "FA" EC  <header>  MRC SRC  MRES SRES  data  FCS "*" CR
+//     "@" UU "FA" EC  [header]  MRC SRC  MRES SRES  data  FCS "*" CR
 //   error response (EC not "00"; our choice, see README "Host Link (serial)"):
 //     "@" UU "FA" EC  FCS "*" CR
 // UU: Host Link unit number, two decimal digits 00-31. W: response wait time, one hex
