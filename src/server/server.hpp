@@ -13,6 +13,7 @@
 //      failing accept (no descriptors left) backs off instead of spinning.
 #pragma once
 
+#include <array>
 #include <chrono>
 #include <cstdint>
 #include <memory>
@@ -30,6 +31,9 @@ class Plc;
 
 namespace fins::server {
 
+class Dispatcher;
+class Router;
+
 struct ServerOptions {
     std::string bind_address = "127.0.0.1";
     std::uint16_t port = 9600;  // 0 picks a free port (tests)
@@ -46,6 +50,9 @@ struct ServerOptions {
     // doubles up to this, logging at most once per accept_log_interval.
     std::chrono::milliseconds accept_retry_max{1'000};
     std::chrono::milliseconds accept_log_interval{10'000};
+    // In a plant: the router and this server's port in it (router.hpp); null: one node.
+    Router* router = nullptr;
+    std::size_t router_port = 0;
 };
 
 // The node number finsd takes when none is given (see ServerOptions::node).
@@ -64,6 +71,11 @@ class Server {
     [[nodiscard]] std::uint16_t tcp_port() const noexcept;
     [[nodiscard]] NodeAddress address() const noexcept;
     [[nodiscard]] std::size_t tcp_connections() const noexcept;
+    // The dispatcher behind both sessions (the plant hands frames to it directly).
+    Dispatcher& dispatcher() noexcept;
+    // Sends `frame` as a datagram from the FINS/UDP socket (false: no UDP, or not sent).
+    bool send_datagram(Bytes frame, const std::array<std::uint8_t, 4>& ip,
+                       std::uint16_t port) noexcept;
 
     // Closes the sockets and every TCP session; pending handlers finish on `io`.
     void stop();
