@@ -153,12 +153,15 @@ std::size_t Router::forward(std::size_t port, Bytes frame, MutableBytes out,
         return ports_[p].unit_number == local->unit && ports_[p].address.network == hop_network;
     });
     if (out_port == cpu.ports.end()) return fail(EndCode::routing_table_error);
-    if (header.gateway_count == 0) return fail(EndCode::too_many_relays);
+    // An answer is never refused for its GCT: it started from whatever the command had
+    // left, and dropping it would only make the requester time out.
+    if (header.gateway_count == 0 && !header.is_response()) return fail(EndCode::too_many_relays);
 
     std::array<std::uint8_t, max_frame_size> copy{};
     std::memcpy(copy.data(), frame.data(), frame.size());
+    const std::uint8_t gateway_count = std::min(header.gateway_count, max_gateway_count);
     copy[gateway_count_offset] =
-        static_cast<std::uint8_t>(std::min(header.gateway_count, max_gateway_count) - 1);
+        static_cast<std::uint8_t>(gateway_count > 0 ? gateway_count - 1 : 0);
     if (header.source.network == local_network)
         copy[source_network_offset] = arrival.address.network;
     const Bytes relayed{copy.data(), frame.size()};
