@@ -203,5 +203,33 @@ TEST(Plant, W596_A_1_DestinationNetwork0IsTheArrivalNetwork) {
     EXPECT_EQ(r2.header.source, (NodeAddress{2, 1, 0}));
 }
 
+TEST(Plant, W596_2_4_BetweenTwoProcessesTheRelayIsFinsUdp) {
+    // The routers in one plant, line-3 in another (another finsd): router-b reaches
+    // 127.0.3.5 by its node-address table (automatic: 127.0.3.5 at its own port), and
+    // the answer comes back as datagrams routed by DNA through both routers to the
+    // client's learned address. All units share one port, as on a real network.
+    constexpr std::uint16_t port = 29661;
+    auto routers = three_networks();
+    routers.cpus.pop_back();
+    auto line = three_networks();
+    line.cpus.erase(line.cpus.begin(), line.cpus.begin() + 2);
+    for (auto* c : {&routers, &line})
+        for (auto& cpu : c->cpus)
+            for (auto& p : cpu.ports)
+                p.port = port;
+    PlantThread a(routers);
+    PlantThread b(line);
+    ClientOptions o;
+    o.source = {0, 77, 0};  // a node of network 1 no router uses
+    auto c = a.client("127.0.1.1", port, line_3, false, o);
+    const std::array<std::uint16_t, 2> words{0xCAFE, 0x0042};
+    ASSERT_TRUE(c->write_words(dm(300), words));
+    const auto got = c->read_words(dm(300), 2);
+    ASSERT_TRUE(got) << got.error().message();
+    EXPECT_EQ(*got, std::vector<std::uint16_t>(words.begin(), words.end()));
+    auto direct = b.client("127.0.3.5", port, line_3);
+    EXPECT_EQ(*direct->read_words(dm(300), 2), *got);
+}
+
 }  // namespace
 }  // namespace fins::test
