@@ -231,5 +231,20 @@ TEST(Plant, W596_2_4_BetweenTwoProcessesTheRelayIsFinsUdp) {
     EXPECT_EQ(*direct->read_words(dm(300), 2), *got);
 }
 
+TEST(Plant, W342_5_1_3_ARelayLoopEndsWith0504EvenFromAGctAbove07) {
+    auto config = three_networks();
+    config.cpus[0].relays.push_back({9, 2, 2});  // router-a: network 9 via router-b
+    config.cpus[1].relays.push_back({9, 2, 1});  // router-b: network 9 via router-a
+    PlantThread plant(config);
+    ClientOptions o;
+    o.gateway_count = 0xFF;  // taken as 07: at most 7 more crossings
+    auto c = plant.client("127.0.1.1", plant.port(0), {9, 5, 0}, false, o);
+    const auto r = read_memory(*c);
+    EXPECT_EQ(r.code.raw(), 0x8504);
+    ASSERT_TRUE(r.relay);
+    // 07 -> 06 (a), 05 (b), 04 (a), 03 (b), 02 (a), 01 (b), 00 (a); b finds 00.
+    EXPECT_EQ(*r.relay, (RelayErrorSource{2, 2}));
+}
+
 }  // namespace
 }  // namespace fins::test
