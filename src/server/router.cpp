@@ -119,7 +119,8 @@ std::size_t Router::relay_error(const Header& request, CommandCode command, cons
 
 std::size_t Router::forward(std::size_t port, Bytes frame, MutableBytes out,
                             const RequestContext& context) {
-    if (frame.size() < header_size + command_code_size || frame.size() > max_frame_size) return 0;
+    // Without a header and command code there is no SID to answer (as the dispatcher).
+    if (frame.size() < header_size + command_code_size) return 0;
     ByteReader reader(frame);
     const Header header = read_header(reader);
     const CommandCode command{reader.u8(), reader.u8()};
@@ -130,6 +131,9 @@ std::size_t Router::forward(std::size_t port, Bytes frame, MutableBytes out,
         if (header.is_response()) return std::size_t{0};
         return relay_error(header, command, arrival, code, out);
     };
+    // Longer than a FINS frame (W596 1-2: 2,012 bytes): not passed on; 1001 as a node
+    // answers it, from the router that received it.
+    if (frame.size() > max_frame_size) return fail(EndCode::command_too_long);
 
     const auto decoded =
         plc::decode_routing_tables(cpu.plc->parameters().words(plc::routing_table_area));

@@ -75,5 +75,24 @@ TEST(Router, W342_5_1_3_RelayErrorAnswerBytes) {
     EXPECT_EQ(d.handle(quiet, out, {}), 0u);
 }
 
+TEST(Router, W596_1_2_AnOversizedFrameForAnotherNetworkAnswers1001WithTheRelayFlag) {
+    plc::Plc plc;
+    Router r;
+    const auto cpu = r.add_cpu(plc, false);
+    const auto port = r.add_port(cpu, 0, {1, 1, 0});
+    Dispatcher d(plc, {1, 1, 0});
+    d.attach(r, port);
+    r.set_dispatcher(port, d);
+    std::vector<std::uint8_t> request(max_frame_size + 1, 0);
+    const std::vector<std::uint8_t> head{0x80, 0x00, 0x02, 0x04, 0x05, 0x00,
+                                         0x00, 77,   0x00, 0x42, 0x01, 0x02};
+    std::copy(head.begin(), head.end(), request.begin());
+    std::array<std::uint8_t, max_frame_size> out{};
+    const auto n = d.handle(request, out, {});
+    ASSERT_EQ(n, 16u);
+    EXPECT_EQ(out[12], 0x90);
+    EXPECT_EQ(out[13], 0x01);
+}
+
 }  // namespace
 }  // namespace fins::server
