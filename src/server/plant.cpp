@@ -155,6 +155,9 @@ Result<std::unique_ptr<Plant>> Plant::start(asio::io_context& io, const PlantCon
     }
     auto* raw = impl.get();
     impl->router.set_wire([raw](std::size_t port, std::uint8_t node, Bytes frame) {
+        // A FINS/TCP client holding that node gets it on its connection (W421 7-4 pairs
+        // each node with one connection); anything else goes by FINS/UDP.
+        if (raw->by_port[port]->send_to_tcp_node(node, frame)) return true;
         const auto to = raw->router.port(port).addresses.lookup(node);
         if (!to) return false;
         return raw->by_port[port]->send_datagram(frame, to->ip, to->port);

@@ -206,6 +206,11 @@ bool Server::send_datagram(Bytes frame, const std::array<std::uint8_t, 4>& ip,
     return impl_->udp->send_to(frame, to);
 }
 
+bool Server::send_to_tcp_node(std::uint8_t node, Bytes frame) {
+    TcpSession* session = impl_->nodes.owner(node);
+    return session != nullptr && session->push_frame(frame);
+}
+
 std::size_t Server::tcp_connections() const noexcept {
     return impl_->nodes.in_use();
 }

@@ -76,6 +76,8 @@ class Server {
     // Sends `frame` as a datagram from the FINS/UDP socket (false: no UDP, or not sent).
     bool send_datagram(Bytes frame, const std::array<std::uint8_t, 4>& ip,
                        std::uint16_t port) noexcept;
+    // Sends `frame` on the FINS/TCP connection holding client node `node` (false: none).
+    bool send_to_tcp_node(std::uint8_t node, Bytes frame);
 
     // Closes the sockets and every TCP session; pending handlers finish on `io`.
     void stop();

@@ -219,16 +219,20 @@ TEST(Plant, W596_2_4_BetweenTwoProcessesTheRelayIsFinsUdp) {
                 p.port = port;
     PlantThread a(routers);
     PlantThread b(line);
-    ClientOptions o;
-    o.source = {0, 77, 0};  // a node of network 1 no router uses
-    auto c = a.client("127.0.1.1", port, line_3, false, o);
-    const std::array<std::uint16_t, 2> words{0xCAFE, 0x0042};
-    ASSERT_TRUE(c->write_words(dm(300), words));
-    const auto got = c->read_words(dm(300), 2);
-    ASSERT_TRUE(got) << got.error().message();
-    EXPECT_EQ(*got, std::vector<std::uint16_t>(words.begin(), words.end()));
-    auto direct = b.client("127.0.3.5", port, line_3);
-    EXPECT_EQ(*direct->read_words(dm(300), 2), *got);
+    // FINS/UDP from node 77 of network 1 (no router uses it); FINS/TCP from the node the
+    // handshake gives, the answer coming back on that connection.
+    for (const bool tcp : {false, true}) {
+        ClientOptions o;
+        o.source = {0, 77, 0};
+        auto c = a.client("127.0.1.1", port, line_3, tcp, o);
+        const std::array<std::uint16_t, 2> words{0xCAFE, static_cast<std::uint16_t>(tcp)};
+        ASSERT_TRUE(c->write_words(dm(300), words));
+        const auto got = c->read_words(dm(300), 2);
+        ASSERT_TRUE(got) << got.error().message();
+        EXPECT_EQ(*got, std::vector<std::uint16_t>(words.begin(), words.end()));
+        auto direct = b.client("127.0.3.5", port, line_3);
+        EXPECT_EQ(*direct->read_words(dm(300), 2), *got);
+    }
 }
 
 TEST(Plant, W342_5_1_3_ARelayLoopEndsWith0504EvenFromAGctAbove07) {
