@@ -59,6 +59,8 @@ Unexpected fail(std::error_code e) {
 
 }  // namespace
 
+constexpr std::size_t lazy_section_bytes = 16 * 1024;
+
 struct Storage::Impl {
     // Heap sections, 8-byte aligned (enough for every stored type).
     std::vector<std::vector<std::uint64_t>> heap;
@@ -66,6 +68,7 @@ struct Storage::Impl {
     int fd = -1;
     sf::Header* header = nullptr;
     std::vector<std::pair<void*, std::size_t>> maps;
+    std::vector<std::pair<void*, std::size_t>> anonymous;  // heap sections, lazily backed
     std::vector<std::span<std::byte>> sections;  // by entry index
     std::vector<bool> claimed;                   // per existing entry
     bool existing = false;                       // restored from finsd.state
@@ -78,6 +81,18 @@ struct Storage::Impl {
     std::filesystem::path path;
 
     std::span<std::byte> on_heap(std::size_t bytes) {
+        // Large sections (EM banks, DM) come from anonymous memory the kernel backs
+        // lazily with zero pages: a plant of 1,000 CPU Units pays only for the pages its
+        // clients touch (issue 10; docs/benchmarks.md "A plant of 1,000 CPU Units").
+        if (bytes >= lazy_section_bytes) {
+            const std::size_t length = round_up(bytes);
+            void* p = ::mmap(nullptr, length, PROT_READ | PROT_WRITE,
+                             MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
+            if (p != MAP_FAILED) {
+                anonymous.emplace_back(p, length);
+                return {static_cast<std::byte*>(p), bytes};
+            }
+        }
         heap.emplace_back((bytes + 7) / 8 + 1, 0);
         return {reinterpret_cast<std::byte*>(heap.back().data()), bytes};
     }
@@ -119,6 +134,8 @@ struct Storage::Impl {
 
     ~Impl() {
         for (auto [p, n] : maps)
+            ::munmap(p, n);
+        for (auto [p, n] : anonymous)
             ::munmap(p, n);
         if (header != nullptr) ::munmap(header, page);
         if (fd >= 0) ::close(fd);

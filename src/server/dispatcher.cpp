@@ -7,6 +7,7 @@
 #include "fins/command_table.hpp"
 #include "plc/plc.hpp"
 #include "server/handlers/handlers.hpp"
+#include "server/router.hpp"
 
 namespace fins::server {
 
@@ -48,17 +49,32 @@ bool served_by(const plc::Profile& profile, std::uint8_t unit, CommandCode comma
 
 Dispatcher::Dispatcher(plc::Plc& plc, NodeAddress self) noexcept : plc_(plc), self_(self) {}
 
+void Dispatcher::attach(Router& router, std::size_t port) noexcept {
+    router_ = &router;
+    port_ = port;
+}
+
 std::size_t Dispatcher::handle(Bytes request, MutableBytes out, const RequestContext& context) {
     // Without a header and command code there is no SID to answer.
     if (request.size() < header_size + command_code_size) return 0;
     ByteReader reader(request);
     const Header header = read_header(reader);
     const CommandCode command{reader.u8(), reader.u8()};
+    // In a plant, a frame for another node (command or answer) goes on to it.
+    NodeAddress self = self_;
+    bool deliverable = true;
+    if (router_ != nullptr) {
+        deliverable = router_->note_source(port_, header, context);
+        const auto local = router_->local_address(port_, header.destination);
+        if (!local) return router_->forward(port_, request, out, context);
+        self = *local;
+    }
     if (header.is_response()) return 0;
-    const bool reply = header.response_required() && out.size() >= response_prefix_size;
+    const bool reply =
+        deliverable && header.response_required() && out.size() >= response_prefix_size;
 
-    Header response = response_header(header, self_);
-    if (header.destination.node == broadcast_node) response.source.node = self_.node;
+    Header response = response_header(header, self);
+    if (header.destination.node == broadcast_node) response.source.node = self.node;
 
     // Bits 6/7 of every end code report the CPU Unit's non-fatal/fatal errors (W342
     // 5-1-3): 0040 is a normal completion on a CPU Unit with a battery error.
@@ -73,7 +89,7 @@ std::size_t Dispatcher::handle(Bytes request, MutableBytes out, const RequestCon
         return w.overflowed() ? 0 : w.size();
     };
 
-    if (const auto code = check_destination(header.destination, self_, plc_.profile());
+    if (const auto code = check_destination(header.destination, self, plc_.profile());
         code != EndCode::normal_completion)
         return answer(code);
 

@@ -11,6 +11,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include <sys/socket.h>
+
 #include "fins/byte_io.hpp"
 #include "fins/frame.hpp"
 
@@ -19,6 +21,8 @@ class Plc;
 }
 
 namespace fins::server {
+
+class Router;
 
 // serial: the CPU Unit's Host Link port (server/serial_session.hpp).
 enum class Link : std::uint8_t { udp, tcp, local, serial };
@@ -33,6 +37,9 @@ constexpr bool via_network(Link link) noexcept {
 struct RequestContext {
     Link link = Link::udp;
     std::chrono::system_clock::time_point now{};
+    // FINS/UDP: the datagram's source, where the answer goes. In a plant the port's
+    // node-address table may learn from it and redirect the answer (router.hpp).
+    sockaddr_storage* peer = nullptr;
 };
 
 class Dispatcher {
@@ -49,9 +56,16 @@ class Dispatcher {
     [[nodiscard]] const NodeAddress& self() const noexcept { return self_; }
     plc::Plc& plc() noexcept { return plc_; }
 
+    // In a plant (router.hpp) this dispatcher serves port `port` of a CPU Unit: the
+    // router decides whether a frame is for this CPU Unit (any of its ports) and forwards
+    // the others. Without a router only `self` is "me" (the single-node finsd).
+    void attach(Router& router, std::size_t port) noexcept;
+
   private:
     plc::Plc& plc_;
     NodeAddress self_;
+    Router* router_ = nullptr;
+    std::size_t port_ = 0;
 };
 
 }  // namespace fins::server

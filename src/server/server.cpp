@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cstring>
 #include <list>
 #include <optional>
 
@@ -37,7 +38,9 @@ struct Server::Impl {
           limits(options.tcp_limits),
           accept_retry_max(options.accept_retry_max),
           accept_log_interval(options.accept_log_interval),
-          accept_timer(context) {}
+          accept_timer(context) {
+        if (options.router != nullptr) dispatcher.attach(*options.router, options.router_port);
+    }
 
     void accept_tcp() {
         acceptor.async_accept([this](std::error_code ec, asio::ip::tcp::socket socket) {
@@ -189,12 +192,27 @@ NodeAddress Server::address() const noexcept {
     return impl_->dispatcher.self();
 }
 
-std::size_t Server::tcp_connections() const noexcept {
-    return impl_->nodes.in_use();
-}
-
 Dispatcher& Server::dispatcher() noexcept {
     return impl_->dispatcher;
+}
+
+bool Server::send_datagram(Bytes frame, const std::array<std::uint8_t, 4>& ip,
+                           std::uint16_t port) noexcept {
+    if (!impl_->udp) return false;
+    sockaddr_in to{};
+    to.sin_family = AF_INET;
+    to.sin_port = htons(port);
+    std::memcpy(&to.sin_addr.s_addr, ip.data(), ip.size());
+    return impl_->udp->send_to(frame, to);
+}
+
+bool Server::send_to_tcp_node(std::uint8_t node, Bytes frame) {
+    TcpSession* session = impl_->nodes.owner(node);
+    return session != nullptr && session->push_frame(frame);
+}
+
+std::size_t Server::tcp_connections() const noexcept {
+    return impl_->nodes.in_use();
 }
 
 void Server::stop() {

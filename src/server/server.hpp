@@ -13,6 +13,7 @@
 //      failing accept (no descriptors left) backs off instead of spinning.
 #pragma once
 
+#include <array>
 #include <chrono>
 #include <cstdint>
 #include <memory>
@@ -31,6 +32,7 @@ class Plc;
 namespace fins::server {
 
 class Dispatcher;
+class Router;
 
 struct ServerOptions {
     std::string bind_address = "127.0.0.1";
@@ -48,6 +50,9 @@ struct ServerOptions {
     // doubles up to this, logging at most once per accept_log_interval.
     std::chrono::milliseconds accept_retry_max{1'000};
     std::chrono::milliseconds accept_log_interval{10'000};
+    // In a plant: the router and this server's port in it (router.hpp); null: one node.
+    Router* router = nullptr;
+    std::size_t router_port = 0;
 };
 
 // The node number finsd takes when none is given (see ServerOptions::node).
@@ -68,6 +73,11 @@ class Server {
     [[nodiscard]] std::size_t tcp_connections() const noexcept;
     // The one dispatcher every session uses (serial sessions attach to it too).
     [[nodiscard]] Dispatcher& dispatcher() noexcept;
+    // Sends `frame` as a datagram from the FINS/UDP socket (false: no UDP, or not sent).
+    bool send_datagram(Bytes frame, const std::array<std::uint8_t, 4>& ip,
+                       std::uint16_t port) noexcept;
+    // Sends `frame` on the FINS/TCP connection holding client node `node` (false: none).
+    bool send_to_tcp_node(std::uint8_t node, Bytes frame);
 
     // Closes the sockets and every TCP session; pending handlers finish on `io`.
     void stop();

@@ -249,7 +249,7 @@ bool TcpSession::from_bound_node(Bytes frame) const noexcept {
 }
 
 void TcpSession::send_and_continue(std::size_t size, bool close_after) {
-    if (confirming_) {
+    if (confirming_ || pushing_) {
         // Command 6 is on its way; this packet follows it whole, never interleaved.
         deferred_ = true;
         deferred_size_ = size;
@@ -276,6 +276,8 @@ void TcpSession::send_and_continue(std::size_t size, bool close_after) {
                           if (self->confirm_wanted_) {
                               self->confirm_wanted_ = false;
                               self->send_confirmation();
+                          } else if (!self->pushed_.empty()) {
+                              self->write_pushed();
                           }
                           self->process();
                       });
@@ -306,6 +308,47 @@ void TcpSession::send_confirmation() {
                               return;
                           }
                           if (self->deferred_) {
+                              self->deferred_ = false;
+                              self->send_and_continue(self->deferred_size_, self->deferred_close_);
+                          } else if (!self->pushed_.empty() && !self->writing_) {
+                              self->write_pushed();
+                          }
+                      });
+}
+
+bool TcpSession::push_frame(Bytes frame) {
+    if (state_ != State::established || pushed_.size() >= max_pushed ||
+        frame.size() > max_frame_size)
+        return false;
+    std::vector<std::uint8_t> packet(tcp_header_size + frame.size());
+    ByteWriter w{packet};
+    write_tcp_header(w, TcpCommand::frame, frame.size());
+    std::memcpy(packet.data() + tcp_header_size, frame.data(), frame.size());
+    pushed_.push_back(std::move(packet));
+    if (!writing_ && !confirming_) write_pushed();
+    return true;
+}
+
+void TcpSession::write_pushed() {
+    writing_ = true;
+    pushing_ = true;
+    auto self = shared_from_this();
+    asio::async_write(socket_, asio::buffer(pushed_.front()),
+                      [self](std::error_code ec, std::size_t) {
+                          self->writing_ = false;
+                          self->pushing_ = false;
+                          if (!self->open()) return;
+                          if (ec) {
+                              self->close();
+                              return;
+                          }
+                          self->pushed_.pop_front();
+                          if (self->confirm_wanted_) {
+                              self->confirm_wanted_ = false;
+                              self->send_confirmation();
+                          } else if (!self->pushed_.empty()) {
+                              self->write_pushed();
+                          } else if (self->deferred_) {
                               self->deferred_ = false;
                               self->send_and_continue(self->deferred_size_, self->deferred_close_);
                           }

@@ -23,7 +23,9 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <deque>
 #include <memory>
+#include <vector>
 
 #include <asio/ip/tcp.hpp>
 #include <asio/steady_timer.hpp>
@@ -61,6 +63,13 @@ class TcpSession : public std::enable_shared_from_this<TcpSession> {
     // answers with a reset and the read or write that sees it closes this session.
     void confirm_connection();
     [[nodiscard]] const asio::ip::address& peer_address() const noexcept { return peer_; }
+    // Sends a FINS frame that answers no request of this connection's read loop (in a
+    // plant: an answer routed back from another process to this client's node). Queued
+    // behind a write in progress, never interleaved; false when the connection is not
+    // established or max_pushed frames already wait (the frame is dropped, as a full
+    // send buffer drops a datagram).
+    bool push_frame(Bytes frame);
+    static constexpr std::size_t max_pushed = 32;
 
   private:
     enum class State : std::uint8_t { handshake, established, draining, closed };
@@ -77,6 +86,7 @@ class TcpSession : public std::enable_shared_from_this<TcpSession> {
     void send_and_continue(std::size_t size, bool close_after);
     void send_confirmation();
     void close_after_notice();
+    void write_pushed();
     void drain();
 
     void set_deadline(Deadline kind, Clock::duration after);
@@ -104,7 +114,9 @@ class TcpSession : public std::enable_shared_from_this<TcpSession> {
     std::size_t deferred_size_ = 0;  // a response that waits for command 6
     bool deferred_close_ = false;
     bool deferred_ = false;
-    bool logged_foreign_source_ = false;  // one warning per connection
+    bool pushing_ = false;                          // pushed_.front() is being written
+    std::deque<std::vector<std::uint8_t>> pushed_;  // push_frame() packets
+    bool logged_foreign_source_ = false;            // one warning per connection
     std::size_t drained_ = 0;
     // Room for two maximal packets so a read never has to wait for the parser.
     std::array<std::uint8_t, 2 * tcp_max_packet> in_{};

@@ -24,6 +24,7 @@
 #include <cstdint>
 #include <memory>
 
+#include <netinet/in.h>
 #include <sys/socket.h>
 
 #include <asio/generic/datagram_protocol.hpp>
@@ -59,6 +60,9 @@ class UdpSession : public std::enable_shared_from_this<UdpSession> {
     // The bound IPv4/IPv6 port, 0 when closed or not an IP socket.
     [[nodiscard]] std::uint16_t local_port() const noexcept;
     [[nodiscard]] const Counters& counters() const noexcept { return counters_; }
+    // Sends one datagram that is not a reply (a frame a plant relays to another
+    // process); false when the kernel did not take it whole.
+    bool send_to(Bytes frame, const sockaddr_in& to) noexcept;
 
   private:
     struct Slots;  // the per-batch buffers and message headers

@@ -1,6 +1,8 @@
 // finsd --config FILE and its flags, as a user runs them: the profile a file selects,
 // initial memory, protections, flags overriding the file, configuration errors (exit 2,
 // naming the key and line) and state-file errors (exit 3).
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -255,6 +257,10 @@ TEST(FinsdConfig, EveryExampleConfigStarts) {
     int n = 0;
     for (const auto& entry : std::filesystem::directory_iterator(examples)) {
         if (entry.path().extension() != ".toml") continue;
+        // A plant's example binds its own addresses: plant_example_test.cpp runs it.
+        std::ifstream file(entry.path());
+        const std::string text{std::istreambuf_iterator<char>(file), {}};
+        if (text.find("[[plc]]") != std::string::npos) continue;
         ++n;
         // The examples leave data_dir and control commented out; --port 0, --bind and
         // --node override theirs (node 1: what a UDP client derives on loopback).

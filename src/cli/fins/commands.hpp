@@ -98,6 +98,9 @@ class Output {
     void print(const nlohmann::json& doc, const std::string& text);
     // Records the CPU error flags (bits 7 and 6, W342 5-1-3) of an answer.
     void note_flags(ResponseCode code);
+    // A relay error (end code bit 15, README "A plant of several networks"): failure()
+    // names the relay node that answered, in the text and in the JSON "relay_error".
+    void note_relay(const std::optional<RelayErrorSource>& relay) { relay_ = relay; }
     // The connection settings failures are explained against (set by open_client).
     void set_target(const GlobalOptions& g) { target_ = &g; }
 
@@ -105,6 +108,7 @@ class Output {
     bool json_;
     const GlobalOptions* target_ = nullptr;
     bool flags_tracked_ = false;
+    std::optional<RelayErrorSource> relay_;
     bool fatal_ = false;
     bool non_fatal_ = false;
 };
@@ -171,6 +175,7 @@ Result<typename C::Response> send_noting_flags(Client& client, const C& command,
     auto r = client.send_raw(C::code, w.written());
     if (!r) return Unexpected(r.error());
     out.note_flags(r->code);
+    if (r->code.relay_error()) out.note_relay(r->relay);
     if (!r->code.ok()) return Unexpected(make_error_code(r->code.end_code()));
     return command.decode_response(r->data);
 }

@@ -65,7 +65,14 @@ int Output::failure(std::error_code ec, const std::string& context) {
     const ErrorKind kind = kind_of(ec);
     std::string hint;
     // 0201: the request named a node the PLC is not. Ask the PLC which node it is.
-    if (ec == make_error_code(EndCode::destination_node_not_in_network) && target_ != nullptr) {
+    if (relay_ && kind == ErrorKind::end_code) {
+        // A router on the way answered, not the destination (W342 5-1-3 bit 15).
+        hint = fmt::format(
+            "relay error: the router at network {} node {} could not pass the "
+            "command on (check its routing tables)",
+            relay_->network, relay_->node);
+    } else if (ec == make_error_code(EndCode::destination_node_not_in_network) &&
+               target_ != nullptr) {
         if (const auto found = discover_node(*target_)) {
             hint = fmt::format("the PLC at {} is node {}: use --dest {}", endpoint(*target_),
                                found->address.node, node_text(found->address));
@@ -85,6 +92,8 @@ int Output::failure(std::error_code ec, const std::string& context) {
             const auto* info = find_end_code(static_cast<std::uint16_t>(ec.value()));
             e["name"] = info ? std::string(info->name) : "unknown";
         }
+        if (relay_ && kind == ErrorKind::end_code)
+            e["relay_error"] = {{"network", relay_->network}, {"node", relay_->node}};
         if (!hint.empty()) e["hint"] = hint;
         std::printf("%s\n", nlohmann::json{{"error", e}}.dump().c_str());
     }

@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include "cli/finsd/config_plant.hpp"
 #include "fins/values.hpp"
 
 namespace fins::cli::finsd {
@@ -69,6 +70,8 @@ class Loader {
                 r = section(key, node, k, &Loader::files);
             else if (k == "serial")
                 r = load_serial_table(node, source_, s_.serial);
+            else if (k == "plc")
+                r = load_plant(key, node, source_, s_);
             else
                 r = fail(key, k, "unknown key");
             if (!r) return r;

@@ -22,6 +22,7 @@
 #include "plc/injections.hpp"
 #include "plc/io_memory.hpp"
 #include "plc/plc.hpp"
+#include "server/plant.hpp"
 
 namespace fins::cli::finsd {
 
@@ -77,6 +78,7 @@ struct Settings {
     std::vector<MemoryInit> memory;        // [memory]
     plc::Injections inject;                // [inject]
     std::vector<SerialPortConfig> serial;  // [serial], --serial (config_serial.hpp)
+    server::PlantConfig plant;             // [[plc]] (config_plant.hpp); empty: one node
 };
 
 // Command-line values; a set optional overrides the file.

@@ -30,6 +30,7 @@
 
 #include "cli/finsd/serial_ports.hpp"
 #include "cli/finsd/config.hpp"
+#include "cli/finsd/config_plant.hpp"
 #include "cli/finsd/ctl.hpp"
 #include "plc/plc.hpp"
 #include "plc/profile.hpp"
@@ -370,6 +371,7 @@ int main(int argc, char** argv) {
     Settings settings;
     if (const int rc = configure(argc, argv, settings); rc >= 0) return rc;
     try {
+        if (!settings.plant.cpus.empty()) return fins::cli::finsd::serve_plant(settings);
         return serve(settings);
     } catch (const std::exception& e) {
         return fail(3, e.what());

@@ -1,0 +1,250 @@
+// The [[plc]] loader (config_plant.hpp).
+#include "cli/finsd/config_plant.hpp"
+
+#include <fmt/format.h>
+
+#include "server/node_address_table.hpp"
+
+namespace fins::cli::finsd {
+
+namespace {
+
+using server::AddressMethod;
+using server::PlantCpuConfig;
+using server::PlantPortConfig;
+
+class PlantLoader {
+  public:
+    explicit PlantLoader(std::string_view source) : source_(source) {}
+
+    Expected<void> load(const toml::node& node, const toml::source_region& where,
+                        Settings& settings) {
+        const auto* array = node.as_array();
+        if (array == nullptr) return fail(where, "plc", "must be an array of tables ([[plc]])");
+        for (std::size_t i = 0; i < array->size(); ++i) {
+            const auto* table = (*array)[i].as_table();
+            const std::string path = fmt::format("plc[{}]", i);
+            if (table == nullptr) return fail((*array)[i].source(), path, "must be a table");
+            PlantCpuConfig cpu;
+            if (auto r = load_cpu(*table, path, cpu); !r) return r;
+            settings.plant.cpus.push_back(std::move(cpu));
+        }
+        return {};
+    }
+
+  private:
+    tl::unexpected<Error> fail(const toml::source_region& where, std::string_view path,
+                               std::string_view message) const {
+        return tl::unexpected<Error>(fmt::format("{}:{}:{}: {}: {}", source_, where.begin.line,
+                                                 where.begin.column, path, message));
+    }
+
+    Expected<std::int64_t> integer(const toml::node& v, const std::string& path, std::int64_t lo,
+                                   std::int64_t hi) const {
+        const auto* i = v.as_integer();
+        if (i == nullptr) return fail(v.source(), path, "must be an integer");
+        if (i->get() < lo || i->get() > hi)
+            return fail(v.source(), path, fmt::format("{} is not {}-{}", i->get(), lo, hi));
+        return i->get();
+    }
+    Expected<std::string> text(const toml::node& v, const std::string& path) const {
+        const auto* s = v.as_string();
+        if (s == nullptr) return fail(v.source(), path, "must be a string");
+        return s->get();
+    }
+    Expected<bool> flag(const toml::node& v, const std::string& path) const {
+        const auto* b = v.as_boolean();
+        if (b == nullptr) return fail(v.source(), path, "must be true or false");
+        return b->get();
+    }
+    template <class F>
+    Expected<void> tables(const toml::node& v, const std::string& path, F&& each) const {
+        const auto* array = v.as_array();
+        if (array == nullptr) return fail(v.source(), path, "must be an array of tables");
+        for (std::size_t i = 0; i < array->size(); ++i) {
+            const auto* t = (*array)[i].as_table();
+            const std::string child = fmt::format("{}[{}]", path, i);
+            if (t == nullptr) return fail((*array)[i].source(), child, "must be a table");
+            if (auto r = each(*t, child); !r) return r;
+        }
+        return {};
+    }
+
+    Expected<void> load_cpu(const toml::table& t, const std::string& path, PlantCpuConfig& cpu) {
+        for (auto&& [k, v] : t) {
+            const std::string key(k.str());
+            const std::string p = path + "." + key;
+            Expected<void> r;
+            if (key == "name") {
+                auto s = text(v, p);
+                if (!s) return tl::unexpected(s.error());
+                cpu.name = *s;
+            } else if (key == "profile") {
+                auto s = text(v, p);
+                if (!s) return tl::unexpected(s.error());
+                cpu.profile = *s;
+            } else if (key == "mode") {
+                auto s = text(v, p);
+                if (!s) return tl::unexpected(s.error());
+                const auto m = parse_mode(*s);
+                if (!m)
+                    return fail(v.source(), p,
+                                fmt::format("'{}' is not program, monitor or run", *s));
+                cpu.mode = *m;
+            } else if (key == "data_dir") {
+                auto s = text(v, p);
+                if (!s) return tl::unexpected(s.error());
+                if (s->empty()) return fail(v.source(), p, "must not be empty");
+                cpu.data_dir = *s;
+            } else if (key == "gateway_count") {
+                auto g = integer(v, p, 2, 7);
+                if (!g) return tl::unexpected(g.error());
+                if (*g != 2 && *g != 7) return fail(v.source(), p, "must be 2 or 7");
+                cpu.gateway_count = static_cast<std::uint8_t>(*g);
+            } else if (key == "routing_tables") {
+                auto s = text(v, p);
+                if (!s) return tl::unexpected(s.error());
+                if (*s != "config" && *s != "keep")
+                    return fail(v.source(), p, fmt::format("'{}' is not config or keep", *s));
+                cpu.write_routing_tables = *s == "config";
+            } else if (key == "ethernet") {
+                r = tables(v, p, [&](const toml::table& e, const std::string& ep) {
+                    PlantPortConfig port;
+                    if (auto rr = load_port(e, ep, port); !rr) return rr;
+                    cpu.ports.push_back(std::move(port));
+                    return Expected<void>{};
+                });
+            } else if (key == "relay") {
+                r = tables(v, p, [&](const toml::table& e, const std::string& ep) {
+                    return load_relay(e, ep, cpu);
+                });
+            } else {
+                return fail(k.source(), p, "unknown key");
+            }
+            if (!r) return r;
+        }
+        if (cpu.name.empty()) return fail(t.source(), path, "name: missing");
+        return {};
+    }
+
+    Expected<void> load_port(const toml::table& t, const std::string& path, PlantPortConfig& port) {
+        bool has_bind = false;
+        for (auto&& [k, v] : t) {
+            const std::string key(k.str());
+            const std::string p = path + "." + key;
+            if (key == "unit" || key == "network" || key == "node" || key == "port" ||
+                key == "max_connections") {
+                const std::int64_t lo =
+                    key == "network" || key == "node" || key == "max_connections";
+                const std::int64_t hi = key == "unit"      ? 15
+                                        : key == "network" ? 127
+                                        : key == "node"    ? 254
+                                        : key == "port"    ? 65535
+                                                           : 254;
+                auto i = integer(v, p, lo, hi);
+                if (!i) return tl::unexpected(i.error());
+                if (key == "unit") port.unit_number = static_cast<std::uint8_t>(*i);
+                if (key == "network") port.network = static_cast<std::uint8_t>(*i);
+                if (key == "node") port.node = static_cast<std::uint8_t>(*i);
+                if (key == "port") port.port = static_cast<std::uint16_t>(*i);
+                if (key == "max_connections") port.max_connections = static_cast<std::size_t>(*i);
+            } else if (key == "bind") {
+                auto s = text(v, p);
+                if (!s) return tl::unexpected(s.error());
+                if (!server::parse_ipv4(*s))
+                    return fail(v.source(), p, fmt::format("'{}' is not an IPv4 address", *s));
+                port.bind = *s;
+                has_bind = true;
+            } else if (key == "udp" || key == "tcp" || key == "dynamic_remote_ip") {
+                auto b = flag(v, p);
+                if (!b) return tl::unexpected(b.error());
+                (key == "udp" ? port.udp : key == "tcp" ? port.tcp : port.dynamic_remote_ip) = *b;
+            } else if (key == "address_method") {
+                auto s = text(v, p);
+                if (!s) return tl::unexpected(s.error());
+                if (*s == "automatic" || *s == "automatic-dynamic")
+                    port.method = AddressMethod::automatic_dynamic;
+                else if (*s == "automatic-static")
+                    port.method = AddressMethod::automatic_static;
+                else if (*s == "table")
+                    port.method = AddressMethod::table;
+                else if (*s == "combined")
+                    port.method = AddressMethod::combined;
+                else
+                    return fail(v.source(), p,
+                                fmt::format("'{}' is not automatic, automatic-static, table or "
+                                            "combined",
+                                            *s));
+            } else if (key == "ip_table") {
+                auto r = tables(v, p, [&](const toml::table& e, const std::string& ep) {
+                    return load_ip_entry(e, ep, port);
+                });
+                if (!r) return r;
+            } else {
+                return fail(k.source(), p, "unknown key");
+            }
+        }
+        if (!has_bind) return fail(t.source(), path, "bind: missing");
+        return {};
+    }
+
+    Expected<void> load_ip_entry(const toml::table& t, const std::string& path,
+                                 PlantPortConfig& port) {
+        server::IpTableEntry entry;
+        bool node = false, ip = false;
+        for (auto&& [k, v] : t) {
+            const std::string key(k.str());
+            const std::string p = path + "." + key;
+            if (key == "node") {
+                auto i = integer(v, p, 1, 254);
+                if (!i) return tl::unexpected(i.error());
+                entry.node = static_cast<std::uint8_t>(*i);
+                node = true;
+            } else if (key == "ip") {
+                auto s = text(v, p);
+                if (!s) return tl::unexpected(s.error());
+                const auto a = server::parse_ipv4(*s);
+                if (!a) return fail(v.source(), p, fmt::format("'{}' is not an IPv4 address", *s));
+                entry.ip = *a;
+                ip = true;
+            } else {
+                return fail(k.source(), p, "unknown key");
+            }
+        }
+        if (!node || !ip) return fail(t.source(), path, "needs node and ip");
+        port.ip_table.push_back(entry);
+        return {};
+    }
+
+    Expected<void> load_relay(const toml::table& t, const std::string& path, PlantCpuConfig& cpu) {
+        plc::RelayNetwork entry;
+        for (auto&& [k, v] : t) {
+            const std::string key(k.str());
+            const std::string p = path + "." + key;
+            const bool node = key == "via_node";
+            if (key != "network" && key != "via_network" && !node)
+                return fail(k.source(), p, "unknown key");
+            auto i = integer(v, p, 1, node ? 254 : 127);
+            if (!i) return tl::unexpected(i.error());
+            const auto value = static_cast<std::uint8_t>(*i);
+            if (key == "network") entry.network = value;
+            if (key == "via_network") entry.relay_network = value;
+            if (node) entry.relay_node = value;
+        }
+        if (entry.network == 0 || entry.relay_network == 0 || entry.relay_node == 0)
+            return fail(t.source(), path, "needs network, via_network and via_node");
+        cpu.relays.push_back(entry);
+        return {};
+    }
+
+    std::string_view source_;
+};
+
+}  // namespace
+
+Expected<void> load_plant(const toml::key& key, const toml::node& node, std::string_view source,
+                          Settings& settings) {
+    return PlantLoader(source).load(node, key.source(), settings);
+}
+
+}  // namespace fins::cli::finsd

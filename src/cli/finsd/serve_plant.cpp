@@ -1,0 +1,92 @@
+// finsd with [[plc]] tables: the plant (server/plant.hpp) on one I/O thread.
+#include <csignal>
+#include <cstdio>
+#include <string>
+
+#include <spdlog/spdlog.h>
+#include <asio/io_context.hpp>
+#include <asio/signal_set.hpp>
+
+#include "cli/finsd/config_plant.hpp"
+#include "server/control.hpp"
+#include "server/router.hpp"
+#include "server/server.hpp"
+
+namespace fins::cli::finsd {
+
+int serve_plant(const Settings& s) {
+    spdlog::set_level(spdlog::level::from_str(s.log_level));
+    std::signal(SIGXFSZ, SIG_IGN);
+    server::PlantConfig config = s.plant;
+    config.tcp_limits.handshake_timeout = std::chrono::seconds(s.tcp_handshake_timeout);
+    config.tcp_limits.frame_timeout = std::chrono::seconds(s.tcp_frame_timeout);
+    config.tcp_limits.idle_timeout = std::chrono::seconds(s.tcp_idle_timeout);
+    config.tcp_limits.keepalive = std::chrono::seconds(s.tcp_keepalive);
+    config.tcp_limits.max_pending = s.tcp_max_pending;
+    if (const auto problem = server::validate_plant(config); !problem.empty()) {
+        std::fprintf(stderr, "finsd: %s\n", problem.c_str());
+        return 2;
+    }
+    // The single node's keys and flags describe no unit of the plant: say so rather than
+    // let someone believe they took effect.
+    const Settings single;
+    std::string ignored;
+    const auto note = [&](bool set, const char* what) {
+        if (set) ignored += std::string(ignored.empty() ? "" : ", ") + what;
+    };
+    note(s.profile != single.profile, "profile");
+    note(s.bind != single.bind, "bind");
+    note(s.port != single.port, "port");
+    note(s.node != single.node, "node");
+    note(s.network != single.network, "network");
+    note(s.data_dir.has_value(), "data_dir");
+    note(!s.memory.empty(), "[memory]");
+    if (!ignored.empty())
+        spdlog::warn(
+            "finsd: {} set for a single node: a plant ([[plc]]) sets them per CPU "
+            "Unit and unit, so they are ignored",
+            ignored);
+    asio::io_context io{1};
+    auto plant = server::Plant::start(io, config);
+    if (!plant) {
+        std::fprintf(stderr, "finsd: cannot start the plant: %s\n",
+                     plant.error().message().c_str());
+        return 3;
+    }
+    // The control channel (`finsd ctl`) drives the first [[plc]] of the plant.
+    std::unique_ptr<server::ControlServer> control;
+    if (s.control_socket) {
+        auto started = server::ControlServer::start(io, (*plant)->plc(0), *s.control_socket);
+        if (!started) {
+            std::fprintf(stderr, "finsd: control channel %s: %s\n", s.control_socket->c_str(),
+                         started.error().message().c_str());
+            return 3;
+        }
+        control = std::move(*started);
+        spdlog::info("finsd: control channel {} drives plc \"{}\"", s.control_socket->string(),
+                     s.plant.cpus[0].name);
+    }
+    asio::signal_set signals{io, SIGINT, SIGTERM};
+    auto& router = (*plant)->router();
+    for (std::size_t i = 0; i < router.port_count(); ++i) {
+        const auto& p = router.port(i);
+        spdlog::info("finsd: plc \"{}\" unit {} is FINS node {}.{}", s.plant.cpus[p.cpu].name,
+                     p.unit_number, p.address.network, p.address.node);
+    }
+    auto& first = (*plant)->server(0, 0);
+    const unsigned port = first.tcp_port() != 0 ? first.tcp_port() : first.udp_port();
+    spdlog::info("finsd: plant of {} CPU Units, {} units", (*plant)->cpu_count(),
+                 router.port_count());
+    std::printf("listening %u\n", port);
+    std::fflush(stdout);
+    signals.async_wait([&](std::error_code, int signal) {
+        spdlog::info("finsd: signal {}, shutting down", signal);
+        (*plant)->stop();
+        if (control) control->stop();
+        io.stop();
+    });
+    io.run();
+    return 0;
+}
+
+}  // namespace fins::cli::finsd

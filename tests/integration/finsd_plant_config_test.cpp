@@ -1,0 +1,116 @@
+// The [[plc]] configuration (cli/finsd/config_plant.hpp; README "A plant of several
+// networks"): parsed keys, positioned errors, and the plant's cross-field checks.
+#include <gtest/gtest.h>
+
+#include "cli/finsd/config.hpp"
+#include "server/plant.hpp"
+
+namespace fins::cli::finsd {
+namespace {
+
+Expected<Settings> load(std::string_view text) {
+    Settings s;
+    if (auto r = load_config_text(text, "plant.toml", s); !r) return tl::unexpected(r.error());
+    return s;
+}
+
+TEST(FinsdPlantConfig, ParsesCpuUnitsUnitsIpTablesAndRelays) {
+    const auto s = load(R"(
+[[plc]]
+name = "router"
+profile = "cs1h"
+mode = "monitor"
+gateway_count = 7
+  [[plc.ethernet]]
+  unit = 0
+  network = 1
+  bind = "127.0.1.1"
+  [[plc.ethernet]]
+  unit = 3
+  network = 2
+  node = 40
+  bind = "127.0.2.9"
+  port = 9700
+  tcp = false
+  max_connections = 4
+  address_method = "combined"
+  dynamic_remote_ip = false
+    [[plc.ethernet.ip_table]]
+    node = 7
+    ip = "127.0.2.77"
+  [[plc.relay]]
+  network = 5
+  via_network = 2
+  via_node = 8
+)");
+    ASSERT_TRUE(s) << s.error();
+    ASSERT_EQ(s->plant.cpus.size(), 1u);
+    const auto& cpu = s->plant.cpus[0];
+    EXPECT_EQ(cpu.name, "router");
+    EXPECT_EQ(cpu.profile, "cs1h");
+    EXPECT_EQ(cpu.mode, plc::OperatingMode::monitor);
+    EXPECT_EQ(cpu.gateway_count, 7);
+    ASSERT_EQ(cpu.ports.size(), 2u);
+    const auto& p = cpu.ports[1];
+    EXPECT_EQ(p.unit_number, 3);
+    EXPECT_EQ(p.network, 2);
+    EXPECT_EQ(p.node, 40);
+    EXPECT_EQ(p.port, 9700);
+    EXPECT_FALSE(p.tcp);
+    EXPECT_EQ(p.max_connections, 4u);
+    EXPECT_EQ(p.method, server::AddressMethod::combined);
+    EXPECT_FALSE(p.dynamic_remote_ip);
+    ASSERT_EQ(p.ip_table.size(), 1u);
+    EXPECT_EQ(p.ip_table[0].node, 7);
+    EXPECT_EQ(p.ip_table[0].ip, (std::array<std::uint8_t, 4>{127, 0, 2, 77}));
+    ASSERT_EQ(cpu.relays.size(), 1u);
+    EXPECT_EQ(cpu.relays[0], (plc::RelayNetwork{5, 2, 8}));
+    EXPECT_EQ(server::validate_plant(s->plant), "");
+}
+
+TEST(FinsdPlantConfig, ErrorsNameTheFilePositionAndKey) {
+    const auto bad_method = load(
+        "[[plc]]\nname = \"a\"\n[[plc.ethernet]]\nbind = \"127.0.1.1\"\naddress_method = "
+        "\"dhcp\"\n");
+    ASSERT_FALSE(bad_method);
+    EXPECT_EQ(bad_method.error(),
+              "plant.toml:5:18: plc[0].ethernet[0].address_method: 'dhcp' is not automatic, "
+              "automatic-static, table or combined");
+    const auto unknown = load("[[plc]]\nname = \"a\"\ncolour = 1\n");
+    ASSERT_FALSE(unknown);
+    EXPECT_EQ(unknown.error(), "plant.toml:3:1: plc[0].colour: unknown key");
+    const auto network = load("[[plc]]\nname = \"a\"\n[[plc.ethernet]]\nnetwork = 128\n");
+    ASSERT_FALSE(network);
+    EXPECT_EQ(network.error(), "plant.toml:4:11: plc[0].ethernet[0].network: 128 is not 1-127");
+    EXPECT_FALSE(load("[[plc]]\nprofile = \"cj2h\"\n"));  // no name
+}
+
+TEST(FinsdPlantConfig, W420_5_2_AutomaticGenerationNeedsNodeEqualToTheLastOctet) {
+    auto s = load("[[plc]]\nname = \"a\"\n[[plc.ethernet]]\nbind = \"127.0.1.5\"\nnode = 6\n");
+    ASSERT_TRUE(s) << s.error();
+    EXPECT_NE(server::validate_plant(s->plant).find("differs from the last octet"),
+              std::string::npos);
+    s->plant.cpus[0].ports[0].method = server::AddressMethod::table;
+    EXPECT_EQ(server::validate_plant(s->plant), "");
+}
+
+TEST(FinsdPlantConfig, CrossChecksRefuseDuplicatesAndForeignRelayNetworks) {
+    server::PlantConfig c;
+    server::PlantCpuConfig a;
+    a.name = "a";
+    server::PlantPortConfig p;
+    p.bind = "127.0.1.1";
+    a.ports = {p};
+    c.cpus = {a, a};
+    EXPECT_NE(server::validate_plant(c).find("used twice"), std::string::npos);
+    c.cpus[1].name = "b";
+    EXPECT_NE(server::validate_plant(c).find("exists twice in the plant"), std::string::npos);
+    c.cpus.pop_back();
+    c.cpus[0].relays = {{3, 2, 2}};
+    EXPECT_NE(server::validate_plant(c).find("relay network 2 is not"), std::string::npos);
+    c.cpus[0].relays = {{1, 1, 2}};
+    EXPECT_NE(server::validate_plant(c).find("a local network"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace fins::cli::finsd
