@@ -17,11 +17,13 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <asio/io_context.hpp>
 
 #include "fins/error.hpp"
 #include "fins/frame.hpp"
+#include "server/instruction_udp.hpp"
 #include "server/tcp_limits.hpp"
 
 namespace fins::plc {
@@ -46,6 +48,8 @@ struct ServerOptions {
     // doubles up to this, logging at most once per accept_log_interval.
     std::chrono::milliseconds accept_retry_max{1'000};
     std::chrono::milliseconds accept_log_interval{10'000};
+    // PLC-initiated messages: where remote nodes are ([[remote]], instruction_udp.hpp).
+    std::vector<RemoteNode> remotes;
 };
 
 // The node number finsd takes when none is given (see ServerOptions::node).
@@ -64,6 +68,8 @@ class Server {
     [[nodiscard]] std::uint16_t tcp_port() const noexcept;
     [[nodiscard]] NodeAddress address() const noexcept;
     [[nodiscard]] std::size_t tcp_connections() const noexcept;
+    // This node's Send/Rcv/SendCmd engine (network_instructions.hpp).
+    NetworkInstructions& instructions() noexcept;
 
     // Closes the sockets and every TCP session; pending handlers finish on `io`.
     void stop();

@@ -138,6 +138,12 @@ int UdpSession::serve_batch() {
         const auto& request = s.in_msgs[static_cast<std::size_t>(i)];
         // A longer datagram was cut to receive_size (MSG_TRUNC), still more than a frame.
         const std::size_t size = std::min<std::size_t>(request.msg_len, receive_size);
+        const Bytes frame{s.in[static_cast<std::size_t>(i)].data(), size};
+        // An answer to one of this node's own Send/Rcv/SendCmd instructions.
+        if (response_hook_ && size > 0 && (frame[0] & icf_response) != 0) {
+            response_hook_(frame);
+            continue;
+        }
         const std::size_t n = dispatcher_.handle(
             Bytes{s.in[static_cast<std::size_t>(i)].data(), size}, s.out[replies], context);
         if (n == 0) continue;
@@ -172,6 +178,17 @@ void UdpSession::send_replies(unsigned count) {
         ++done;
     }
     if (done < count) note_dropped(count - done);
+}
+
+bool UdpSession::send_to(Bytes frame, const sockaddr* to, socklen_t to_size) noexcept {
+    for (int attempt = 0; attempt < 4; ++attempt) {
+        const auto n = ::sendto(socket_.native_handle(), frame.data(), frame.size(),
+                                MSG_DONTWAIT | MSG_NOSIGNAL, to, to_size);
+        if (n >= 0) return true;
+        if (errno != EINTR) break;
+    }
+    spdlog::debug("fins/udp: instruction frame not sent: {}", std::strerror(errno));
+    return false;
 }
 
 void UdpSession::note_dropped(std::uint64_t count) {

@@ -20,6 +20,7 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 
 #include <sys/socket.h>
@@ -58,6 +59,15 @@ class UdpSession : public std::enable_shared_from_this<UdpSession> {
     [[nodiscard]] std::uint16_t local_port() const noexcept;
     [[nodiscard]] const Counters& counters() const noexcept { return counters_; }
 
+    // PLC-initiated messages (network_instructions.hpp): every received frame whose ICF
+    // response bit is set goes to `hook` instead of the dispatcher (which drops
+    // responses); the hook returns false for an answer nobody waited for (dropped).
+    using ResponseHook = std::function<bool(Bytes frame)>;
+    void set_response_hook(ResponseHook hook) { response_hook_ = std::move(hook); }
+    // Sends one frame from this socket (the node's own port) to `to`, without blocking.
+    // False when the kernel refused it or the send buffer is full.
+    bool send_to(Bytes frame, const sockaddr* to, socklen_t to_size) noexcept;
+
   private:
     struct Slots;  // the per-batch buffers and message headers
 
@@ -74,6 +84,7 @@ class UdpSession : public std::enable_shared_from_this<UdpSession> {
     Dispatcher& dispatcher_;
     std::unique_ptr<Slots> slots_;
     Counters counters_;
+    ResponseHook response_hook_;
     std::uint64_t dropped_unlogged_ = 0;
     std::chrono::steady_clock::time_point last_drop_log_{};
 };

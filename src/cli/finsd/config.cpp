@@ -67,6 +67,10 @@ class Loader {
                 r = section(key, node, k, &Loader::inject);
             else if (k == "files")
                 r = section(key, node, k, &Loader::files);
+            else if (k == "remote")
+                r = load_remotes(key, node, source_, s_);
+            else if (k == "schedule")
+                r = load_schedule(key, node, source_, s_);
             else
                 r = fail(key, k, "unknown key");
             if (!r) return r;

@@ -17,6 +17,7 @@
 
 #include <tl/expected.hpp>
 
+#include "cli/finsd/config_schedule.hpp"
 #include "fins/address.hpp"
 #include "plc/injections.hpp"
 #include "plc/io_memory.hpp"
@@ -72,6 +73,10 @@ struct Settings {
 
     std::vector<MemoryInit> memory;  // [memory]
     plc::Injections inject;          // [inject]
+
+    // PLC-initiated messages (config_schedule.hpp).
+    std::vector<server::RemoteNode> remotes;  // [[remote]]
+    std::vector<ScheduleEntry> schedule;      // [[schedule]]
 };
 
 // Command-line values; a set optional overrides the file.

@@ -21,9 +21,9 @@
 #include <string>
 #include <string_view>
 
+#include <fmt/format.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
-#include <fmt/format.h>
 #include <CLI/CLI.hpp>
 #include <asio/io_context.hpp>
 #include <asio/signal_set.hpp>
@@ -35,6 +35,7 @@
 #include "plc/storage.hpp"
 #include "plc/storage_format.hpp"
 #include "server/control.hpp"
+#include "server/instruction_schedule.hpp"
 #include "server/server.hpp"
 
 namespace {
@@ -148,7 +149,7 @@ int configure(int argc, char** argv, Settings& settings) {
         app.add_option("--network-write-protection", protection,
                        "off, all, listed or all-except-listed (W342 5-1-2 note 5)");
     auto* o_nodes = app.add_option("--protect-node", o.protect_nodes,
-                   "A listed node, network.node (repeatable; node * = any)");
+                                   "A listed node, network.node (repeatable; node * = any)");
     auto* o_um = app.add_flag("--um-read-protection", um_read, "UM read protection set");
     auto* o_dip = app.add_flag("--dip-write-protection", dip_write,
                                "DIP switch pin 1 ON (UM write-protected)");
@@ -198,16 +199,17 @@ int configure(int argc, char** argv, Settings& settings) {
     // let someone believe those nodes are refused (or, under "all", the only ones).
     const auto write_mode = settings.network_write_protection.mode;
     using fins::plc::NetworkWriteProtection;
-    if (o_nodes->count() > 0 && (write_mode == NetworkWriteProtection::off ||
-                                 write_mode == NetworkWriteProtection::all))
+    if (o_nodes->count() > 0 &&
+        (write_mode == NetworkWriteProtection::off || write_mode == NetworkWriteProtection::all))
         return fail(2, fmt::format("--protect-node has no effect with network write protection "
                                    "'{}': add --network-write-protection listed (refuse those "
                                    "nodes) or all-except-listed (accept only those)",
                                    write_mode == NetworkWriteProtection::off ? "off" : "all"));
     if (!settings.network_write_protection.nodes.empty() &&
         write_mode == NetworkWriteProtection::off)
-        spdlog::warn("finsd: protection.nodes is set but protection.network_write is \"off\": "
-                     "no node is refused");
+        spdlog::warn(
+            "finsd: protection.nodes is set but protection.network_write is \"off\": "
+            "no node is refused");
     return -1;
 }
 
@@ -279,6 +281,7 @@ int serve(const Settings& s) {
                      plc.storage().path().string());
 
     if (auto r = check_initial_memory(s.memory, plc.memory()); !r) return fail(2, r.error());
+    if (auto r = check_schedule(s, plc.memory()); !r) return fail(2, r.error());
     const auto written = apply_initial_memory(s.memory, plc.memory(), restored);
     if (!s.memory.empty()) spdlog::info("finsd: {} [memory] entries written", written);
     plc.change_mode(s.mode, std::chrono::system_clock::now());
@@ -312,6 +315,7 @@ int serve(const Settings& s) {
     options.tcp_limits.idle_timeout = std::chrono::seconds(s.tcp_idle_timeout);
     options.tcp_limits.keepalive = std::chrono::seconds(s.tcp_keepalive);
     options.tcp_limits.max_pending = s.tcp_max_pending;
+    options.remotes = s.remotes;
     asio::io_context io{1};
     auto server = fins::server::Server::start(io, plc, options);
     if (!server)
@@ -319,12 +323,20 @@ int serve(const Settings& s) {
                            server.error().message());
     std::unique_ptr<fins::server::ControlServer> control;
     if (s.control_socket) {
-        auto started = fins::server::ControlServer::start(io, plc, *s.control_socket);
+        auto started = fins::server::ControlServer::start(io, plc, *s.control_socket,
+                                                          &(*server)->instructions());
         if (!started)
             return fail(3, "control channel " + s.control_socket->string() + ": " +
                                started.error().message());
         control = std::move(*started);
     }
+    // [[schedule]]: this node's own Send/Rcv/SendCmd at fixed periods.
+    std::vector<fins::server::ScheduledInstruction> scheduled;
+    for (const auto& e : s.schedule)
+        scheduled.push_back(e.scheduled);
+    fins::server::InstructionSchedule schedule(io.get_executor(), (*server)->instructions(),
+                                               std::move(scheduled));
+    schedule.start();
     // Before "listening": a SIGTERM right after that line still stops finsd cleanly.
     asio::signal_set signals{io, SIGINT, SIGTERM};
     const auto self = (*server)->address();
@@ -339,6 +351,7 @@ int serve(const Settings& s) {
 
     signals.async_wait([&](std::error_code, int signal) {
         spdlog::info("finsd: signal {}, shutting down", signal);
+        schedule.stop();
         (*server)->stop();
         if (control) control->stop();
         plc.storage().flush();
