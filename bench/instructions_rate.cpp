@@ -99,10 +99,14 @@ int main(int argc, char** argv) {
     r.options.timeout = 10;
     r.options.retries = 0;
     const auto start = Clock::now();
-    Runner runner{(*node1)->instructions(), r,
-                  start + std::chrono::duration_cast<Clock::duration>(
-                              std::chrono::duration<double>(seconds))};
-    runner.finished = [&] { (*node1)->stop(); };
+    Runner runner{
+        (*node1)->instructions(),
+        r,
+        start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds)),
+        0,
+        0,
+        0,
+        [&] { (*node1)->stop(); }};
     asio::post(io1, [&] {
         for (unsigned i = 0; i < in_flight; ++i)
             runner.launch();

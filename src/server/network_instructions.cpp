@@ -15,7 +15,6 @@ namespace fins::server {
 
 namespace {
 
-constexpr std::size_t response_data_offset = header_size + command_code_size + end_code_size;
 // A202: Communications Port Enabled Flags; A203-A210: Completion Codes; A219: Error Flags.
 constexpr std::size_t a_port_enabled = 202;
 constexpr std::size_t a_completion_first = 203;

@@ -149,9 +149,10 @@ tl::expected<void, std::string> load_schedule(const toml::key& key, const toml::
             const std::string path = p + "." + std::string(k.str());
             const auto* s = v.as_string();
             const auto* n = v.as_integer();
+            const toml::node& value = v;  // clang 14 cannot capture a structured binding
             const auto integer = [&](std::int64_t hi) -> tl::expected<std::int64_t, std::string> {
                 if (n == nullptr || n->get() < 0 || n->get() > hi)
-                    return fail(source, v, path, fmt::format("must be an integer 0-{}", hi));
+                    return fail(source, value, path, fmt::format("must be an integer 0-{}", hi));
                 return n->get();
             };
             if (k == "every") {
