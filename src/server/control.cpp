@@ -51,7 +51,8 @@ namespace {
 using Json = nlohmann::json;
 using stream = asio::local::stream_protocol;
 
-constexpr std::size_t max_line_size = 4096;
+// A SendCmd of 2,002 bytes is 4,004 hex digits plus its keys: room for it.
+constexpr std::size_t max_line_size = 8192;
 constexpr std::size_t max_connections = 16;
 
 std::string hex4(std::uint16_t v) {
@@ -281,6 +282,7 @@ std::string answer(plc::Plc& plc, const std::string& line) {
 struct Shared {
     plc::Plc* plc = nullptr;
     NetworkInstructions* instructions = nullptr;
+    const InstructionSchedule* schedule = nullptr;
     bool stopped = false;
 };
 
@@ -333,7 +335,7 @@ class Session : public std::enable_shared_from_this<Session> {
         if (j.is_discarded() || !j.is_object() || !j.contains("cmd") || !j["cmd"].is_string())
             return false;
         return handle_instruction_request(
-            shared_->instructions, j, [self = shared_from_this()](Json reply) {
+            shared_->instructions, shared_->schedule, j, [self = shared_from_this()](Json reply) {
                 if (self->shared_->stopped) return;
                 self->reply_ = reply.dump(-1, ' ', false, Json::error_handler_t::replace) + "\n";
                 self->write(false);
@@ -385,7 +387,8 @@ struct ControlServer::Impl {
 
 Result<std::unique_ptr<ControlServer>> ControlServer::start(asio::io_context& io, plc::Plc& plc,
                                                             const std::filesystem::path& path,
-                                                            NetworkInstructions* instructions) {
+                                                            NetworkInstructions* instructions,
+                                                            const InstructionSchedule* schedule) {
     // sockaddr_un holds at most 107 characters and a terminating NUL.
     if (path.empty() || path.native().size() >= sizeof(sockaddr_un{}.sun_path))
         return Unexpected(std::make_error_code(std::errc::filename_too_long));
@@ -404,6 +407,7 @@ Result<std::unique_ptr<ControlServer>> ControlServer::start(asio::io_context& io
     auto impl = std::make_unique<Impl>(io, path);
     impl->shared->plc = &plc;
     impl->shared->instructions = instructions;
+    impl->shared->schedule = schedule;
     const stream::endpoint endpoint(path.native());
     if (impl->acceptor.open(endpoint.protocol(), ec); ec) return Unexpected(ec);
     if (impl->acceptor.bind(endpoint, ec); ec) return Unexpected(ec);

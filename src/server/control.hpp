@@ -19,6 +19,7 @@ class Plc;
 namespace fins::server {
 
 class NetworkInstructions;
+class InstructionSchedule;
 
 class ControlServer {
   public:
@@ -27,7 +28,7 @@ class ControlServer {
     // (control_instructions.hpp).
     static Result<std::unique_ptr<ControlServer>> start(
         asio::io_context& io, plc::Plc& plc, const std::filesystem::path& socket_path,
-        NetworkInstructions* instructions = nullptr);
+        NetworkInstructions* instructions = nullptr, const InstructionSchedule* schedule = nullptr);
     ~ControlServer();
     ControlServer(const ControlServer&) = delete;
     ControlServer& operator=(const ControlServer&) = delete;

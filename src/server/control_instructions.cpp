@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "server/instruction_schedule.hpp"
 #include "server/network_instructions.hpp"
 
 namespace fins::server {
@@ -110,8 +111,8 @@ Json result_json(InstructionKind kind, const InstructionResult& r) {
 
 }  // namespace
 
-bool handle_instruction_request(NetworkInstructions* engine, const Json& j,
-                                const ControlReply& reply) {
+bool handle_instruction_request(NetworkInstructions* engine, const InstructionSchedule* schedule,
+                                const Json& j, const ControlReply& reply) {
     const std::string cmd = j.at("cmd").get<std::string>();
     const bool status = cmd == "instructions";
     const auto kind = parse_instruction_kind(cmd);
@@ -122,7 +123,18 @@ bool handle_instruction_request(NetworkInstructions* engine, const Json& j,
     }
     if (status) {
         const auto& c = engine->counters();
+        Json entries = Json::array();
+        for (std::size_t i = 0; schedule != nullptr && i < schedule->size(); ++i) {
+            const auto& e = schedule->counters(i);
+            entries.push_back({{"runs", e.runs},
+                               {"done", e.done},
+                               {"errors", e.errors},
+                               {"skipped", e.skipped},
+                               {"last_error_id", hex4(e.last_error_id)},
+                               {"last_error_id_ex", hex4(e.last_error_id_ex)}});
+        }
         reply(Json{{"ok", true},
+                   {"schedule", entries},
                    {"instructions",
                     {{"in_flight", engine->in_flight()},
                      {"available", engine->available()},

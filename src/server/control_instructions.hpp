@@ -4,7 +4,8 @@
 //    "timeout":20,"retries":2,"no_response":false}
 //   {"cmd":"recv", ... same keys: reads `count` words at `remote` into `local`}
 //   {"cmd":"sendcmd","dest":"0.5.0","command":"0501", "timeout" ...}
-//   {"cmd":"instructions"}   the engine's state: ports in use, counters
+//   {"cmd":"instructions"}   the engine's state: ports in use, counters, and each
+//                            [[schedule]] entry's runs, done, errors, skipped ticks
 //
 // An instruction answers when it completes (so a reply may take timeout x (retries + 1)):
 //   {"ok":true|false,"result":{"instruction":"send","done":true,"error_id":"0000",
@@ -21,12 +22,13 @@
 namespace fins::server {
 
 class NetworkInstructions;
+class InstructionSchedule;
 
 using ControlReply = std::function<void(nlohmann::json)>;
 
 // True when `request` is one of the verbs above; `reply` is then called exactly once
 // (maybe later, on the io_context). False leaves the request to the caller.
-bool handle_instruction_request(NetworkInstructions* engine, const nlohmann::json& request,
-                                const ControlReply& reply);
+bool handle_instruction_request(NetworkInstructions* engine, const InstructionSchedule* schedule,
+                                const nlohmann::json& request, const ControlReply& reply);
 
 }  // namespace fins::server

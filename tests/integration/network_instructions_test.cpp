@@ -45,8 +45,8 @@ class Peer {
                                       reinterpret_cast<sockaddr*>(&peer), &size);
             if (n >= 0) {
                 buf.resize(static_cast<std::size_t>(n));
-                from_ = asio::ip::udp::endpoint(
-                    asio::ip::address_v4(ntohl(peer.sin_addr.s_addr)), ntohs(peer.sin_port));
+                from_ = asio::ip::udp::endpoint(asio::ip::address_v4(ntohl(peer.sin_addr.s_addr)),
+                                                ntohs(peer.sin_port));
                 return buf;
             }
         }
@@ -151,6 +151,24 @@ TEST_F(NetworkInstructions, W596_3_SendCmdReturnsTheAnswerAndRemoteEndCodesExit4
     EXPECT_EQ(refused["result"]["error_id"], "0800");
     EXPECT_EQ(refused["result"]["error_id_ex"], refused["result"]["end_code"]);
     EXPECT_NE(refused["result"]["end_code"], "0000");
+}
+
+// The largest command a frame holds (W596 3 CmdSize; 2,002 bytes: 01 02 with 997 words)
+// passes through the control channel and the instruction.
+TEST_F(NetworkInstructions, W596_3_SendCmdOfTheLargestCommandWorks) {
+    start_pair();
+    std::string command =
+        "0102820000"
+        "0003E5";
+    for (int i = 0; i < 997; ++i)
+        command += "ABCD";
+    ASSERT_EQ(command.size(), 2 * 2002u);
+    auto r = ctl_json({"sendcmd", "--dest", "0.5.0", "--command", command}, 0);
+    EXPECT_EQ(r["result"]["response"], "01020000");
+    auto c5 = client5();
+    EXPECT_EQ(words_of(*c5, "D996", 1), (std::vector<std::uint16_t>{0xABCD}));
+    auto too_long = ctl_json({"sendcmd", "--dest", "0.5.0", "--command", command + "00"}, 2);
+    EXPECT_EQ(too_long["result"]["error_id"], "0400");
 }
 
 // "A host program that receives unsolicited FINS from a PLC": node 1 on 127.0.0.1 port P
@@ -266,6 +284,10 @@ TEST_F(NetworkInstructions, ScheduleSendsAtItsPeriod) {
         got = words_of(*c5, "D400", 1);
     }
     EXPECT_EQ(got, (std::vector<std::uint16_t>{0x0A0B}));
+    const auto status = Json::parse(ctl({"instructions"}).out, nullptr, false);
+    ASSERT_EQ(status["schedule"].size(), 1u) << status.dump();
+    EXPECT_GE(status["schedule"][0]["done"].get<int>(), 1);
+    EXPECT_EQ(status["schedule"][0]["last_error_id"], "0000");
 }
 
 TEST_F(NetworkInstructions, ConfigErrorsNameTheEntry) {

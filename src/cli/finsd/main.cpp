@@ -321,15 +321,6 @@ int serve(const Settings& s) {
     if (!server)
         return fail(3, "cannot listen on " + s.bind + " port " + std::to_string(s.port) + ": " +
                            server.error().message());
-    std::unique_ptr<fins::server::ControlServer> control;
-    if (s.control_socket) {
-        auto started = fins::server::ControlServer::start(io, plc, *s.control_socket,
-                                                          &(*server)->instructions());
-        if (!started)
-            return fail(3, "control channel " + s.control_socket->string() + ": " +
-                               started.error().message());
-        control = std::move(*started);
-    }
     // [[schedule]]: this node's own Send/Rcv/SendCmd at fixed periods.
     std::vector<fins::server::ScheduledInstruction> scheduled;
     for (const auto& e : s.schedule)
@@ -337,6 +328,15 @@ int serve(const Settings& s) {
     fins::server::InstructionSchedule schedule(io.get_executor(), (*server)->instructions(),
                                                std::move(scheduled));
     schedule.start();
+    std::unique_ptr<fins::server::ControlServer> control;
+    if (s.control_socket) {
+        auto started = fins::server::ControlServer::start(io, plc, *s.control_socket,
+                                                          &(*server)->instructions(), &schedule);
+        if (!started)
+            return fail(3, "control channel " + s.control_socket->string() + ": " +
+                               started.error().message());
+        control = std::move(*started);
+    }
     // Before "listening": a SIGTERM right after that line still stops finsd cleanly.
     asio::signal_set signals{io, SIGINT, SIGTERM};
     const auto self = (*server)->address();
