@@ -19,6 +19,9 @@
 //                                                   profile's or 30720) or removes the card
 //   {"cmd":"cassette","inserted":false}             removes (or mounts) the CP1H Memory
 //                                                   Cassette; other profiles: an error
+//   {"cmd":"send"|"recv"|"sendcmd"|"instructions", ...}  PLC-initiated messages
+//                                                   (control_instructions.hpp); these
+//                                                   answer when the instruction completes
 // Anything else answers {"error":"..."} and the connection stays open. A line longer
 // than max_line_size answers an error and closes the connection; at most
 // max_connections clients at once (others get an error and are closed). Every handler
@@ -41,6 +44,7 @@
 
 #include "fins/commands/diagnostics.hpp"
 #include "plc/plc.hpp"
+#include "server/control_instructions.hpp"
 
 namespace fins::server {
 
@@ -49,7 +53,8 @@ namespace {
 using Json = nlohmann::json;
 using stream = asio::local::stream_protocol;
 
-constexpr std::size_t max_line_size = 4096;
+// A SendCmd of 2,002 bytes is 4,004 hex digits plus its keys: room for it.
+constexpr std::size_t max_line_size = 8192;
 constexpr std::size_t max_connections = 16;
 
 std::string hex4(std::uint16_t v) {
@@ -286,6 +291,8 @@ std::string answer(plc::Plc& plc, const std::string& line) {
 
 struct Shared {
     plc::Plc* plc = nullptr;
+    NetworkInstructions* instructions = nullptr;
+    const InstructionSchedule* schedule = nullptr;
     bool stopped = false;
 };
 
@@ -326,8 +333,23 @@ class Session : public std::enable_shared_from_this<Session> {
                          asio::buffers_begin(data) + static_cast<std::ptrdiff_t>(n - 1));
         buffer_.consume(n);
         if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (instruction(line)) return;
         reply_ = answer(*shared_->plc, line);
         write(false);
+    }
+
+    // A send / recv / sendcmd line: the answer is written when the instruction ends
+    // (the next line is read only then, so answers stay in request order).
+    bool instruction(const std::string& line) {
+        const Json j = Json::parse(line, nullptr, false);
+        if (j.is_discarded() || !j.is_object() || !j.contains("cmd") || !j["cmd"].is_string())
+            return false;
+        return handle_instruction_request(
+            shared_->instructions, shared_->schedule, j, [self = shared_from_this()](Json reply) {
+                if (self->shared_->stopped) return;
+                self->reply_ = reply.dump(-1, ' ', false, Json::error_handler_t::replace) + "\n";
+                self->write(false);
+            });
     }
 
     void write(bool close_after) {
@@ -374,7 +396,9 @@ struct ControlServer::Impl {
 };
 
 Result<std::unique_ptr<ControlServer>> ControlServer::start(asio::io_context& io, plc::Plc& plc,
-                                                            const std::filesystem::path& path) {
+                                                            const std::filesystem::path& path,
+                                                            NetworkInstructions* instructions,
+                                                            const InstructionSchedule* schedule) {
     // sockaddr_un holds at most 107 characters and a terminating NUL.
     if (path.empty() || path.native().size() >= sizeof(sockaddr_un{}.sun_path))
         return Unexpected(std::make_error_code(std::errc::filename_too_long));
@@ -392,6 +416,8 @@ Result<std::unique_ptr<ControlServer>> ControlServer::start(asio::io_context& io
     }
     auto impl = std::make_unique<Impl>(io, path);
     impl->shared->plc = &plc;
+    impl->shared->instructions = instructions;
+    impl->shared->schedule = schedule;
     const stream::endpoint endpoint(path.native());
     if (impl->acceptor.open(endpoint.protocol(), ec); ec) return Unexpected(ec);
     if (impl->acceptor.bind(endpoint, ec); ec) return Unexpected(ec);

@@ -18,11 +18,17 @@ class Plc;
 
 namespace fins::server {
 
+class NetworkInstructions;
+class InstructionSchedule;
+
 class ControlServer {
   public:
-    // Listens on `socket_path` (an existing stale socket file is replaced).
-    static Result<std::unique_ptr<ControlServer>> start(asio::io_context& io, plc::Plc& plc,
-                                                        const std::filesystem::path& socket_path);
+    // Listens on `socket_path` (an existing stale socket file is replaced). With
+    // `instructions`, the send / recv / sendcmd verbs run on that node's engine
+    // (control_instructions.hpp).
+    static Result<std::unique_ptr<ControlServer>> start(
+        asio::io_context& io, plc::Plc& plc, const std::filesystem::path& socket_path,
+        NetworkInstructions* instructions = nullptr, const InstructionSchedule* schedule = nullptr);
     ~ControlServer();
     ControlServer(const ControlServer&) = delete;
     ControlServer& operator=(const ControlServer&) = delete;

@@ -126,6 +126,9 @@ struct Server::Impl {
 
     Dispatcher dispatcher;
     std::shared_ptr<UdpSession> udp;  // null without FINS/UDP
+    // PLC-initiated messages: answers arriving at the UDP session go to `instructions`.
+    std::unique_ptr<UdpInstructionTransport> transport;
+    std::unique_ptr<NetworkInstructions> instructions;
     asio::ip::tcp::acceptor acceptor;
     TcpNodeTable nodes;
     TcpLimits limits;
@@ -168,6 +171,14 @@ Result<std::unique_ptr<Server>> Server::start(asio::io_context& io, plc::Plc& pl
         if (ec) return Unexpected(ec);
         impl->udp = std::make_shared<UdpSession>(std::move(socket), impl->dispatcher);
     }
+    impl->transport =
+        std::make_unique<UdpInstructionTransport>(impl->udp, ip, self, options.remotes);
+    impl->instructions =
+        std::make_unique<NetworkInstructions>(io.get_executor(), plc, self, *impl->transport);
+    if (impl->udp)
+        impl->udp->set_response_hook([engine = impl->instructions.get()](Bytes frame) {
+            return engine->on_response(frame);
+        });
     if (options.tcp) impl->accept_tcp();
     if (impl->udp) impl->udp->start();
     return std::unique_ptr<Server>(new Server(std::move(impl)));
@@ -215,8 +226,13 @@ std::size_t Server::tcp_connections() const noexcept {
     return impl_->nodes.in_use();
 }
 
+NetworkInstructions& Server::instructions() noexcept {
+    return *impl_->instructions;
+}
+
 void Server::stop() {
     std::error_code ignored;
+    impl_->instructions->stop();
     if (impl_->udp) impl_->udp->close();
     impl_->acceptor.close(ignored);
     impl_->accept_timer.cancel();

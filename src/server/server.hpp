@@ -18,11 +18,13 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <asio/io_context.hpp>
 
 #include "fins/error.hpp"
 #include "fins/frame.hpp"
+#include "server/instruction_udp.hpp"
 #include "server/tcp_limits.hpp"
 
 namespace fins::plc {
@@ -53,6 +55,8 @@ struct ServerOptions {
     // In a plant: the router and this server's port in it (router.hpp); null: one node.
     Router* router = nullptr;
     std::size_t router_port = 0;
+    // PLC-initiated messages: where remote nodes are ([[remote]], instruction_udp.hpp).
+    std::vector<RemoteNode> remotes;
 };
 
 // The node number finsd takes when none is given (see ServerOptions::node).
@@ -78,6 +82,8 @@ class Server {
                        std::uint16_t port) noexcept;
     // Sends `frame` on the FINS/TCP connection holding client node `node` (false: none).
     bool send_to_tcp_node(std::uint8_t node, Bytes frame);
+    // This node's Send/Rcv/SendCmd engine (network_instructions.hpp).
+    NetworkInstructions& instructions() noexcept;
 
     // Closes the sockets and every TCP session; pending handlers finish on `io`.
     void stop();

@@ -147,6 +147,13 @@ int UdpSession::serve_batch() {
         context.peer = &s.peers[static_cast<std::size_t>(i)];
         // A longer datagram was cut to receive_size (MSG_TRUNC), still more than a frame.
         const std::size_t size = std::min<std::size_t>(request.msg_len, receive_size);
+        const Bytes frame{s.in[static_cast<std::size_t>(i)].data(), size};
+        // An answer to one of this node's own Send/Rcv/SendCmd instructions.
+        // One it did not wait for goes on to the dispatcher: in a plant the router
+        // relays answers for other nodes; a single node drops them there.
+        if (response_hook_ && size > 0 && (frame[0] & icf_response) != 0 &&
+            response_hook_(frame))
+            continue;
         const std::size_t n = dispatcher_.handle(
             Bytes{s.in[static_cast<std::size_t>(i)].data(), size}, s.out[replies], context);
         if (n == 0) continue;
@@ -186,11 +193,18 @@ void UdpSession::send_replies(unsigned count) {
 }
 
 bool UdpSession::send_to(Bytes frame, const sockaddr_in& to) noexcept {
-    const auto sent =
-        ::sendto(socket_.native_handle(), frame.data(), frame.size(), MSG_DONTWAIT | MSG_NOSIGNAL,
-                 reinterpret_cast<const sockaddr*>(&to), sizeof to);
-    if (sent < 0) spdlog::debug("fins/udp: send: {}", std::strerror(errno));
-    return sent == static_cast<ssize_t>(frame.size());
+    return send_to(frame, reinterpret_cast<const sockaddr*>(&to), sizeof to);
+}
+
+bool UdpSession::send_to(Bytes frame, const sockaddr* to, socklen_t to_size) noexcept {
+    for (int attempt = 0; attempt < 4; ++attempt) {
+        const auto n = ::sendto(socket_.native_handle(), frame.data(), frame.size(),
+                                MSG_DONTWAIT | MSG_NOSIGNAL, to, to_size);
+        if (n >= 0) return true;
+        if (errno != EINTR) break;
+    }
+    spdlog::debug("fins/udp: instruction frame not sent: {}", std::strerror(errno));
+    return false;
 }
 
 void UdpSession::note_dropped(std::uint64_t count) {

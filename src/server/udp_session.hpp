@@ -22,6 +22,7 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 
 #include <netinet/in.h>
@@ -64,6 +65,15 @@ class UdpSession : public std::enable_shared_from_this<UdpSession> {
     // process); false when the kernel did not take it whole.
     bool send_to(Bytes frame, const sockaddr_in& to) noexcept;
 
+    // PLC-initiated messages (network_instructions.hpp): every received frame whose ICF
+    // response bit is set goes to `hook` instead of the dispatcher (which drops
+    // responses); the hook returns false for an answer nobody waited for (dropped).
+    using ResponseHook = std::function<bool(Bytes frame)>;
+    void set_response_hook(ResponseHook hook) { response_hook_ = std::move(hook); }
+    // Sends one frame from this socket (the node's own port) to `to`, without blocking.
+    // False when the kernel refused it or the send buffer is full.
+    bool send_to(Bytes frame, const sockaddr* to, socklen_t to_size) noexcept;
+
   private:
     struct Slots;  // the per-batch buffers and message headers
 
@@ -80,6 +90,7 @@ class UdpSession : public std::enable_shared_from_this<UdpSession> {
     Dispatcher& dispatcher_;
     std::unique_ptr<Slots> slots_;
     Counters counters_;
+    ResponseHook response_hook_;
     std::uint64_t dropped_unlogged_ = 0;
     std::chrono::steady_clock::time_point last_drop_log_{};
 };

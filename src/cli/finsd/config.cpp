@@ -72,6 +72,10 @@ class Loader {
                 r = load_serial_table(node, source_, s_.serial);
             else if (k == "plc")
                 r = load_plant(key, node, source_, s_);
+            else if (k == "remote")
+                r = load_remotes(key, node, source_, s_);
+            else if (k == "schedule")
+                r = load_schedule(key, node, source_, s_);
             else
                 r = fail(key, k, "unknown key");
             if (!r) return r;

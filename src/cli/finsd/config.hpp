@@ -18,6 +18,7 @@
 #include <tl/expected.hpp>
 
 #include "cli/finsd/config_serial.hpp"
+#include "cli/finsd/config_schedule.hpp"
 #include "fins/address.hpp"
 #include "plc/injections.hpp"
 #include "plc/io_memory.hpp"
@@ -79,6 +80,10 @@ struct Settings {
     plc::Injections inject;                // [inject]
     std::vector<SerialPortConfig> serial;  // [serial], --serial (config_serial.hpp)
     server::PlantConfig plant;             // [[plc]] (config_plant.hpp); empty: one node
+
+    // PLC-initiated messages (config_schedule.hpp).
+    std::vector<server::RemoteNode> remotes;  // [[remote]]
+    std::vector<ScheduleEntry> schedule;      // [[schedule]]
 };
 
 // Command-line values; a set optional overrides the file.

@@ -15,16 +15,20 @@
 //   card insert [KB] | card remove  inserts (capacity in KB) or removes the memory card
 //   cassette insert | cassette remove  the CP1H Memory Cassette (22 20)
 //   send JSON                       any request line as is
+//   send|recv|sendcmd|instructions  PLC-initiated messages (ctl_instructions.hpp; their
+//                                   own exit codes)
 //
 // Exit codes: 0 the server answered "ok"; 2 usage error or the server refused the
 // request (its message on stderr); 3 cannot connect, or no answer within 5 s.
 #include "cli/finsd/ctl.hpp"
+#include "cli/finsd/ctl_instructions.hpp"
 
 #include <poll.h>
 #include <sys/socket.h>
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -52,7 +56,8 @@ struct Fd {
 };
 
 // Sends `request` (one line) and returns the answer line, or prints why not.
-std::optional<std::string> send_request(const std::string& path, const std::string& request) {
+std::optional<std::string> send_request(const std::string& path, const std::string& request,
+                                        std::chrono::milliseconds wait) {
     sockaddr_un address{};
     if (path.size() >= sizeof address.sun_path) {
         std::fprintf(stderr, "finsd ctl: socket path too long: %s\n", path.c_str());
@@ -77,8 +82,8 @@ std::optional<std::string> send_request(const std::string& path, const std::stri
         sent += static_cast<std::size_t>(n);
     }
     std::string answer;
-    const auto deadline =
-        std::chrono::steady_clock::now() + std::chrono::milliseconds(answer_timeout_ms);
+    const auto deadline = std::chrono::steady_clock::now() +
+                          std::max(wait, std::chrono::milliseconds(answer_timeout_ms));
     while (answer.size() < max_answer_size) {
         const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
             deadline - std::chrono::steady_clock::now());
@@ -115,7 +120,6 @@ int run_ctl(int argc, char** argv) {
     std::string text;
     std::string code;
     std::string mode;
-    std::string raw;
     const auto add_on_off = [&](const char* name, const char* help, const char* cmd) {
         auto* c = app.add_subcommand(name, help);
         c->add_option("state", on_off, "on or off")
@@ -194,8 +198,8 @@ int run_ctl(int argc, char** argv) {
     app.add_subcommand("release-access", "Release the access right (as 0C 03)")->callback([&] {
         request = {{"cmd", "release_access_right"}};
     });
-    auto* c_send = app.add_subcommand("send", "Send one request line as is");
-    c_send->add_option("json", raw, "The request, e.g. '{\"cmd\":\"status\"}'")->required();
+    InstructionVerbs verbs;
+    add_instruction_verbs(app, request, verbs);
 
     try {
         // argv[0] is "ctl": CLI11 skips it as the program name.
@@ -205,15 +209,19 @@ int run_ctl(int argc, char** argv) {
         std::fprintf(stderr, "finsd ctl: %s (see finsd ctl --help)\n", e.what());
         return exit_usage;
     }
-    const std::string line = c_send->parsed() ? raw : request.dump();
+    const bool raw_line = verbs.send->parsed() && !verbs.raw.empty();
+    const std::string line = raw_line ? verbs.raw : request.dump();
     if (line.find('\n') != std::string::npos) {
         std::fprintf(stderr, "finsd ctl: a request is one line\n");
         return exit_usage;
     }
-    const auto answer = send_request(socket, line);
+    const auto answer = send_request(socket, line, verbs.wait);
     if (!answer) return exit_io;
-    std::printf("%s\n", answer->c_str());
     const Json doc = Json::parse(*answer, nullptr, false);
+    const bool instruction =
+        !raw_line && (verbs.send->parsed() || verbs.recv->parsed() || verbs.sendcmd->parsed());
+    if (instruction && doc.is_object()) return print_instruction_answer(doc, *answer, verbs.json);
+    std::printf("%s\n", answer->c_str());
     if (doc.is_object() && doc.contains("ok") && doc["ok"] == true) return exit_ok;
     if (doc.is_object() && doc.contains("error") && doc["error"].is_string())
         std::fprintf(stderr, "finsd ctl: %s\n", doc["error"].get<std::string>().c_str());

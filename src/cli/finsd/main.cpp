@@ -37,6 +37,7 @@
 #include "plc/storage.hpp"
 #include "plc/storage_format.hpp"
 #include "server/control.hpp"
+#include "server/instruction_schedule.hpp"
 #include "server/server.hpp"
 
 namespace {
@@ -285,6 +286,7 @@ int serve(const Settings& s) {
                      plc.storage().path().string());
 
     if (auto r = check_initial_memory(s.memory, plc.memory()); !r) return fail(2, r.error());
+    if (auto r = check_schedule(s, plc.memory()); !r) return fail(2, r.error());
     const auto written = apply_initial_memory(s.memory, plc.memory(), restored);
     if (!s.memory.empty()) spdlog::info("finsd: {} [memory] entries written", written);
     plc.change_mode(s.mode, std::chrono::system_clock::now());
@@ -319,14 +321,23 @@ int serve(const Settings& s) {
     options.tcp_limits.idle_timeout = std::chrono::seconds(s.tcp_idle_timeout);
     options.tcp_limits.keepalive = std::chrono::seconds(s.tcp_keepalive);
     options.tcp_limits.max_pending = s.tcp_max_pending;
+    options.remotes = s.remotes;
     asio::io_context io{1};
     auto server = fins::server::Server::start(io, plc, options);
     if (!server)
         return fail(3, "cannot listen on " + s.bind + " port " + std::to_string(s.port) + ": " +
                            server.error().message());
+    // [[schedule]]: this node's own Send/Rcv/SendCmd at fixed periods.
+    std::vector<fins::server::ScheduledInstruction> scheduled;
+    for (const auto& e : s.schedule)
+        scheduled.push_back(e.scheduled);
+    fins::server::InstructionSchedule schedule(io.get_executor(), (*server)->instructions(),
+                                               std::move(scheduled));
+    schedule.start();
     std::unique_ptr<fins::server::ControlServer> control;
     if (s.control_socket) {
-        auto started = fins::server::ControlServer::start(io, plc, *s.control_socket);
+        auto started = fins::server::ControlServer::start(io, plc, *s.control_socket,
+                                                          &(*server)->instructions(), &schedule);
         if (!started)
             return fail(3, "control channel " + s.control_socket->string() + ": " +
                                started.error().message());
@@ -349,6 +360,7 @@ int serve(const Settings& s) {
 
     signals.async_wait([&](std::error_code, int signal) {
         spdlog::info("finsd: signal {}, shutting down", signal);
+        schedule.stop();
         (*server)->stop();
         if (control) control->stop();
         serial.stop();

@@ -1,0 +1,124 @@
+// Send/Rcv rate between two finsd nodes (W596 3 network instructions).
+//
+//   build/bin/fins_instructions_rate [--kind send|recv] [--in-flight 1..32]
+//                                    [--words 10] [--seconds 3]
+//
+// Node 1 and node 5 are two Servers on 127.0.0.1, each on its own io_context thread
+// (as two finsd processes are): node 1 keeps `in-flight` instructions running against
+// node 5 and counts completions. Prints instructions per second.
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <functional>
+#include <memory>
+#include <thread>
+
+#include <CLI/CLI.hpp>
+#include <asio/executor_work_guard.hpp>
+#include <asio/io_context.hpp>
+#include <asio/post.hpp>
+
+#include "plc/plc.hpp"
+#include "server/network_instructions.hpp"
+#include "server/server.hpp"
+
+namespace {
+
+using namespace fins;
+using Clock = std::chrono::steady_clock;
+
+struct Runner {
+    server::NetworkInstructions& engine;
+    server::InstructionRequest request;
+    Clock::time_point end;
+    std::uint64_t done = 0;
+    std::uint64_t errors = 0;
+    unsigned running = 0;
+    std::function<void()> finished;  // the last instruction ended after `end`
+
+    void launch() {
+        ++running;
+        engine.start(request, [this](const server::InstructionResult& r) {
+            --running;
+            ++(r.done() ? done : errors);
+            if (Clock::now() < end)
+                launch();
+            else if (running == 0)
+                finished();
+        });
+    }
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"Send/Rcv rate between two finsd nodes"};
+    std::string kind = "send";
+    unsigned in_flight = 1;
+    unsigned words = 10;
+    double seconds = 3;
+    app.add_option("--kind", kind, "send or recv")->check(CLI::IsMember({"send", "recv"}));
+    app.add_option("--in-flight", in_flight, "Instructions at once (1-32)")
+        ->check(CLI::Range(1, 32));
+    app.add_option("--words", words, "Words per instruction")->check(CLI::Range(1, 990));
+    app.add_option("--seconds", seconds, "Duration")->check(CLI::Range(0.5, 60.0));
+    CLI11_PARSE(app, argc, argv);
+
+    asio::io_context io5{1};
+    plc::Plc plc5;
+    server::ServerOptions o5;
+    o5.port = 0;
+    o5.node = 5;
+    o5.tcp = false;
+    auto node5 = server::Server::start(io5, plc5, o5);
+    if (!node5) {
+        std::fprintf(stderr, "node 5: %s\n", node5.error().message().c_str());
+        return 1;
+    }
+    auto guard5 = asio::make_work_guard(io5);
+    std::thread t5([&] { io5.run(); });
+
+    asio::io_context io1{1};
+    plc::Plc plc1;
+    server::ServerOptions o1;
+    o1.port = 0;
+    o1.node = 1;
+    o1.tcp = false;
+    o1.remotes.push_back({0, 5, "127.0.0.1", (*node5)->udp_port()});
+    auto node1 = server::Server::start(io1, plc1, o1);
+    if (!node1) {
+        std::fprintf(stderr, "node 1: %s\n", node1.error().message().c_str());
+        return 1;
+    }
+    server::InstructionRequest r;
+    r.kind = kind == "send" ? server::InstructionKind::send : server::InstructionKind::recv;
+    r.destination = {0, 5, 0};
+    r.local = *parse_address("D1000");
+    r.remote = *parse_address("D2000");
+    r.count = static_cast<std::uint16_t>(words);
+    r.options.timeout = 10;
+    r.options.retries = 0;
+    const auto start = Clock::now();
+    Runner runner{
+        (*node1)->instructions(),
+        r,
+        start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds)),
+        0,
+        0,
+        0,
+        [&] { (*node1)->stop(); }};
+    asio::post(io1, [&] {
+        for (unsigned i = 0; i < in_flight; ++i)
+            runner.launch();
+    });
+    io1.run();  // ends when the last instruction completed after the deadline
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    guard5.reset();
+    asio::post(io5, [&] { (*node5)->stop(); });
+    t5.join();
+    std::printf("%s %u words, %u in flight: %.0f instructions/s (%llu done, %llu errors, %.2f s)\n",
+                kind.c_str(), words, in_flight, static_cast<double>(runner.done) / elapsed,
+                static_cast<unsigned long long>(runner.done),
+                static_cast<unsigned long long>(runner.errors), elapsed);
+    return runner.errors == 0 ? 0 : 1;
+}

@@ -1,0 +1,175 @@
+// PLC-initiated messages (W596 section 3): the node runs Send (write words to a remote
+// node: 01 02), Rcv (read words from a remote node: 01 01) and SendCmd (any command),
+// as a CPU Unit's network instructions do, from its own port and FINS address.
+//
+// One engine per node, owned by whatever owns the node's sessions (server.cpp). It has
+// no socket of its own: frames leave through an InstructionTransport (the node's UDP
+// socket, port 9600 as configured; a fake in unit tests) and responses come back
+// through on_response(), which the node's UDP session calls for every frame whose ICF
+// response bit is set (udp_session.cpp) instead of handing it to the dispatcher.
+//
+// W596 3 parameters and limits:
+//   destination network 0-127, node 0-254 (255 = broadcast: Send/SendCmd only, no
+//   response), unit 00-FF; words 0-990 (0: Done without sending); timeout in 0.1 s
+//   units, 0 = 2.0 s; retries 0-15; no-response mode (ICF bit 0; Rcv refuses it);
+//   at most 32 instructions at once.
+// Completion (W596 3 "Error, ErrorID, ErrorIDEx"): ErrorID 0000 Done; 0400 a parameter
+// is out of range (nothing is sent); 0800 communications: ErrorIDEx holds the FINS end
+// code (W596: "the end code for the communication command"): the response's end code
+// when it is not normal, 0205 response timeout after the last retry, 0104 when 32
+// instructions are already running (the 33rd), 0501 no IP address for that network or
+// node, 0101 the node has no FINS/UDP port, 0103 the frame could not be sent. README "PLC-initiated
+// messages" lists them.
+//
+// CS/CJ profiles also show the instruction ports in the Auxiliary Area as their CPU
+// Units do: A202 bits 0-7 Communications Port Enabled Flags (ON = port free), A203-A210
+// Communications Port Completion Codes, A219 bits 0-7 Communications Port Error Flags.
+// An instruction takes the lowest free port (0-31); ports 0-7 have flags.
+#pragma once
+
+#include <array>
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <asio/any_io_executor.hpp>
+#include <asio/steady_timer.hpp>
+
+#include "fins/address.hpp"
+#include "fins/frame.hpp"
+
+namespace fins::plc {
+class Plc;
+class IoMemory;
+}  // namespace fins::plc
+
+namespace fins::server {
+
+inline constexpr std::size_t max_instructions = 32;  // W596 3: Send, Rcv, SendCmd at once
+// Words per Send/Rcv: W596 says "depends on the network type"; 990 is the CS/CJ
+// SEND(090)/RECV(098) limit over Ethernet, and fits one 01 02 / 01 01 frame.
+inline constexpr std::uint16_t max_instruction_words = 990;
+inline constexpr std::uint8_t max_instruction_retries = 15;
+// SendCmd: MRC SRC and up to 2,000 parameter bytes.
+inline constexpr std::size_t max_instruction_command = max_frame_size - header_size;
+inline constexpr std::uint16_t default_instruction_timeout = 20;  // 0.1 s units (W596)
+
+// ErrorID values.
+inline constexpr std::uint16_t instruction_done = 0x0000;
+inline constexpr std::uint16_t instruction_parameter_error = 0x0400;
+inline constexpr std::uint16_t instruction_communications_error = 0x0800;
+
+enum class InstructionKind : std::uint8_t { send, recv, sendcmd };
+
+struct InstructionOptions {
+    bool no_response = false;   // Option.isNonResp
+    std::uint16_t timeout = 0;  // Option.TimeOut, 0.1 s; 0 = 2.0 s
+    unsigned retries = 0;       // Option.Retry, 0-15
+};
+
+struct InstructionRequest {
+    InstructionKind kind = InstructionKind::send;
+    NodeAddress destination;
+    Address local;   // Send: the words sent; Rcv: where the answer is stored
+    Address remote;  // Send: DstArea/DstCh; Rcv: SrcArea/SrcCh
+    std::uint16_t count = 0;
+    std::vector<std::uint8_t> command;  // SendCmd: MRC SRC parameters
+    InstructionOptions options;
+};
+
+struct InstructionResult {
+    std::uint16_t error_id = instruction_done;
+    std::uint16_t error_id_ex = 0;          // the FINS end code when error_id is 0800
+    std::optional<std::uint16_t> end_code;  // the response's end code word, when one came
+    int port = -1;                          // the port used; -1: none (parameter error ...)
+    unsigned transmissions = 0;             // frames sent (1 + retries used)
+    std::vector<std::uint8_t> response;     // SendCmd: MRC SRC MRES SRES data
+    std::vector<std::uint16_t> words;       // Rcv: the words stored
+    std::string detail;                     // why, in words
+    [[nodiscard]] bool done() const noexcept { return error_id == instruction_done; }
+};
+
+using InstructionCallback = std::function<void(const InstructionResult&)>;
+
+// Where an instruction's frames go.
+class InstructionTransport {
+  public:
+    // ok; no_route: no IP address for that network/node; no_port: the node has no
+    // FINS/UDP port; failed: the kernel refused the frame.
+    enum class Sent : std::uint8_t { ok, no_route, no_port, failed };
+    virtual ~InstructionTransport() = default;
+    virtual Sent send_frame(const NodeAddress& destination, Bytes frame) = 0;
+};
+
+// The request's parameters against W596's ranges and the local model: empty when it
+// may run, else why not (ErrorID 0400). Used by start() and by the config loader.
+std::optional<std::string> check_instruction(const InstructionRequest& request,
+                                             const plc::IoMemory& memory);
+// Milliseconds of Option.TimeOut (0 = 2.0 s).
+std::chrono::milliseconds instruction_timeout(std::uint16_t timeout) noexcept;
+// "send" / "recv" / "sendcmd" (also "rcv", "cmnd").
+std::optional<InstructionKind> parse_instruction_kind(std::string_view text) noexcept;
+const char* instruction_kind_name(InstructionKind kind) noexcept;
+// "NET.NODE.UNIT" (unit decimal or hex with 0x) or "NET.NODE" (unit 0).
+std::optional<NodeAddress> parse_destination(std::string_view text) noexcept;
+
+class NetworkInstructions {
+  public:
+    struct Counters {
+        std::uint64_t started = 0;
+        std::uint64_t done = 0;
+        std::uint64_t errors = 0;
+        std::uint64_t timeouts = 0;         // instructions that ended with 0205
+        std::uint64_t retransmissions = 0;  // frames sent again after a timeout
+        std::uint64_t unmatched = 0;        // responses no instruction waited for
+    };
+
+    NetworkInstructions(asio::any_io_executor executor, plc::Plc& plc, NodeAddress self,
+                        InstructionTransport& transport);
+    ~NetworkInstructions();
+    NetworkInstructions(const NetworkInstructions&) = delete;
+    NetworkInstructions& operator=(const NetworkInstructions&) = delete;
+
+    // Runs `request`; `done` is called once, later, on the executor (never inside start).
+    void start(InstructionRequest request, InstructionCallback done);
+    // A frame with the ICF response bit set that arrived at the node. True when it was
+    // the answer an instruction waited for; false leaves it to the caller (dropped).
+    bool on_response(Bytes frame);
+    // Ends every running instruction without calling back (shutdown).
+    void stop();
+
+    [[nodiscard]] std::size_t in_flight() const noexcept { return in_flight_; }
+    // _Port_isAvailable: a port is free.
+    [[nodiscard]] bool available() const noexcept { return in_flight_ < max_instructions; }
+    [[nodiscard]] const Counters& counters() const noexcept { return counters_; }
+    [[nodiscard]] const NodeAddress& self() const noexcept { return self_; }
+
+  private:
+    struct Port;
+    void transmit(std::size_t port);
+    void arm(std::size_t port);
+    void on_timeout(std::size_t port, std::uint64_t generation);
+    void finish(std::size_t port, InstructionResult result);
+    void complete_later(InstructionCallback done, InstructionResult result);
+    void show_port(std::size_t port, bool busy, std::optional<std::uint16_t> completion);
+    std::uint8_t next_sid() noexcept;
+
+    asio::any_io_executor executor_;
+    plc::Plc& plc_;
+    NodeAddress self_;
+    InstructionTransport& transport_;
+    std::vector<std::unique_ptr<Port>> ports_;
+    std::size_t in_flight_ = 0;
+    std::uint8_t sid_ = 0;
+    bool flags_ = false;  // the profile shows ports in A202/A203-A210/A219
+    Counters counters_;
+    std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+};
+
+}  // namespace fins::server
