@@ -1,0 +1,60 @@
+#include "transport/serial_port.hpp"
+
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
+#include <termios.h>
+
+#include <cerrno>
+
+namespace fins::transport {
+
+std::error_code SerialPort::open(const SerialSettings& line) {
+    close();
+    std::error_code ec;
+    port_.open(line.device, ec);
+    if (ec) return ec;
+    using asio::serial_port_base;
+    const auto parity = line.parity == SerialSettings::Parity::none ? serial_port_base::parity::none
+                        : line.parity == SerialSettings::Parity::even
+                            ? serial_port_base::parity::even
+                            : serial_port_base::parity::odd;
+    const auto stop =
+        line.stop_bits == 2 ? serial_port_base::stop_bits::two : serial_port_base::stop_bits::one;
+    port_.set_option(serial_port_base::baud_rate(line.baud), ec);
+    if (!ec) {
+        port_.set_option(serial_port_base::character_size(line.data_bits), ec);
+        // Linux ptys (socat) refuse 7 data bits (EINVAL); they have no line, and Host Link
+        // characters are 7-bit ASCII, so the 8-bit bytes of a pty carry them unchanged.
+        if (ec.value() == EINVAL && is_pseudo_terminal()) ec.clear();
+    }
+    if (!ec) port_.set_option(serial_port_base::parity(parity), ec);
+    if (!ec) port_.set_option(serial_port_base::stop_bits(stop), ec);
+    if (!ec)
+        port_.set_option(serial_port_base::flow_control(serial_port_base::flow_control::none), ec);
+    if (ec) {
+        close();
+        return ec;
+    }
+    flush();
+    return {};
+}
+
+bool SerialPort::is_pseudo_terminal() noexcept {
+    struct stat st {};
+    if (!port_.is_open() || ::fstat(port_.native_handle(), &st) != 0) return false;
+    // Unix98 pty slaves: character devices with majors 136-143 (Documentation/admin-guide/
+    // devices.txt).
+    const auto major_number = major(st.st_rdev);
+    return S_ISCHR(st.st_mode) && major_number >= 136 && major_number <= 143;
+}
+
+void SerialPort::flush() noexcept {
+    if (port_.is_open()) ::tcflush(port_.native_handle(), TCIOFLUSH);
+}
+
+void SerialPort::close() noexcept {
+    std::error_code ignored;
+    port_.close(ignored);
+}
+
+}  // namespace fins::transport
