@@ -189,6 +189,10 @@ NodeAddress Server::address() const noexcept {
     return impl_->dispatcher.self();
 }
 
+void Server::attach_serial_ports(SerialPorts* ports) noexcept {
+    impl_->dispatcher.attach_serial_ports(ports);
+}
+
 std::size_t Server::tcp_connections() const noexcept {
     return impl_->nodes.in_use();
 }

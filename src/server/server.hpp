@@ -30,6 +30,8 @@ class Plc;
 
 namespace fins::server {
 
+class SerialPorts;
+
 struct ServerOptions {
     std::string bind_address = "127.0.0.1";
     std::uint16_t port = 9600;  // 0 picks a free port (tests)
@@ -64,6 +66,9 @@ class Server {
     [[nodiscard]] std::uint16_t tcp_port() const noexcept;
     [[nodiscard]] NodeAddress address() const noexcept;
     [[nodiscard]] std::size_t tcp_connections() const noexcept;
+    // Serves these Serial Gateway ports (W342 5-3-46 .. 5-3-48) from now on; they must
+    // outlive the server's use of them.
+    void attach_serial_ports(SerialPorts* ports) noexcept;
 
     // Closes the sockets and every TCP session; pending handlers finish on `io`.
     void stop();

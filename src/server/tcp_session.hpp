@@ -23,24 +23,27 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <deque>
 #include <memory>
+#include <vector>
 
 #include <asio/ip/tcp.hpp>
 #include <asio/steady_timer.hpp>
 
 #include "fins/error.hpp"
 #include "fins/tcp.hpp"
+#include "server/dispatcher.hpp"
 #include "server/tcp_limits.hpp"
 #include "server/tcp_node_table.hpp"
 
 namespace fins::server {
 
-class Dispatcher;
-
 // Turns TCP keep-alive on `socket` on with `idle` (see TcpLimits::keepalive) or off (0).
 std::error_code set_keepalive(asio::ip::tcp::socket& socket, std::chrono::seconds idle) noexcept;
 
-class TcpSession : public std::enable_shared_from_this<TcpSession> {
+// Deferred answers (a Serial Gateway port's) wait in a small queue of their own and are
+// written whole between the in-order responses, never interleaved with one.
+class TcpSession : public std::enable_shared_from_this<TcpSession>, private ReplyPath {
   public:
     TcpSession(asio::ip::tcp::socket socket, Dispatcher& dispatcher, TcpNodeTable& nodes,
                const TcpLimits& limits);
@@ -78,6 +81,9 @@ class TcpSession : public std::enable_shared_from_this<TcpSession> {
     void send_confirmation();
     void close_after_notice();
     void drain();
+    Completion defer() override;
+    void queue_late(Bytes frame);
+    void write_late();
 
     void set_deadline(Deadline kind, Clock::duration after);
     void arm_timer(Clock::time_point at);
@@ -112,6 +118,10 @@ class TcpSession : public std::enable_shared_from_this<TcpSession> {
     std::array<std::uint8_t, tcp_max_packet> out_{};
     std::size_t out_size_pending_ = 0;  // bytes of out_ to send after handle_packet
     std::array<std::uint8_t, tcp_header_size> confirmation_{};
+    // Deferred answers with their envelope; bounded (every port's queue fits).
+    static constexpr std::size_t max_late = 64;
+    std::deque<std::vector<std::uint8_t>> late_;
+    bool late_writing_ = false;
 };
 
 }  // namespace fins::server
