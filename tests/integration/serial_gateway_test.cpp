@@ -20,8 +20,8 @@
 #include <asio/io_context.hpp>
 #include <asio/post.hpp>
 
-#include "fins/frame.hpp"
 #include "codec/test_support.hpp"
+#include "fins/frame.hpp"
 #include "integration/process.hpp"
 #include "integration/pty_pair.hpp"
 #include "integration/raw_socket.hpp"
@@ -218,6 +218,34 @@ TEST(SerialGateway, W342_5_3_47_ModbusRtuAgainstLibmodbus) {
     r = gw.call(scu1_port2, modbus_rtu, hex("01 03 01 00 00 01"));
     EXPECT_EQ(end_code_of(r), 0x0000);
     EXPECT_EQ(std::vector<std::uint8_t>(r.begin() + 14, r.end()), hex("01 83 02"));
+}
+
+TEST(SerialGateway, W342_5_3_48_ModbusAsciiAgainstPymodbus) {
+    if (!std::filesystem::exists("/usr/bin/python3"))
+        GTEST_SKIP() << "Debian's python3 (with python3-pymodbus) is not installed";
+    PtyPair line;
+    ASSERT_TRUE(line.ok());
+    Child slave({"/usr/bin/python3",
+                 std::string(FINS_SOURCE_DIR) + "/tests/tools/modbus_ascii_slave.py", line.b(),
+                 "2"});
+    const auto ready = slave.read_line(std::chrono::seconds(20));
+    if (ready != "ready")
+        GTEST_SKIP() << "pymodbus slave did not start (python3-pymodbus missing?)";
+    Gateway gw({port_config("scu1.2", scu1_port2, line.a())});
+
+    // Read holding registers 4 and 5 of slave 2 (they hold 4 and 5); the answer's LRC is
+    // checked and stripped by the port.
+    auto r = gw.call(scu1_port2, CommandCode{0x28, 0x05}, ascii("020300040002"));
+    EXPECT_EQ(end_code_of(r), 0x0000);
+    EXPECT_EQ(text_of(r), "02030400040005");
+    r = gw.call(scu1_port2, CommandCode{0x28, 0x05}, ascii("020600071234"));
+    EXPECT_EQ(text_of(r), "020600071234");
+    r = gw.call(scu1_port2, CommandCode{0x28, 0x05}, ascii("020300070001"));
+    EXPECT_EQ(text_of(r), "0203021234");
+    // An exception from the slave (illegal data address) inside a normal answer.
+    r = gw.call(scu1_port2, CommandCode{0x28, 0x05}, ascii("020301000001"));
+    EXPECT_EQ(end_code_of(r), 0x0000);
+    EXPECT_EQ(text_of(r), "028302");
 }
 
 TEST(SerialGateway, W336_6_6_2_NoAnswerWithinTheTimeoutIs0205) {
