@@ -67,6 +67,8 @@ class Loader {
                 r = section(key, node, k, &Loader::inject);
             else if (k == "files")
                 r = section(key, node, k, &Loader::files);
+            else if (k == "serial")
+                r = load_serial_table(node, source_, s_.serial);
             else
                 r = fail(key, k, "unknown key");
             if (!r) return r;

@@ -17,6 +17,7 @@
 
 #include <tl/expected.hpp>
 
+#include "cli/finsd/config_serial.hpp"
 #include "fins/address.hpp"
 #include "plc/injections.hpp"
 #include "plc/io_memory.hpp"
@@ -70,8 +71,9 @@ struct Settings {
     std::optional<std::uint32_t> card_kbytes;
     std::optional<std::uint8_t> em_file_bank;
 
-    std::vector<MemoryInit> memory;  // [memory]
-    plc::Injections inject;          // [inject]
+    std::vector<MemoryInit> memory;        // [memory]
+    plc::Injections inject;                // [inject]
+    std::vector<SerialPortConfig> serial;  // [serial], --serial (config_serial.hpp)
 };
 
 // Command-line values; a set optional overrides the file.
@@ -89,6 +91,7 @@ struct Overrides {
     std::optional<bool> um_read_protection, dip_write_protection;
     std::optional<std::string> durability;
     bool reset_state = false;
+    std::vector<std::string> serial;  // --serial NAME=DEVICE[,...], in order
 };
 
 using Error = std::string;

@@ -79,6 +79,7 @@ std::optional<NodeAddress> parse_node(std::string_view text) noexcept {
 }
 
 Expected<void> apply_overrides(const Overrides& o, Settings& s) {
+    if (auto r = apply_serial_flags(o.serial, s.serial); !r) return r;
     if (o.profile) s.profile = *o.profile;
     if (o.mode) {
         const auto m = parse_mode(*o.mode);
@@ -146,6 +147,7 @@ Expected<void> validate(const Settings& s) {
     if (plc::find_profile(s.profile) == nullptr)
         return error(fmt::format("profile: unknown '{}' (known: {})", s.profile, known_profiles()));
     if (!s.udp && !s.tcp) return error("network: udp and tcp are both off, nothing to serve");
+    if (auto r = validate_serial(s.serial); !r) return r;
     static constexpr std::string_view levels[] = {"trace", "debug", "info", "warn", "error", "off"};
     if (std::find(std::begin(levels), std::end(levels), s.log_level) == std::end(levels))
         return error(fmt::format("log_level: '{}' is not trace, debug, info, warn, error or off",
