@@ -21,20 +21,22 @@
 #include <string>
 #include <string_view>
 
+#include <fmt/format.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
-#include <fmt/format.h>
 #include <CLI/CLI.hpp>
 #include <asio/io_context.hpp>
 #include <asio/signal_set.hpp>
 
 #include "cli/finsd/config.hpp"
 #include "cli/finsd/ctl.hpp"
+#include "cli/finsd/serial_gateway_setup.hpp"
 #include "plc/plc.hpp"
 #include "plc/profile.hpp"
 #include "plc/storage.hpp"
 #include "plc/storage_format.hpp"
 #include "server/control.hpp"
+#include "server/serial_ports.hpp"
 #include "server/server.hpp"
 
 namespace {
@@ -148,7 +150,7 @@ int configure(int argc, char** argv, Settings& settings) {
         app.add_option("--network-write-protection", protection,
                        "off, all, listed or all-except-listed (W342 5-1-2 note 5)");
     auto* o_nodes = app.add_option("--protect-node", o.protect_nodes,
-                   "A listed node, network.node (repeatable; node * = any)");
+                                   "A listed node, network.node (repeatable; node * = any)");
     auto* o_um = app.add_flag("--um-read-protection", um_read, "UM read protection set");
     auto* o_dip = app.add_flag("--dip-write-protection", dip_write,
                                "DIP switch pin 1 ON (UM write-protected)");
@@ -201,16 +203,17 @@ int configure(int argc, char** argv, Settings& settings) {
     // let someone believe those nodes are refused (or, under "all", the only ones).
     const auto write_mode = settings.network_write_protection.mode;
     using fins::plc::NetworkWriteProtection;
-    if (o_nodes->count() > 0 && (write_mode == NetworkWriteProtection::off ||
-                                 write_mode == NetworkWriteProtection::all))
+    if (o_nodes->count() > 0 &&
+        (write_mode == NetworkWriteProtection::off || write_mode == NetworkWriteProtection::all))
         return fail(2, fmt::format("--protect-node has no effect with network write protection "
                                    "'{}': add --network-write-protection listed (refuse those "
                                    "nodes) or all-except-listed (accept only those)",
                                    write_mode == NetworkWriteProtection::off ? "off" : "all"));
     if (!settings.network_write_protection.nodes.empty() &&
         write_mode == NetworkWriteProtection::off)
-        spdlog::warn("finsd: protection.nodes is set but protection.network_write is \"off\": "
-                     "no node is refused");
+        spdlog::warn(
+            "finsd: protection.nodes is set but protection.network_write is \"off\": "
+            "no node is refused");
     return -1;
 }
 
@@ -266,6 +269,8 @@ int serve(const Settings& s) {
     std::signal(SIGXFSZ, SIG_IGN);
     fins::plc::Profile profile = *fins::plc::find_profile(s.profile);
     if (s.dip_write_protection) profile.dip_switch |= fins::plc::dip_pin1;
+    if (auto r = fins::cli::finsd::mount_serial_units(s.serial, profile); !r)
+        return fail(2, r.error());
 
     std::unique_ptr<fins::plc::Plc> plc_owner;
     if (const int rc = open_plc(s, profile, plc_owner); rc >= 0) return rc;
@@ -320,6 +325,11 @@ int serve(const Settings& s) {
     if (!server)
         return fail(3, "cannot listen on " + s.bind + " port " + std::to_string(s.port) + ": " +
                            server.error().message());
+    // Serial Gateway ports (scuN.P / board.P in mode gateway): serial_gateway_setup.hpp.
+    fins::server::SerialPorts gateway_ports;
+    if (auto r = fins::cli::finsd::open_gateway_ports(io, s.serial, gateway_ports); !r)
+        return fail(3, "serial gateway port " + r.error());
+    (*server)->attach_serial_ports(&gateway_ports);
     std::unique_ptr<fins::server::ControlServer> control;
     if (s.control_socket) {
         auto started = fins::server::ControlServer::start(io, plc, *s.control_socket);
@@ -343,6 +353,7 @@ int serve(const Settings& s) {
     signals.async_wait([&](std::error_code, int signal) {
         spdlog::info("finsd: signal {}, shutting down", signal);
         (*server)->stop();
+        gateway_ports.close_all();
         if (control) control->stop();
         plc.storage().flush();
         io.stop();
