@@ -83,6 +83,12 @@ std::size_t Dispatcher::handle(Bytes request, MutableBytes out, const RequestCon
         return w.overflowed() ? 0 : w.size();
     };
 
+    // Host Link FINS conversion (W342 5-1-1): a frame for a PLC behind a gateway port.
+    if (serial_ != nullptr && header.destination.network != local_network &&
+        header.destination.network != self_.network)
+        if (SerialGatewayPort* port = serial_->host_link_port(header.destination.network))
+            return handlers::relay_to_host_link(*port, request, header, self_, out, context);
+
     if (const auto code = check_destination(header.destination, self_, plc_.profile(), serial_);
         code != EndCode::normal_completion)
         return answer(code);

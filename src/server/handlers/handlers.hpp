@@ -75,6 +75,13 @@ std::span<const HandlerEntry> forced_handlers() noexcept;          // 23 xx  for
 std::span<const HandlerEntry> file_memory_handlers() noexcept;     // 22 xx  file_memory.cpp
 std::span<const HandlerEntry> serial_gateway_handlers() noexcept;  // 28 xx  serial_gateway.cpp
 
+// Host Link FINS conversion (W342 5-1-1, host_link_relay.cpp): sends the whole request
+// frame on `port` as Host Link FINS and answers later; returns the length of an answer
+// written to `out` now (an error end code), or 0 (deferred, or no answer wanted).
+std::size_t relay_to_host_link(SerialGatewayPort& port, Bytes request, const Header& header,
+                               const NodeAddress& self, MutableBytes out,
+                               const RequestContext& context);
+
 // The execution conditions of W342 5-1-2, checked in this order: operating mode
 // (RUN 2206, MONITOR 2205, PROGRAM 2203), network write protection (2102, only for
 // requests that came over a network link), access right held by another node (3001),
