@@ -69,13 +69,23 @@
 #include "fins/commands/memory_area.hpp"
 #include "fins/error.hpp"
 #include "fins/frame.hpp"
+#include "fins/serial.hpp"
 
 namespace fins {
 
 struct ClientOptions {
     std::string host = "127.0.0.1";
     std::uint16_t port = 9600;
-    enum class Protocol { udp, tcp } protocol = Protocol::udp;
+    enum class Protocol { udp, tcp, serial } protocol = Protocol::udp;
+    // Protocol::serial: FINS over Host Link (README "Host Link (serial)") on this device,
+    // to the PLC with this Host Link unit number (0-31). Half duplex: one request on the
+    // line at a time, the others wait (their timeout starts when they are sent). The
+    // direct form is used while destination and source network and node are 0 (the
+    // directly connected CPU Unit), else the network form. An answer with a Host Link end
+    // code fails the request with a HostLinkEndCode, one with a bad FCS with
+    // HostLinkError::bad_fcs (fins/host_link.hpp). host/port are not used.
+    SerialSettings serial;
+    std::uint8_t host_link_unit = 0;
     NodeAddress destination;  // node 0: derive (see above)
     NodeAddress source;       // node 0: derive (see above); TCP: sent in the handshake
     // Per attempt; also bounds connecting and the TCP handshake. W596 p. 3-16: 0 means 2.0 s.
@@ -87,7 +97,7 @@ struct ClientOptions {
     std::chrono::milliseconds sid_quarantine{0};
 };
 
-// "host:port" of the options ("[::1]:9600" for an IPv6 literal).
+// "host:port" of the options ("[::1]:9600" for an IPv6 literal); serial: "DEVICE unit N".
 std::string endpoint_name(const ClientOptions& options);
 // "<endpoint>: <message>", e.g. "127.0.0.1:9600: connection refused".
 std::string describe_error(const ClientOptions& options, std::error_code ec);
@@ -194,6 +204,11 @@ class Client {
     // The addresses put in request headers (after derivation).
     [[nodiscard]] NodeAddress destination() const noexcept;
     [[nodiscard]] NodeAddress source() const noexcept;
+    // The most parameter bytes (after MRC SRC) a request may carry and response data
+    // bytes an answer may carry: 2,000 / 1,998 over Ethernet (2,012-byte frames), 540 /
+    // 538 over Host Link (W342 3-5). The helpers split by them.
+    [[nodiscard]] std::size_t max_parameters() const noexcept;
+    [[nodiscard]] std::size_t max_response_data() const noexcept;
     // describe_error(options(), ec).
     [[nodiscard]] std::string describe(std::error_code ec) const;
     // Closes the connection; requests in flight fail with ClientError::canceled. The next

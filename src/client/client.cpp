@@ -19,7 +19,8 @@ Client::~Client() {
 }
 
 Result<std::unique_ptr<Client>> Client::connect(ClientOptions options) {
-    if (options.retries > max_retries)
+    if (options.retries > max_retries || (options.protocol == ClientOptions::Protocol::serial &&
+                                          options.host_link_unit > host_link_max_unit))
         return Unexpected(make_error_code(ClientError::invalid_argument));
     if (options.timeout.count() <= 0) options.timeout = default_timeout;
     std::unique_ptr<Client> client(new Client(std::make_unique<Impl>(std::move(options))));
@@ -169,6 +170,8 @@ ClientStats Client::stats() const noexcept {
 }
 
 std::string endpoint_name(const ClientOptions& options) {
+    if (options.protocol == ClientOptions::Protocol::serial)
+        return options.serial.device + " unit " + std::to_string(options.host_link_unit);
     const bool v6_literal = options.host.find(':') != std::string::npos;
     return (v6_literal ? "[" + options.host + "]" : options.host) + ":" +
            std::to_string(options.port);
@@ -178,14 +181,25 @@ std::string describe_error(const ClientOptions& options, std::error_code ec) {
     auto message = ec.message();
     // strerror() capitalises ("Connection refused"); the library's own texts do not, and
     // an acronym ("FINS/TCP ...") is left alone.
-    if (message.size() > 1 && message[0] >= 'A' && message[0] <= 'Z' &&
-        message[1] >= 'a' && message[1] <= 'z')
+    if (message.size() > 1 && message[0] >= 'A' && message[0] <= 'Z' && message[1] >= 'a' &&
+        message[1] <= 'z')
         message[0] = static_cast<char>(message[0] - 'A' + 'a');
     return endpoint_name(options) + ": " + message;
 }
 
 std::string Client::describe(std::error_code ec) const {
     return describe_error(impl_->options, ec);
+}
+
+std::size_t Client::max_parameters() const noexcept {
+    return impl_->options.protocol == ClientOptions::Protocol::serial
+               ? host_link_max_parameter_bytes
+               : max_parameter_size;
+}
+std::size_t Client::max_response_data() const noexcept {
+    return impl_->options.protocol == ClientOptions::Protocol::serial
+               ? host_link_max_response_data_bytes
+               : max_response_data_size;
 }
 
 std::size_t Client::in_flight() const noexcept {

@@ -11,6 +11,8 @@
 
 #include "client/request_tracker.hpp"
 #include "fins/client.hpp"
+#include "fins/host_link.hpp"
+#include "transport/host_link_transport.hpp"
 #include "transport/tcp_transport.hpp"
 #include "transport/udp_transport.hpp"
 
@@ -33,7 +35,12 @@ struct Client::Impl final : FrameSink {
         t.port = options.port;
         t.open_timeout = options.timeout;
         t.requested_node = options.source.node;
-        if (options.protocol == ClientOptions::Protocol::tcp)
+        if (options.protocol == ClientOptions::Protocol::serial) {
+            transport = std::make_unique<transport::HostLinkTransport>(
+                io, transport::HostLinkOptions{options.serial, options.host_link_unit, 0});
+            tracker.set_window(1);  // half duplex
+            tracker.set_max_frame(host_link_max_fins_command);
+        } else if (options.protocol == ClientOptions::Protocol::tcp)
             transport = std::make_unique<transport::TcpTransport>(io, std::move(t));
         else
             transport = std::make_unique<transport::UdpTransport>(io, std::move(t));
@@ -48,8 +55,12 @@ struct Client::Impl final : FrameSink {
             rearm();
         });
         // The transport stays open (e.g. UDP port unreachable): fail what waits.
+        // Host Link: an error answer ends only the request on the line.
         transport->set_error_handler([this](std::error_code reason) {
-            tracker.cancel_all(reason, now());
+            if (options.protocol == ClientOptions::Protocol::serial)
+                tracker.fail_sent(reason, now());
+            else
+                tracker.cancel_all(reason, now());
             rearm();
         });
     }
@@ -96,6 +107,7 @@ struct Client::Impl final : FrameSink {
 
     NodeAddress derive_source(const transport::LinkInfo& info) const {
         NodeAddress s = options.source;
+        if (options.protocol == ClientOptions::Protocol::serial) return s;  // as given
         if (options.protocol == ClientOptions::Protocol::tcp) {
             // The server's answer is authoritative (it may have allocated the node).
             s.node = info.local_node;

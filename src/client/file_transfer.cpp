@@ -15,8 +15,14 @@ namespace {
 // path length. The frame holds 2,012 bytes (header 10, command code 2).
 constexpr std::size_t write_fixed = 2 + 2 + 12 + 4 + 2 + 2;
 
-std::size_t write_chunk(const std::string& directory) noexcept {
-    return max_parameter_size - write_fixed - directory.size();
+std::size_t write_chunk(const Client& client, const std::string& directory) noexcept {
+    return client.max_parameters() - write_fixed - directory.size();
+}
+// 22 02 answer bytes before the data: file capacity, position, length (Ethernet: 1,988).
+constexpr std::size_t read_fixed = 4 + 4 + 2;
+std::uint16_t read_chunk(const Client& client) noexcept {
+    return static_cast<std::uint16_t>(
+        std::min<std::size_t>(max_file_read_bytes, client.max_response_data() - read_fixed));
 }
 
 // Keeps up to `window` requests in flight: `issue(i)` starts chunk i and must call
@@ -49,7 +55,8 @@ Result<DirectoryListing> list_directory(Client& client, std::uint16_t disk,
 Result<std::vector<std::uint8_t>> get_file(Client& client, std::uint16_t disk,
                                            const std::string& directory, const FileName& file,
                                            const FileProgress& progress, std::size_t window) {
-    const auto first = client.send(SingleFileRead{disk, file, 0, max_file_read_bytes, directory});
+    const std::uint16_t chunk = read_chunk(client);
+    const auto first = client.send(SingleFileRead{disk, file, 0, chunk, directory});
     if (!first) return Unexpected(first.error());
     const std::uint64_t size = first->file_size;
     auto data = std::make_shared<std::vector<std::uint8_t>>(static_cast<std::size_t>(size));
@@ -62,14 +69,13 @@ Result<std::vector<std::uint8_t>> get_file(Client& client, std::uint16_t disk,
     }
     auto p = std::make_shared<Pipeline>();
     p->next = 0;
-    p->count =
-        static_cast<std::size_t>((size - done + max_file_read_bytes - 1) / max_file_read_bytes);
+    p->count = static_cast<std::size_t>((size - done + chunk - 1) / chunk);
     const std::uint64_t base = done;
     std::function<void()> issue = [&]() {
         while (!p->error && p->in_flight < std::max<std::size_t>(window, 1) && p->next < p->count) {
-            const std::uint64_t offset = base + std::uint64_t{p->next} * max_file_read_bytes;
-            const auto length = static_cast<std::uint16_t>(
-                std::min<std::uint64_t>(max_file_read_bytes, size - offset));
+            const std::uint64_t offset = base + std::uint64_t{p->next} * chunk;
+            const auto length =
+                static_cast<std::uint16_t>(std::min<std::uint64_t>(chunk, size - offset));
             ++p->next;
             ++p->in_flight;
             client.async_send(
@@ -102,7 +108,7 @@ Result<std::vector<std::uint8_t>> get_file(Client& client, std::uint16_t disk,
 Result<void> put_file(Client& client, std::uint16_t disk, const std::string& directory,
                       const FileName& file, std::span<const std::uint8_t> data, bool replace,
                       const FileProgress& progress, std::size_t window) {
-    const std::size_t chunk = write_chunk(directory);
+    const std::size_t chunk = write_chunk(client, directory);
     const auto first_size = std::min(chunk, data.size());
     const auto mode = replace ? FileWriteMode::create_or_replace : FileWriteMode::create;
     if (auto r = client.send(SingleFileWrite{disk, static_cast<std::uint16_t>(mode), file, 0,

@@ -55,6 +55,21 @@ bool steps_by_bit(const MemoryAddress& a) {
     return segment != nullptr && segment->bit_addressed();
 }
 
+// Elements per request: W342 5-2-2 (999 read, 997 written, 167 for 01 04 over Ethernet),
+// or what the link's frame holds (Host Link: 269 read, 267 written, W342 5-2-2 SYSWAY).
+constexpr std::size_t write_fixed = 6;  // 01 02: area, address, count
+std::size_t read_limit(const Client& c) {
+    return std::min<std::size_t>(max_read_words, c.max_response_data() / 2);
+}
+std::size_t write_limit(const Client& c) {
+    return std::min<std::size_t>(max_write_words, (c.max_parameters() - write_fixed) / 2);
+}
+// 01 04: 4 request bytes per element; up to 5 answer bytes (area code + 4-byte value).
+std::size_t multiple_limit(const Client& c) {
+    return std::min(
+        {max_multiple_read_elements, c.max_parameters() / 4, c.max_response_data() / 5});
+}
+
 }  // namespace
 
 Result<std::vector<std::uint16_t>> Client::read_words(const Address& start, std::size_t count) {
@@ -65,8 +80,8 @@ Result<std::vector<std::uint16_t>> Client::read_words(const Address& start, std:
         return Unexpected(invalid());
     auto batch = std::make_shared<Batch>();
     auto words = std::make_shared<std::vector<std::uint16_t>>(count);
-    for (std::size_t offset = 0; offset < count; offset += max_read_words) {
-        const auto n = std::min<std::size_t>(max_read_words, count - offset);
+    for (std::size_t offset = 0; offset < count; offset += read_limit(*this)) {
+        const auto n = std::min<std::size_t>(read_limit(*this), count - offset);
         MemoryAreaRead command{advance(*mem, offset, false), static_cast<std::uint16_t>(n)};
         ++batch->remaining;
         async_send(command, [batch, words, offset](Result<MemoryAreaReadResponse> r) {
@@ -91,8 +106,8 @@ Result<void> Client::write_words(const Address& start, std::span<const std::uint
         return Unexpected(invalid());
     const auto bytes = words_to_bytes(words);
     auto batch = std::make_shared<Batch>();
-    for (std::size_t offset = 0; offset < words.size(); offset += max_write_words) {
-        const auto n = std::min<std::size_t>(max_write_words, words.size() - offset);
+    for (std::size_t offset = 0; offset < words.size(); offset += write_limit(*this)) {
+        const auto n = std::min<std::size_t>(write_limit(*this), words.size() - offset);
         MemoryAreaWrite command{advance(*mem, offset, false), static_cast<std::uint16_t>(n),
                                 Bytes{bytes}.subspan(offset * 2, n * 2)};
         ++batch->remaining;
@@ -115,8 +130,8 @@ Result<std::vector<bool>> Client::read_bits(const Address& start, std::size_t co
         return Unexpected(invalid());
     auto batch = std::make_shared<Batch>();
     auto bits = std::make_shared<std::vector<bool>>(count);
-    for (std::size_t offset = 0; offset < count; offset += max_read_words) {
-        const auto n = std::min<std::size_t>(max_read_words, count - offset);
+    for (std::size_t offset = 0; offset < count; offset += read_limit(*this)) {
+        const auto n = std::min<std::size_t>(read_limit(*this), count - offset);
         MemoryAreaRead command{advance(*mem, offset, bit_steps), static_cast<std::uint16_t>(n)};
         ++batch->remaining;
         async_send(command, [batch, bits, offset](Result<MemoryAreaReadResponse> r) {
@@ -143,8 +158,8 @@ Result<void> Client::write_bits(const Address& start, const std::vector<bool>& b
     for (std::size_t i = 0; i < bits.size(); ++i)
         bytes[i] = bits[i] ? 1 : 0;
     auto batch = std::make_shared<Batch>();
-    for (std::size_t offset = 0; offset < bits.size(); offset += max_write_words) {
-        const auto n = std::min<std::size_t>(max_write_words, bits.size() - offset);
+    for (std::size_t offset = 0; offset < bits.size(); offset += write_limit(*this)) {
+        const auto n = std::min<std::size_t>(write_limit(*this), bits.size() - offset);
         MemoryAreaWrite command{advance(*mem, offset, bit_steps), static_cast<std::uint16_t>(n),
                                 Bytes{bytes}.subspan(offset, n)};
         ++batch->remaining;
@@ -190,8 +205,8 @@ Result<std::vector<std::uint32_t>> Client::read_multiple(std::span<const Address
     }
     auto batch = std::make_shared<Batch>();
     auto values = std::make_shared<std::vector<std::uint32_t>>(items.size());
-    for (std::size_t offset = 0; offset < items.size(); offset += max_multiple_read_elements) {
-        const auto n = std::min(max_multiple_read_elements, items.size() - offset);
+    for (std::size_t offset = 0; offset < items.size(); offset += multiple_limit(*this)) {
+        const auto n = std::min(multiple_limit(*this), items.size() - offset);
         MultipleMemoryAreaRead command;
         command.items.assign(items.begin() + static_cast<std::ptrdiff_t>(offset),
                              items.begin() + static_cast<std::ptrdiff_t>(offset + n));

@@ -37,7 +37,7 @@ Result<void> RequestTracker::submit(CommandCode command, Bytes parameters,
                                     SteadyTime now) {
     if (timing.retries > max_retries)
         return Unexpected(make_error_code(ClientError::invalid_argument));
-    if (header_size + command_code_size + parameters.size() > max_frame_size)
+    if (header_size + command_code_size + parameters.size() > max_frame_)
         return Unexpected(make_error_code(ClientError::request_too_long));
     if (free_requests_.empty()) return Unexpected(make_error_code(ClientError::too_many_in_flight));
     const auto index = free_requests_.back();
@@ -63,7 +63,7 @@ Result<void> RequestTracker::submit(CommandCode command, Bytes parameters,
 }
 
 void RequestTracker::pump(SteadyTime now) {
-    while (link_up_ && !queue_.empty()) {
+    while (link_up_ && !queue_.empty() && in_flight_ - queue_.size() < window_) {
         auto sid = sids_.acquire(now);
         if (!sid) return;
         const auto index = queue_.front();
@@ -118,6 +118,17 @@ void RequestTracker::link_down(std::error_code reason) {
 
 void RequestTracker::cancel_all(std::error_code reason, SteadyTime now) {
     fail_all(reason, now);
+}
+
+void RequestTracker::fail_sent(std::error_code reason, SteadyTime now) {
+    std::vector<Completion> failed;
+    for (std::size_t i = 0; i < requests_.size(); ++i)
+        if (requests_[i].busy && requests_[i].sid != none)
+            failed.push_back(finish(static_cast<std::uint16_t>(i), false, now));
+    stats_.failed += failed.size();
+    pump(now);
+    for (auto& done : failed)
+        if (done) done(Unexpected(reason));
 }
 
 RequestTracker::Completion RequestTracker::finish(std::uint16_t index, bool answered,
@@ -186,7 +197,8 @@ RequestTracker::Disposition RequestTracker::on_frame(Bytes frame, SteadyTime now
     if (requests_[index].transmissions == 1) {
         // Smoothed like TCP's SRTT (RFC 6298, gain 1/8); sets how long clean SIDs rest.
         const auto rtt = now - requests_[index].sent_at;
-        smoothed_rtt_ = smoothed_rtt_.count() == 0 ? rtt : smoothed_rtt_ + (rtt - smoothed_rtt_) / 8;
+        smoothed_rtt_ =
+            smoothed_rtt_.count() == 0 ? rtt : smoothed_rtt_ + (rtt - smoothed_rtt_) / 8;
         const auto rest = std::clamp<std::chrono::nanoseconds>(smoothed_rtt_ * rest_rtts,
                                                                min_clean_rest, sids_.quarantine());
         sids_.set_min_rest(rest);
@@ -228,7 +240,8 @@ std::optional<SteadyTime> RequestTracker::next_deadline() const noexcept {
         if (!r.busy || (r.sid == none && link_up_)) continue;
         if (!next || r.deadline < *next) next = r.deadline;
     }
-    if (link_up_ && !queue_.empty()) {
+    // A full window is reopened by an answer or a deadline above, not by a SID.
+    if (link_up_ && !queue_.empty() && in_flight_ - queue_.size() < window_) {
         auto usable = sids_.next_usable();
         if (usable && (!next || *usable < *next)) next = usable;
     }

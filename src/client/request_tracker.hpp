@@ -32,8 +32,8 @@
 // - Link state: while the link is down, submitted requests are held (built but not sent,
 //   no SID; a timeout while held or queued consumes an attempt without sending anything).
 //   link_up() makes every SID clean again (a new connection or socket: no old answer
-//   reaches it), puts the current addresses into the held frames and sends them. link_down() fails every
-//   request, sent or held, with the given error: nothing is re-sent after a reconnect,
+//   reaches it), puts the current addresses into the held frames and sends them. link_down() fails
+//   every request, sent or held, with the given error: nothing is re-sent after a reconnect,
 //   because a request may already have been executed by the PLC.
 // - Completions are never called from inside submit(). They are called after the slot is
 //   freed, so a completion may submit again; a completion must not destroy the tracker.
@@ -128,6 +128,15 @@ class RequestTracker {
 
     // Fails every request with `reason`; the link state is unchanged.
     void cancel_all(std::error_code reason, SteadyTime now);
+    // Fails only the requests sent and not answered (e.g. the one on a Host Link line that
+    // got an error answer); held and queued requests stay.
+    void fail_sent(std::error_code reason, SteadyTime now);
+    // At most `window` requests sent and unanswered at once; the others wait in the queue
+    // with their clock stopped (Host Link is half duplex: 1). Default: no limit (256).
+    void set_window(std::size_t window) noexcept { window_ = window == 0 ? 1 : window; }
+    // Largest frame a request may have (Host Link: 552 bytes); submit() refuses longer ones
+    // with request_too_long.
+    void set_max_frame(std::size_t size) noexcept { max_frame_ = std::min(size, max_frame_size); }
 
     // Requests accepted and not ended yet (sent, queued for a SID, or held).
     [[nodiscard]] std::size_t in_flight() const noexcept { return in_flight_; }
@@ -172,14 +181,16 @@ class RequestTracker {
     void fail_all(std::error_code reason, SteadyTime now);
 
     FrameSink& sink_;
-    std::vector<Request> requests_;              // max_in_flight of them
-    std::vector<std::uint16_t> free_requests_;   // indexes into requests_
-    std::array<std::uint16_t, 256> by_sid_{};    // request index of each SID in flight
-    std::deque<std::uint16_t> queue_;            // held or waiting for a SID, oldest first
+    std::vector<Request> requests_;             // max_in_flight of them
+    std::vector<std::uint16_t> free_requests_;  // indexes into requests_
+    std::array<std::uint16_t, 256> by_sid_{};   // request index of each SID in flight
+    std::deque<std::uint16_t> queue_;           // held or waiting for a SID, oldest first
     SidPool sids_;
     std::uint8_t next_unanswered_sid_ = 0;
     std::chrono::nanoseconds smoothed_rtt_{0};  // of answers to first attempts
     std::size_t in_flight_ = 0;
+    std::size_t window_ = max_in_flight;
+    std::size_t max_frame_ = max_frame_size;
     bool link_up_ = false;
     std::uint8_t gateway_count_;
     NodeAddress destination_;

@@ -21,7 +21,14 @@ class Plc;
 
 namespace fins::server {
 
-enum class Link : std::uint8_t { udp, tcp, local };
+// serial: the CPU Unit's Host Link port (server/serial_session.hpp).
+enum class Link : std::uint8_t { udp, tcp, local, serial };
+
+// W342 5-1-2 note 5: network write protection covers commands "sent to CPU Units via
+// networks"; in-process requests and the directly connected Host Link port are not.
+constexpr bool via_network(Link link) noexcept {
+    return link == Link::udp || link == Link::tcp;
+}
 
 class SerialPorts;
 

@@ -197,6 +197,10 @@ std::size_t Server::tcp_connections() const noexcept {
     return impl_->nodes.in_use();
 }
 
+Dispatcher& Server::dispatcher() noexcept {
+    return impl_->dispatcher;
+}
+
 void Server::stop() {
     std::error_code ignored;
     if (impl_->udp) impl_->udp->close();

@@ -30,6 +30,7 @@ class Plc;
 
 namespace fins::server {
 
+class Dispatcher;
 class SerialPorts;
 
 struct ServerOptions {
@@ -66,6 +67,8 @@ class Server {
     [[nodiscard]] std::uint16_t tcp_port() const noexcept;
     [[nodiscard]] NodeAddress address() const noexcept;
     [[nodiscard]] std::size_t tcp_connections() const noexcept;
+    // The one dispatcher every session uses (serial sessions attach to it too).
+    [[nodiscard]] Dispatcher& dispatcher() noexcept;
     // Serves these Serial Gateway ports (W342 5-3-46 .. 5-3-48) from now on; they must
     // outlive the server's use of them.
     void attach_serial_ports(SerialPorts* ports) noexcept;

@@ -77,11 +77,60 @@ TEST(FinsdSerialGateway, UnitNumberOfTheEthernetUnitIsRefusedAtStart) {
     EXPECT_NE(finsd.result().err.find("unit address 10"), std::string::npos) << finsd.result().err;
 }
 
-TEST(FinsdSerialGateway, MissingDeviceIsAClearStartError) {
-    Finsd finsd({"--serial", "scu2.1=/nonexistent/tty"});
-    EXPECT_FALSE(finsd.started());
-    EXPECT_EQ(finsd.result().exit_code, 3);
-    EXPECT_NE(finsd.result().err.find("scu2.1"), std::string::npos) << finsd.result().err;
+// finsd keeps serving (as with a Host Link port): the port answers 0205 while its device
+// cannot be opened (W336 11-3-2: a send that cannot start is a 0205-class failure).
+TEST(FinsdSerialGateway, MissingDeviceAnswers0205AndFinsdKeepsServing) {
+    Finsd finsd({"--serial", "scu2.1=/nonexistent/tty,timeout=0.5"});
+    ASSERT_TRUE(finsd.started()) << finsd.result().err;
+    auto port = client_to(finsd, 0x88, false);  // unit 2, port 1
+    const auto r = port->send_raw(CommandCode{0x28, 0x03}, ascii("01000"
+                                                                 "0601"));
+    ASSERT_TRUE(r.has_value());
+    EXPECT_EQ(r->code.raw(), 0x0205);
+    EXPECT_EQ(words_of(*finsd.client(), "D0", 1).size(), 1U);
+}
+
+}  // namespace
+}  // namespace fins::test
+
+namespace fins::test {
+namespace {
+
+// W342 5-1-1 "Specifying the Destination PLC's FINS Address", without a routing table:
+// DNA = the serial port's unit address (84: unit 1, port 1), DA1 = Host Link unit
+// number + 1, DA2 = a unit of the PLC behind the port (00, its CPU Unit). Client ->
+// UDP -> finsd A (gateway port scu1.1) -> socat pty pair -> finsd B (--serial cpu=...,
+// Host Link unit 3) -> the answer back, with a write and a read checked on both sides.
+TEST(FinsdSerialGateway, W342_5_1_1_HostLinkFinsThroughTheGatewayEndToEnd) {
+    PtyPair line;
+    ASSERT_TRUE(line.ok());
+    Finsd plc_b({"--serial", "cpu=" + line.b() + ",unit=3"});
+    ASSERT_TRUE(plc_b.started()) << plc_b.result().err;
+    Finsd gateway_a({"--serial", "scu1.1=" + line.a() + ",timeout=3"});
+    ASSERT_TRUE(gateway_a.started()) << gateway_a.result().err;
+
+    ClientOptions o;
+    o.port = gateway_a.port();
+    o.destination = NodeAddress{0x84, 3 + 1, 0x00};
+    o.timeout = std::chrono::milliseconds(5000);
+    auto through = Client::connect(o);
+    ASSERT_TRUE(through.has_value()) << through.error().message();
+
+    const std::vector<std::uint16_t> values{0x1234, 0xBEEF};
+    const auto written = (*through)->write_words(addr("D100"), values);
+    ASSERT_TRUE(written.has_value()) << written.error().message();
+    const auto read = (*through)->read_words(addr("D100"), 2);
+    ASSERT_TRUE(read.has_value()) << read.error().message();
+    EXPECT_EQ(*read, values);
+    // The write landed in PLC B, not in the gateway's own CPU Unit.
+    EXPECT_EQ(words_of(*plc_b.client(), "D100", 2), values);
+    EXPECT_EQ(words_of(*gateway_a.client(), "D100", 2), (std::vector<std::uint16_t>{0, 0}));
+
+    // DA1 beyond Host Link unit 31 + 1: no such node behind the port.
+    o.destination = NodeAddress{0x84, 40, 0x00};
+    auto nowhere = Client::connect(o);
+    ASSERT_TRUE(nowhere.has_value());
+    EXPECT_EQ(end_code(**nowhere, CommandCode{0x01, 0x01}, {0x82, 0, 100, 0, 0, 1}), 0x0201U);
 }
 
 }  // namespace

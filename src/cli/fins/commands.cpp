@@ -84,7 +84,8 @@ std::optional<std::string> past_the_end(const Address& start, std::size_t count,
                        format_address(end));
 }
 
-// Reads `count` elements from `mem` in blocks of 999 (5-3-2), noting CPU error flags.
+// Reads `count` elements from `mem` in blocks of 999 (5-3-2), or what one answer holds
+// (Host Link: 538 bytes, 269 words), noting CPU error flags.
 Result<std::vector<std::uint8_t>> read_elements(Client& client, const MemoryAddress& mem,
                                                 std::size_t count, bool bit_steps, Output& out,
                                                 const std::string& what) {
@@ -92,7 +93,9 @@ Result<std::vector<std::uint8_t>> read_elements(Client& client, const MemoryAddr
     std::vector<std::uint8_t> data;
     data.reserve(count * size);
     Progress progress(what, count, bit_steps || size == 1 ? "bits" : "words");
-    for (std::size_t done = 0; done < count; done += max_read_words) {
+    const std::size_t block = std::min<std::size_t>(
+        max_read_words, client.max_response_data() / std::max<std::size_t>(size, 1));
+    for (std::size_t done = 0; done < count; done += block) {
         MemoryAddress at = mem;
         if (bit_steps) {
             const std::size_t linear = std::size_t{mem.word} * 16 + mem.bit + done;
@@ -101,7 +104,7 @@ Result<std::vector<std::uint8_t>> read_elements(Client& client, const MemoryAddr
         } else {
             at.word = static_cast<std::uint16_t>(mem.word + done);
         }
-        const auto n = std::min<std::size_t>(max_read_words, count - done);
+        const auto n = std::min<std::size_t>(block, count - done);
         auto r = send_noting_flags(client, MemoryAreaRead{at, static_cast<std::uint16_t>(n)}, out);
         if (!r) return Unexpected(r.error());
         data.insert(data.end(), r->data.begin(), r->data.end());

@@ -26,6 +26,8 @@ struct GlobalOptions {
     std::string host = "127.0.0.1";
     std::uint16_t port = 9600;
     bool tcp = false;
+    std::string serial;  // --serial DEVICE[,baud=...]: FINS over Host Link
+    unsigned unit = 0;   // --unit: Host Link unit number 0-31
     double timeout_seconds = 2.0;
     unsigned retries = 0;
     std::string dest;

@@ -11,6 +11,7 @@
 
 #include "cli/fins/commands.hpp"
 #include "fins/client.hpp"
+#include "transport/serial_options.hpp"
 
 namespace fins::cli {
 
@@ -52,6 +53,8 @@ std::optional<NodeAddress> parse_node_address(const std::string& s) {
 }
 
 std::string endpoint(const GlobalOptions& g) {
+    if (!g.serial.empty())
+        return fmt::format("{} unit {}", g.serial.substr(0, g.serial.find(',')), g.unit);
     if (g.host.find(':') != std::string::npos) return fmt::format("[{}]:{}", g.host, g.port);
     return fmt::format("{}:{}", g.host, g.port);
 }
@@ -62,6 +65,20 @@ std::unique_ptr<Client> open_client(const GlobalOptions& g, Output& out, int& ex
     o.host = g.host;
     o.port = g.port;
     o.protocol = g.tcp ? ClientOptions::Protocol::tcp : ClientOptions::Protocol::udp;
+    if (!g.serial.empty()) {
+        if (g.tcp) {
+            exit_code = out.usage("--serial and --tcp exclude each other");
+            return nullptr;
+        }
+        auto spec = transport::parse_serial_spec(g.serial, transport::SerialKeys::line);
+        if (!spec) {
+            exit_code = out.usage(fmt::format("--serial: {}", spec.error()));
+            return nullptr;
+        }
+        o.protocol = ClientOptions::Protocol::serial;
+        o.serial = spec->line;
+        o.host_link_unit = static_cast<std::uint8_t>(g.unit);
+    }
     o.timeout = std::chrono::milliseconds(static_cast<long>(g.timeout_seconds * 1000.0 + 0.5));
     o.retries = g.retries;
     if (!g.dest.empty()) {
@@ -93,6 +110,11 @@ void add_global_options(CLI::App& app, GlobalOptions& g) {
     app.add_option("--host", g.host, "PLC host name or IP address")->capture_default_str();
     app.add_option("--port", g.port, "FINS port")->capture_default_str();
     app.add_flag("--tcp", g.tcp, "Use FINS/TCP instead of FINS/UDP");
+    app.add_option("--serial", g.serial,
+                   "FINS over Host Link on DEVICE[,baud=9600,parity=even,data=7,stop=2]");
+    app.add_option("--unit", g.unit, "Host Link unit number of the PLC (with --serial)")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 31));
     app.add_option("--timeout", g.timeout_seconds, "Seconds to wait for each attempt")
         ->capture_default_str()
         ->check(CLI::Range(0.001, 3600.0));

@@ -114,9 +114,25 @@ std::optional<FoundNode> discover_tcp(const GlobalOptions& g) {
     return node;
 }
 
+// Host Link: the PLC on the line answers its CPU Unit data (there is no node to find).
+std::optional<FoundNode> discover_serial(const GlobalOptions& g) {
+    int rc = 0;
+    Output quiet{false};
+    auto client = open_client(g, quiet, rc);
+    if (!client) return std::nullopt;
+    auto data = client->send(CpuUnitDataRead{CpuUnitDataSection::model_and_area});
+    if (!data) return std::nullopt;
+    return FoundNode{client->destination(), data->model};
+}
+
+const char* link_name(const GlobalOptions& g) {
+    return !g.serial.empty() ? "Host Link" : g.tcp ? "TCP" : "UDP";
+}
+
 }  // namespace
 
 std::optional<FoundNode> discover_node(const GlobalOptions& g) {
+    if (!g.serial.empty()) return discover_serial(g);
     return g.tcp ? discover_tcp(g) : discover_udp(g);
 }
 
@@ -124,12 +140,12 @@ int run_probe(const GlobalOptions& g, Output& out) {
     auto found = discover_node(g);
     if (!found)
         return out.failure(make_error_code(ClientError::timeout),
-                           fmt::format("probe {} over {}", endpoint(g), g.tcp ? "TCP" : "UDP"));
+                           fmt::format("probe {} over {}", endpoint(g), link_name(g)));
     // The node a plain `fins` would address: the client's own derivation, no request sent.
     GlobalOptions plain = g;
     plain.dest.clear();
     std::optional<NodeAddress> derived;
-    if (!g.tcp) {
+    if (!g.tcp && g.serial.empty()) {
         int rc = 0;
         Output quiet{false};
         if (auto c = open_client(plain, quiet, rc)) derived = c->destination();
@@ -137,12 +153,14 @@ int run_probe(const GlobalOptions& g, Output& out) {
     const bool needs_dest = derived && derived->node != found->address.node;
     nlohmann::json doc{{"host", g.host},
                        {"port", g.port},
-                       {"protocol", g.tcp ? "tcp" : "udp"},
+                       {"protocol", !g.serial.empty() ? "hostlink"
+                                    : g.tcp           ? "tcp"
+                                                      : "udp"},
                        {"node", node_text(found->address)},
                        {"model", found->model},
                        {"needs_dest", needs_dest}};
     std::string text =
-        fmt::format("{} over {}: FINS node {}{}\n", endpoint(g), g.tcp ? "TCP" : "UDP",
+        fmt::format("{} over {}: FINS node {}{}\n", endpoint(g), link_name(g),
                     node_text(found->address), found->model.empty() ? "" : ", " + found->model);
     if (needs_dest)
         text += fmt::format("fins addresses node {} here by default: add --dest {}\n",

@@ -31,6 +31,7 @@
 #include "cli/finsd/config.hpp"
 #include "cli/finsd/ctl.hpp"
 #include "cli/finsd/serial_gateway_setup.hpp"
+#include "cli/finsd/serial_ports.hpp"
 #include "plc/plc.hpp"
 #include "plc/profile.hpp"
 #include "plc/storage.hpp"
@@ -327,8 +328,7 @@ int serve(const Settings& s) {
                            server.error().message());
     // Serial Gateway ports (scuN.P / board.P in mode gateway): serial_gateway_setup.hpp.
     fins::server::SerialPorts gateway_ports;
-    if (auto r = fins::cli::finsd::open_gateway_ports(io, s.serial, gateway_ports); !r)
-        return fail(3, "serial gateway port " + r.error());
+    fins::cli::finsd::open_gateway_ports(io, s.serial, gateway_ports);
     (*server)->attach_serial_ports(&gateway_ports);
     std::unique_ptr<fins::server::ControlServer> control;
     if (s.control_socket) {
@@ -338,6 +338,9 @@ int serve(const Settings& s) {
                                started.error().message());
         control = std::move(*started);
     }
+    fins::cli::finsd::SerialPorts serial;
+    if (auto r = start_serial_ports(io, (*server)->dispatcher(), s.serial, serial); !r)
+        return fail(2, r.error());
     // Before "listening": a SIGTERM right after that line still stops finsd cleanly.
     asio::signal_set signals{io, SIGINT, SIGTERM};
     const auto self = (*server)->address();
@@ -355,6 +358,7 @@ int serve(const Settings& s) {
         (*server)->stop();
         gateway_ports.close_all();
         if (control) control->stop();
+        serial.stop();
         plc.storage().flush();
         io.stop();
     });

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 namespace fins::cli::finsd {
 
@@ -69,18 +70,18 @@ server::GatewayPortConfig gateway_port_config(const SerialPortConfig& port) {
     return c;
 }
 
-tl::expected<void, std::string> open_gateway_ports(asio::io_context& io,
-                                                   const std::vector<SerialPortConfig>& ports,
-                                                   server::SerialPorts& out) {
+void open_gateway_ports(asio::io_context& io, const std::vector<SerialPortConfig>& ports,
+                        server::SerialPorts& out) {
     for (const auto& port : ports) {
         if (!is_gateway_port(port)) continue;
         auto gateway = std::make_shared<server::SerialGatewayPort>(io, gateway_port_config(port));
+        // As on a real unit, a port with nothing behind it still answers: 0205 until its
+        // device can be opened (each request retries, at most once a second).
         if (const auto ec = gateway->open())
-            return tl::unexpected(
-                fmt::format("{}: {}: {}", port.name, port.line.device, ec.message()));
+            spdlog::warn("finsd: serial gateway port {}: {}: {} (answering 0205 until it opens)",
+                         port.name, port.line.device, ec.message());
         out.add(std::move(gateway));
     }
-    return {};
 }
 
 }  // namespace fins::cli::finsd

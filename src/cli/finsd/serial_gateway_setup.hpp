@@ -33,9 +33,10 @@ tl::expected<void, std::string> mount_serial_units(const std::vector<SerialPortC
 // The server-side configuration of one gateway port.
 server::GatewayPortConfig gateway_port_config(const SerialPortConfig& port);
 
-// Opens every gateway port into `out`; an error names the port and device.
-tl::expected<void, std::string> open_gateway_ports(asio::io_context& io,
-                                                   const std::vector<SerialPortConfig>& ports,
-                                                   server::SerialPorts& out);
+// Opens every gateway port into `out`. A device that cannot be opened is logged and the
+// port kept: its requests answer 0205 until the device opens (finsd keeps serving, as
+// it does for Host Link ports).
+void open_gateway_ports(asio::io_context& io, const std::vector<SerialPortConfig>& ports,
+                        server::SerialPorts& out);
 
 }  // namespace fins::cli::finsd

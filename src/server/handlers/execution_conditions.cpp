@@ -21,7 +21,7 @@ EndCode check_execution_conditions(const ExecutionConditions& conditions, const 
     // W342 5-1-2 note 5: the protection applies to commands sent "via networks"; a
     // local (in-process) request is not one. Whether `source` is refused depends on the
     // mode (all nodes, listed nodes, all but the listed nodes: plc/plc.hpp).
-    if (link != Link::local && !conditions.network_write_protected &&
+    if (via_network(link) && !conditions.network_write_protected &&
         plc.network_write_protected_from(source))
         return EndCode::write_protected;
     if (plc.access_right_held_by_other(source) && !conditions.access_right_elsewhere)

@@ -4,6 +4,7 @@
 // as a Host Link FINS frame (network form, W342 3-5) and the PLC's answer comes back as
 // the FINS response, later (docs/architecture.md "Deferred answers").
 //
+// Every answer comes from the address the sender asked (clients match on it).
 // The frame on the line addresses the Host Link slave's own CPU Unit: DNA 00, DA1 00
 // (local network, local PLC), DA2 as sent; the gateway count drops by one (a gateway
 // was passed; 0 left: 0504 too many relays). The answer is rebuilt on the request's
@@ -44,13 +45,14 @@ std::size_t relay_to_host_link(SerialGatewayPort& port, Bytes request, const Hea
                                const RequestContext& context) {
     ByteReader reader(request.subspan(header_size));
     const CommandCode command{reader.u8(), reader.u8()};
-    // Errors come from the port's unit on this node.
-    Header from_port = response_header(header, self);
-    from_port.source.unit = port.config().unit_address;
+    // Every answer, errors included, comes from the address the sender asked: clients
+    // match answers by it (the port's own unit address would be dropped as foreign).
+    (void)self;
+    const Header from_plc = response_header(header, header.destination);
     const auto refuse = [&](EndCode code) -> std::size_t {
         if (!header.response_required()) return 0;
         ByteWriter w(out);
-        write_response_prefix(w, from_port, command, static_cast<std::uint16_t>(code));
+        write_response_prefix(w, from_plc, command, static_cast<std::uint16_t>(code));
         return w.overflowed() ? 0 : w.size();
     };
     const std::uint8_t node = header.destination.node;
@@ -72,11 +74,9 @@ std::size_t relay_to_host_link(SerialGatewayPort& port, Bytes request, const Hea
 
     Completion reply;
     if (header.response_required()) reply = context.reply_path->defer();
-    // The PLC behind the port answers from the address the sender asked.
-    Header from_plc = response_header(header, header.destination);
     port.submit(
         SerialFraming::host_link, Bytes{line.data(), *size}, true,
-        [reply = std::move(reply), from_port, from_plc, command, unit](EndCode end, Bytes payload) {
+        [reply = std::move(reply), from_plc, command, unit](EndCode end, Bytes payload) {
             if (!reply) return;
             std::array<std::uint8_t, max_frame_size> frame{};
             ByteWriter w(frame);
@@ -96,7 +96,7 @@ std::size_t relay_to_host_link(SerialGatewayPort& port, Bytes request, const Hea
                     return;
                 }
             }
-            write_response_prefix(w, from_port, command, static_cast<std::uint16_t>(end));
+            write_response_prefix(w, from_plc, command, static_cast<std::uint16_t>(end));
             if (!w.overflowed()) reply(Bytes{frame.data(), w.size()});
         });
     return 0;

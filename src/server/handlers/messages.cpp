@@ -36,7 +36,7 @@ EndCode read_messages(HandlerContext& context, const MessageRead& command, ByteW
 EndCode clear_messages(HandlerContext& context, const MessageClear& command) {
     const auto& source = context.header.source;
     // W342 5-1-2 note 5: only requests "via networks" (not in-process ones).
-    if (context.request.link != Link::local && context.plc.network_write_protected_from(source))
+    if (via_network(context.request.link) && context.plc.network_write_protected_from(source))
         return EndCode::write_protected;
     if (context.plc.access_right_held_by_other(source)) return EndCode::no_access_right;
     context.write = true;
