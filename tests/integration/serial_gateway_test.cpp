@@ -6,10 +6,12 @@
 // while other ports and the CPU Unit keep answering).
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <array>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -87,17 +89,24 @@ class Gateway {
               std::uint8_t sid = 0x11) {
         auto frame = request_frame(code, params, sid);
         frame[5] = unit;  // DA2: the serial port's unit address
-        sockaddr_in to{};
-        to.sin_family = AF_INET;
-        to.sin_port = htons(server_->udp_port());
-        to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-        ::sendto(fd_, frame.data(), frame.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to);
+        send_raw(frame);
     }
     std::vector<std::uint8_t> receive() {
         std::vector<std::uint8_t> buf(max_frame_size);
         const auto n = ::recv(fd_, buf.data(), buf.size(), 0);
         buf.resize(n > 0 ? static_cast<std::size_t>(n) : 0);
         return buf;
+    }
+    void send_raw(const std::vector<std::uint8_t>& frame) {
+        sockaddr_in to{};
+        to.sin_family = AF_INET;
+        to.sin_port = htons(server_->udp_port());
+        to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+        ::sendto(fd_, frame.data(), frame.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to);
+    }
+    std::vector<std::uint8_t> call_raw(const std::vector<std::uint8_t>& frame) {
+        send_raw(frame);
+        return receive();
     }
     std::vector<std::uint8_t> call(std::uint8_t unit, CommandCode code,
                                    const std::vector<std::uint8_t>& params) {
@@ -330,6 +339,35 @@ TEST(SerialGateway, PortThatDisappearsAnswers0205AndTheRestKeepServing) {
     EXPECT_EQ(end_code_of(r), 0x0000);
     r = gw.call(cpu_unit, CommandCode{0x01, 0x01}, hex("82 00 00 00 00 01"));
     EXPECT_EQ(end_code_of(r), 0x0000);
+}
+
+// Host Link FINS conversion faults (W342 5-1-1; choices in host_link_relay.cpp): no
+// slave answers (0205), an answer that is not a valid Host Link frame (0206).
+TEST(SerialGateway, W342_5_1_1_HostLinkRelayTimeoutAndGarbledAnswer) {
+    PtyPair line;
+    ASSERT_TRUE(line.ok());
+    Gateway gw({port_config("scu1.1", scu1_port1, line.a(), 300ms)});
+    auto frame = request_frame(CommandCode{0x01, 0x01}, hex("82 00 64 00 00 01"));
+    frame[3] = scu1_port1;  // DNA: the port's unit address (no routing table)
+    frame[4] = 3 + 1;       // DA1: Host Link unit 3
+    auto r = gw.call_raw(frame);
+    EXPECT_EQ(end_code_of(r), 0x0205);
+
+    // A slave that answers with a bad FCS.
+    const int slave = ::open(line.b().c_str(), O_RDWR | O_NOCTTY);
+    ASSERT_GE(slave, 0);
+    gw.send_raw(frame);
+    std::array<char, 256> got{};
+    ASSERT_GT(::read(slave, got.data(), got.size()), 0);  // the Host Link command
+    const std::string_view bad = "@03FA0040000000000101000000FF*\r";
+    ASSERT_EQ(::write(slave, bad.data(), bad.size()), static_cast<ssize_t>(bad.size()));
+    r = gw.receive();
+    EXPECT_EQ(end_code_of(r), 0x0206);
+    // The answer comes from the address the client asked.
+    ASSERT_GE(r.size(), 10U);
+    EXPECT_EQ(r[6], scu1_port1);
+    EXPECT_EQ(r[7], 3 + 1);
+    ::close(slave);
 }
 
 TEST(SerialGateway, W342_5_1_1_OnlyGatewayCommandsGoToAPortAndNotToTheCpu) {
