@@ -77,7 +77,7 @@ enum class HostLinkEndCode : std::uint8_t {
     aborted_entry_number_error = 0xA5,
     aborted_frame_length_error = 0xA8,
 };
-// "Host Link end code 13: FCS error".
+// "FCS error (Host Link end code 13)".
 const std::error_category& host_link_end_code_category() noexcept;
 std::error_code make_error_code(HostLinkEndCode e) noexcept;
 

@@ -136,7 +136,7 @@ class HostLinkEndCodeCategory final : public std::error_category {
                 text = "aborted: frame length error";
                 break;
         }
-        return fmt::format("Host Link end code {:02X}: {}", value, text);
+        return fmt::format("{} (Host Link end code {:02X})", text, value);
     }
 };
 
@@ -146,13 +146,13 @@ class HostLinkCategory final : public std::error_category {
     std::string message(int value) const override {
         switch (static_cast<HostLinkError>(value)) {
             case HostLinkError::bad_fcs:
-                return "Host Link answer with a bad FCS";
+                return "answer with a bad FCS (Host Link)";
             case HostLinkError::format:
-                return "Host Link answer not a valid FINS frame";
+                return "answer is not a Host Link FINS response";
             case HostLinkError::too_long:
-                return "Host Link frame over the length limit";
+                return "frame over the Host Link length limit";
             case HostLinkError::wrong_unit:
-                return "Host Link answer from another unit number";
+                return "answer from another Host Link unit number";
         }
         return "unknown Host Link error";
     }

@@ -94,7 +94,6 @@ class SerialSession : public std::enable_shared_from_this<SerialSession> {
     Counters counters_;
     std::array<std::uint8_t, max_line + 512> rx_{};
     std::size_t rx_size_ = 0;
-    std::size_t pending_ = 0;  // rx_ bytes not scanned because an answer is in progress
     std::array<std::uint8_t, host_link_max_fins_response> fins_in_{};
     std::array<std::uint8_t, host_link_max_fins_response> fins_out_{};
     std::array<std::uint8_t, host_link_max_response_chars> tx_{};

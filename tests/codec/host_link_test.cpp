@@ -132,7 +132,7 @@ TEST(HostLink, W342p125_ErrorAnswerCarriesNoFinsPart) {
     EXPECT_EQ(f->end_code, HostLinkEndCode::fcs_error);
     EXPECT_EQ(f->fins_size, 0u);
     EXPECT_EQ(make_error_code(HostLinkEndCode::fcs_error).message(),
-              "Host Link end code 13: FCS error");
+              "FCS error (Host Link end code 13)");
 }
 
 TEST(HostLink, OfFormOfTheCpuInitiatedCommand) {

@@ -64,6 +64,15 @@ struct RawArgs {
 
 enum class ErrorKind { usage, end_code, transport };
 
+// How many `unit`-byte elements one request or answer carries: the manual's `max`, or
+// fewer when the link's frame (client.max_parameters() / max_response_data(): Host Link
+// 540 / 538 bytes) holds less after `fixed` bytes.
+inline std::size_t fit(std::size_t max, std::size_t link_bytes, std::size_t fixed,
+                       std::size_t unit) {
+    const std::size_t room = link_bytes > fixed ? (link_bytes - fixed) / unit : 0;
+    return max < room ? max : room;
+}
+
 // "1 word", "3 words"; "1 entry"/"2 entries" with the plural given.
 std::string plural(std::size_t n, std::string_view one);
 std::string plural(std::size_t n, std::string_view one, std::string_view many);

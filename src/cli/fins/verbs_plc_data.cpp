@@ -75,10 +75,9 @@ Result<std::vector<std::uint16_t>> read_words(Client& client, const ParameterAre
     words.reserve(count);
     Progress progress(fmt::format("param-read {}", area.id), count, "words");
     while (words.size() < count) {
-        // 02 01 answers: area, start, count (6 bytes), then the words (Host Link: 266).
-        const auto limit =
-            std::min<std::size_t>(max_parameter_words, (client.max_response_data() - 6) / 2);
-        const auto n = std::min<std::size_t>(limit, count - words.size());
+        // 02 01 answers area, start, count (6 bytes), then the words.
+        const auto n = std::min(fit(max_parameter_words, client.max_response_data(), 6, 2),
+                                count - words.size());
         const ParameterAreaRead command{area.code, static_cast<std::uint16_t>(start + words.size()),
                                         static_cast<std::uint16_t>(n), false};
         auto r = client.send(command);
@@ -98,10 +97,8 @@ Result<std::size_t> write_words(Client& client, const ParameterAreaInfo& area, s
     std::vector<std::uint8_t> bytes;
     Progress progress(fmt::format("param-write {}", area.id), words.size(), "words");
     while (done < words.size()) {
-        // 02 02 carries area, start, count (6 bytes), then the words (Host Link: 267).
-        const auto limit =
-            std::min<std::size_t>(max_parameter_words, (client.max_parameters() - 6) / 2);
-        const auto n = std::min<std::size_t>(limit, words.size() - done);
+        const auto n =
+            std::min(fit(max_parameter_words, client.max_parameters(), 6, 2), words.size() - done);
         bytes.clear();
         for (std::size_t i = 0; i < n; ++i) {
             bytes.push_back(static_cast<std::uint8_t>(words[done + i] >> 8));
@@ -270,10 +267,10 @@ int run_program_read(const GlobalOptions& g, const ProgramArgs& a, Output& out) 
     Progress progress("program-read", a.bytes.empty() ? 0 : *limit, "bytes");
     // Until bit 15 (the UM's last address) or BYTES; the UM is finite, so is this loop.
     while (!last && data.size() < *limit) {
-        // 03 06 answers: program number, address, count (8 bytes), then whole 4-byte steps.
-        const auto block = std::min<std::size_t>(max_program_read_bytes,
-                                                 (client->max_response_data() - 8) / 4 * 4);
-        const auto n = std::min<std::size_t>(block, *limit - data.size());
+        // 03 06 answers program number, address, count (8 bytes), then 4-byte steps.
+        const auto n =
+            std::min(fit(max_program_read_bytes / 4, client->max_response_data(), 8, 4) * 4,
+                     *limit - data.size());
         const ProgramAreaRead command{program_number_all,
                                       static_cast<std::uint32_t>(*start + data.size()),
                                       static_cast<std::uint16_t>(n), false};
@@ -342,10 +339,9 @@ int run_program_write(const GlobalOptions& g, const ProgramArgs& a, Output& out)
     std::size_t blocks = 0;
     Progress progress("program-write", data->size(), "bytes");
     while (done < data->size()) {
-        // 03 07 carries program number, address, count (8 bytes), then the data.
-        const auto block =
-            std::min<std::size_t>(max_program_write_bytes, (client->max_parameters() - 8) / 4 * 4);
-        const auto n = std::min<std::size_t>(block, data->size() - done);
+        const auto n =
+            std::min(fit(max_program_write_bytes / 4, client->max_parameters(), 8, 4) * 4,
+                     data->size() - done);
         const ProgramAreaWrite command{
             program_number_all, static_cast<std::uint32_t>(*start + done),
             static_cast<std::uint16_t>(n), done + n == data->size(), Bytes(data->data() + done, n)};
