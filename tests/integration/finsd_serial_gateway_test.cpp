@@ -135,3 +135,40 @@ TEST(FinsdSerialGateway, W342_5_1_1_HostLinkFinsThroughTheGatewayEndToEnd) {
 
 }  // namespace
 }  // namespace fins::test
+
+namespace fins::test {
+namespace {
+
+// The config file's [serial] table configures a gateway port the same way (a board port
+// on a CS-series profile here: unit addresses E4/E5, the Inner Board E1 in 05 02).
+TEST(FinsdSerialGateway, ConfigFileSerialTableBoardPortOnACsProfile) {
+    PtyPair line;
+    ASSERT_TRUE(line.ok());
+    Child sim({sim_path, line.b(), "--node", "7"});
+    ASSERT_EQ(sim.read_line(), "ready");
+    ScratchDir dir("gateway-config");
+    const auto file = dir.write("finsd.toml", "profile = \"cs1h\"\n[serial]\n\"board.1\" = \"" +
+                                                  line.a() + ",timeout=2\"\n");
+    Finsd finsd({"--config", file});
+    ASSERT_TRUE(finsd.started()) << finsd.result().err;
+    auto board = client_to(finsd, 0xE4, false);
+    const auto r = board->send_raw(CommandCode{0x28, 0x03}, ascii("07000"
+                                                                  "0503"));
+    ASSERT_TRUE(r.has_value()) << r.error().message();
+    EXPECT_EQ(std::string(r->data.begin(), r->data.end()),
+              "0700"
+              "00"
+              "0503"
+              "0000"
+              "E5CC-SIM  00D9");
+    const auto units =
+        finsd.client()->send_raw(CommandCode{0x05, 0x02}, std::vector<std::uint8_t>{0x00});
+    ASSERT_TRUE(units.has_value());
+    const std::string listing(units->data.begin(), units->data.end());
+    EXPECT_NE(listing.find("\xE1"
+                           "CS1W-SCB41-V1"),
+              std::string::npos);
+}
+
+}  // namespace
+}  // namespace fins::test
