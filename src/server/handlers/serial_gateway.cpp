@@ -33,7 +33,14 @@ EndCode submit(HandlerContext& context, CommandCode code, SerialFraming framing,
                      ByteWriter w(out);
                      write_response_prefix(w, response, code, static_cast<std::uint16_t>(end));
                      if (end == EndCode::normal_completion) w.bytes(payload);
-                     if (!w.overflowed()) reply(Bytes{out.data(), w.size()});
+                     if (w.overflowed()) {
+                         // A slave answer longer than a FINS response can carry.
+                         w = ByteWriter(out);
+                         write_response_prefix(
+                             w, response, code,
+                             static_cast<std::uint16_t>(EndCode::response_too_long));
+                     }
+                     reply(Bytes{out.data(), w.size()});
                  });
     context.deferred = true;
     return EndCode::normal_completion;
