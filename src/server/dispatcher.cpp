@@ -7,6 +7,7 @@
 #include "fins/command_table.hpp"
 #include "plc/plc.hpp"
 #include "server/handlers/handlers.hpp"
+#include "server/serial_ports.hpp"
 #include "server/router.hpp"
 
 namespace fins::server {
@@ -18,15 +19,18 @@ constexpr std::size_t response_prefix_size = header_size + command_code_size + e
 // Is the frame for this node? DNA 00 or ours; DA1 00 (local), ours or FF (broadcast,
 // answered like our own node); DA2 00 (the CPU Unit), E1 when the profile has a Loop
 // Control Board (Inner Board), or any unit the profile mounts (the units 05 02 lists).
-// A wrong network or node answers 0201, a unit that is not there 0202.
+// A wrong network or node answers 0201, a unit that is not there 0202. A Serial Gateway
+// port's unit address (W342 5-3-46 tables) is there when finsd serves that port.
 EndCode check_destination(const NodeAddress& destination, const NodeAddress& self,
-                          const plc::Profile& profile) noexcept {
+                          const plc::Profile& profile, const SerialPorts* serial) noexcept {
     if (destination.network != local_network && destination.network != self.network)
         return EndCode::destination_node_not_in_network;
     if (destination.node != 0x00 && destination.node != self.node &&
         destination.node != broadcast_node)
         return EndCode::destination_node_not_in_network;
     if (destination.unit == inner_board_unit && profile.loop_control)
+        return EndCode::normal_completion;
+    if (serial != nullptr && serial->port(destination.unit) != nullptr)
         return EndCode::normal_completion;
     if (destination.unit != cpu_unit && profile.unit(destination.unit) == nullptr)
         return EndCode::unit_missing;
@@ -36,9 +40,15 @@ EndCode check_destination(const NodeAddress& destination, const NodeAddress& sel
 // Which unit runs a command: 02 40 belongs to the Loop Control Board (seed 001); a CPU
 // Bus Unit (10-1F) answers its own 05 01 CONTROLLER DATA READ (handlers/configuration.cpp,
 // W421 7-3-2); every other command belongs to the CPU Unit. A command sent to a unit
-// that does not run it is undefined there (0401), as a present unit answers.
-bool served_by(const plc::Profile& profile, std::uint8_t unit, CommandCode command) noexcept {
+// that does not run it is undefined there (0401), as a present unit answers. 28 03/04/05
+// belong to a Serial Gateway port (W342 5-3-46 .. 5-3-48); the CPU Unit models no serial
+// port of its own.
+bool served_by(const plc::Profile& profile, const SerialPorts* serial, std::uint8_t unit,
+               CommandCode command) noexcept {
     const bool board_command = command == CommandCode{0x02, 0x40};
+    const bool gateway_command = command.main == 0x28;
+    if (serial != nullptr && serial->port(unit) != nullptr) return gateway_command;
+    if (gateway_command) return false;
     if (unit == cpu_unit) return !board_command;
     if (unit == inner_board_unit && profile.loop_control) return board_command;
     const bool bus_unit = unit >= 0x10 && unit <= 0x1F;
@@ -89,7 +99,13 @@ std::size_t Dispatcher::handle(Bytes request, MutableBytes out, const RequestCon
         return w.overflowed() ? 0 : w.size();
     };
 
-    if (const auto code = check_destination(header.destination, self, plc_.profile());
+    // Host Link FINS conversion (W342 5-1-1): a frame for a PLC behind a gateway port.
+    if (serial_ != nullptr && header.destination.network != local_network &&
+        header.destination.network != self.network)
+        if (SerialGatewayPort* port = serial_->host_link_port(header.destination.network))
+            return handlers::relay_to_host_link(*port, request, header, self, out, context);
+
+    if (const auto code = check_destination(header.destination, self, plc_.profile(), serial_);
         code != EndCode::normal_completion)
         return answer(code);
 
@@ -101,7 +117,7 @@ std::size_t Dispatcher::handle(Bytes request, MutableBytes out, const RequestCon
     const CommandInfo* info = find_command(command);
     const handlers::HandlerEntry* entry = handlers::find_handler(command);
     if (info == nullptr || entry == nullptr || !plc_.profile().supports(command) ||
-        !served_by(plc_.profile(), header.destination.unit, command))
+        !served_by(plc_.profile(), serial_, header.destination.unit, command))
         return answer(EndCode::undefined_command);
 
     if (const auto code = handlers::check_execution_conditions(info->conditions, plc_,
@@ -114,7 +130,10 @@ std::size_t Dispatcher::handle(Bytes request, MutableBytes out, const RequestCon
     ByteWriter data(
         out.subspan(data_offset, std::min(out.size() - data_offset, max_response_data_size)));
     handlers::HandlerContext handler_context{plc_, header, context};
+    handler_context.serial = serial_;
+    handler_context.self = response.source;
     auto code = entry->function(handler_context, decoded->parameters, data);
+    if (handler_context.deferred) return 0;
     if (data.overflowed()) code = EndCode::response_too_long;
     // A write is a command whose row network write protection refuses, or a write
     // variant of a shared code (09 20 MESSAGE CLEAR) its handler flagged.

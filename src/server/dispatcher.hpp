@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 
 #include <sys/socket.h>
 
@@ -33,10 +34,29 @@ constexpr bool via_network(Link link) noexcept {
     return link == Link::udp || link == Link::tcp;
 }
 
+class SerialPorts;
+
+// Sends one response frame later, to where its request came from; a no-op once the
+// session is gone. Called at most once, on the I/O thread.
+using Completion = std::function<void(Bytes response_frame)>;
+
+// The session's way back for an answer that is not ready when handle() returns (a
+// Serial Gateway port's, docs/architecture.md "Deferred answers"). Only that path calls
+// defer(); the synchronous path never touches it and allocates nothing.
+class ReplyPath {
+  public:
+    // A completion bound to the request being handled now.
+    virtual Completion defer() = 0;
+
+  protected:
+    ~ReplyPath() = default;
+};
+
 // What the session knows about where a request came from.
 struct RequestContext {
     Link link = Link::udp;
     std::chrono::system_clock::time_point now{};
+    ReplyPath* reply_path = nullptr;  // nullptr: this session cannot answer later
     // FINS/UDP: the datagram's source, where the answer goes. In a plant the port's
     // node-address table may learn from it and redirect the answer (router.hpp).
     sockaddr_storage* peer = nullptr;
@@ -50,8 +70,13 @@ class Dispatcher {
     // Handles one request frame. Writes the response frame into `out` (which must hold
     // max_frame_size bytes) and returns its length, or 0 when nothing is to be sent:
     // the ICF no-response bit was set, the frame is itself a response, or it is too
-    // short to carry a header and command code (there is no SID to answer).
+    // short to carry a header and command code (there is no SID to answer), or the
+    // answer comes later through context.reply_path (a Serial Gateway port's).
     std::size_t handle(Bytes request, MutableBytes out, const RequestContext& context);
+
+    // The Serial Gateway ports (nullptr: none); they outlive the dispatcher's use.
+    void attach_serial_ports(SerialPorts* ports) noexcept { serial_ = ports; }
+    [[nodiscard]] SerialPorts* serial_ports() const noexcept { return serial_; }
 
     [[nodiscard]] const NodeAddress& self() const noexcept { return self_; }
     plc::Plc& plc() noexcept { return plc_; }
@@ -64,6 +89,7 @@ class Dispatcher {
   private:
     plc::Plc& plc_;
     NodeAddress self_;
+    SerialPorts* serial_ = nullptr;
     Router* router_ = nullptr;
     std::size_t port_ = 0;
 };

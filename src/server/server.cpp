@@ -203,6 +203,10 @@ NodeAddress Server::address() const noexcept {
     return impl_->dispatcher.self();
 }
 
+void Server::attach_serial_ports(SerialPorts* ports) noexcept {
+    impl_->dispatcher.attach_serial_ports(ports);
+}
+
 Dispatcher& Server::dispatcher() noexcept {
     return impl_->dispatcher;
 }

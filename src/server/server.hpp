@@ -35,6 +35,7 @@ namespace fins::server {
 
 class Dispatcher;
 class Router;
+class SerialPorts;
 
 struct ServerOptions {
     std::string bind_address = "127.0.0.1";
@@ -84,6 +85,9 @@ class Server {
     bool send_to_tcp_node(std::uint8_t node, Bytes frame);
     // This node's Send/Rcv/SendCmd engine (network_instructions.hpp).
     NetworkInstructions& instructions() noexcept;
+    // Serves these Serial Gateway ports (W342 5-3-46 .. 5-3-48) from now on; they must
+    // outlive the server's use of them.
+    void attach_serial_ports(SerialPorts* ports) noexcept;
 
     // Closes the sockets and every TCP session; pending handlers finish on `io`.
     void stop();

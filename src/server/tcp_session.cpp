@@ -193,7 +193,7 @@ bool TcpSession::handle_packet(const TcpPacket& packet) {
     }
     // Reserve the envelope header, let the dispatcher write the FINS response after it.
     const MutableBytes frame_out{out_.data() + tcp_header_size, max_frame_size};
-    const RequestContext context{Link::tcp, std::chrono::system_clock::now()};
+    const RequestContext context{Link::tcp, std::chrono::system_clock::now(), this};
     const std::size_t n = dispatcher_.handle(packet.data, frame_out, context);
     if (n > 0) {
         write_tcp_header(w, TcpCommand::frame, n);
@@ -249,7 +249,7 @@ bool TcpSession::from_bound_node(Bytes frame) const noexcept {
 }
 
 void TcpSession::send_and_continue(std::size_t size, bool close_after) {
-    if (confirming_ || pushing_) {
+    if (confirming_ || late_writing_) {
         // Command 6 is on its way; this packet follows it whole, never interleaved.
         deferred_ = true;
         deferred_size_ = size;
@@ -276,8 +276,8 @@ void TcpSession::send_and_continue(std::size_t size, bool close_after) {
                           if (self->confirm_wanted_) {
                               self->confirm_wanted_ = false;
                               self->send_confirmation();
-                          } else if (!self->pushed_.empty()) {
-                              self->write_pushed();
+                          } else if (!self->late_.empty()) {
+                              self->write_late();
                           }
                           self->process();
                       });
@@ -285,7 +285,7 @@ void TcpSession::send_and_continue(std::size_t size, bool close_after) {
 
 void TcpSession::confirm_connection() {
     if (state_ != State::established || confirming_) return;
-    if (writing_) {
+    if (writing_ || late_writing_) {
         confirm_wanted_ = true;
         return;
     }
@@ -310,47 +310,60 @@ void TcpSession::send_confirmation() {
                           if (self->deferred_) {
                               self->deferred_ = false;
                               self->send_and_continue(self->deferred_size_, self->deferred_close_);
-                          } else if (!self->pushed_.empty() && !self->writing_) {
-                              self->write_pushed();
+                          } else if (!self->late_.empty() && !self->writing_) {
+                              self->write_late();
                           }
                       });
 }
 
 bool TcpSession::push_frame(Bytes frame) {
-    if (state_ != State::established || pushed_.size() >= max_pushed ||
+    if (state_ != State::established || late_.size() >= max_late ||
         frame.size() > max_frame_size)
         return false;
-    std::vector<std::uint8_t> packet(tcp_header_size + frame.size());
-    ByteWriter w{packet};
-    write_tcp_header(w, TcpCommand::frame, frame.size());
-    std::memcpy(packet.data() + tcp_header_size, frame.data(), frame.size());
-    pushed_.push_back(std::move(packet));
-    if (!writing_ && !confirming_) write_pushed();
+    queue_late(frame);
     return true;
 }
 
-void TcpSession::write_pushed() {
-    writing_ = true;
-    pushing_ = true;
+Completion TcpSession::defer() {
+    return [weak = weak_from_this()](Bytes frame) {
+        if (auto self = weak.lock()) self->queue_late(frame);
+    };
+}
+
+void TcpSession::queue_late(Bytes frame) {
+    if (state_ != State::established) return;
+    if (late_.size() >= max_late) {
+        spdlog::warn("fins/tcp: {}: late answer dropped (peer not reading)", peer_.to_string());
+        return;
+    }
+    std::vector<std::uint8_t> packet(tcp_header_size + frame.size());
+    ByteWriter w{packet};
+    write_tcp_header(w, TcpCommand::frame, frame.size());
+    w.bytes(frame);
+    late_.push_back(std::move(packet));
+    if (!writing_ && !confirming_ && !late_writing_) write_late();
+}
+
+void TcpSession::write_late() {
+    late_writing_ = true;
     auto self = shared_from_this();
-    asio::async_write(socket_, asio::buffer(pushed_.front()),
+    asio::async_write(socket_, asio::buffer(late_.front()),
                       [self](std::error_code ec, std::size_t) {
-                          self->writing_ = false;
-                          self->pushing_ = false;
+                          self->late_writing_ = false;
+                          if (!self->late_.empty()) self->late_.pop_front();
                           if (!self->open()) return;
                           if (ec) {
                               self->close();
                               return;
                           }
-                          self->pushed_.pop_front();
-                          if (self->confirm_wanted_) {
-                              self->confirm_wanted_ = false;
-                              self->send_confirmation();
-                          } else if (!self->pushed_.empty()) {
-                              self->write_pushed();
-                          } else if (self->deferred_) {
+                          if (self->deferred_) {
                               self->deferred_ = false;
                               self->send_and_continue(self->deferred_size_, self->deferred_close_);
+                          } else if (self->confirm_wanted_) {
+                              self->confirm_wanted_ = false;
+                              self->send_confirmation();
+                          } else if (!self->late_.empty() && !self->writing_) {
+                              self->write_late();
                           }
                       });
 }

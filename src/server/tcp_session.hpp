@@ -32,17 +32,18 @@
 
 #include "fins/error.hpp"
 #include "fins/tcp.hpp"
+#include "server/dispatcher.hpp"
 #include "server/tcp_limits.hpp"
 #include "server/tcp_node_table.hpp"
 
 namespace fins::server {
 
-class Dispatcher;
-
 // Turns TCP keep-alive on `socket` on with `idle` (see TcpLimits::keepalive) or off (0).
 std::error_code set_keepalive(asio::ip::tcp::socket& socket, std::chrono::seconds idle) noexcept;
 
-class TcpSession : public std::enable_shared_from_this<TcpSession> {
+// Deferred answers (a Serial Gateway port's) wait in a small queue of their own and are
+// written whole between the in-order responses, never interleaved with one.
+class TcpSession : public std::enable_shared_from_this<TcpSession>, private ReplyPath {
   public:
     TcpSession(asio::ip::tcp::socket socket, Dispatcher& dispatcher, TcpNodeTable& nodes,
                const TcpLimits& limits);
@@ -66,10 +67,9 @@ class TcpSession : public std::enable_shared_from_this<TcpSession> {
     // Sends a FINS frame that answers no request of this connection's read loop (in a
     // plant: an answer routed back from another process to this client's node). Queued
     // behind a write in progress, never interleaved; false when the connection is not
-    // established or max_pushed frames already wait (the frame is dropped, as a full
-    // send buffer drops a datagram).
+    // established or max_late frames already wait (the frame is dropped, as a full
+    // send buffer drops a datagram). The same queue as the Serial Gateway's late answers.
     bool push_frame(Bytes frame);
-    static constexpr std::size_t max_pushed = 32;
 
   private:
     enum class State : std::uint8_t { handshake, established, draining, closed };
@@ -86,8 +86,10 @@ class TcpSession : public std::enable_shared_from_this<TcpSession> {
     void send_and_continue(std::size_t size, bool close_after);
     void send_confirmation();
     void close_after_notice();
-    void write_pushed();
     void drain();
+    Completion defer() override;
+    void queue_late(Bytes frame);
+    void write_late();
 
     void set_deadline(Deadline kind, Clock::duration after);
     void arm_timer(Clock::time_point at);
@@ -114,9 +116,7 @@ class TcpSession : public std::enable_shared_from_this<TcpSession> {
     std::size_t deferred_size_ = 0;  // a response that waits for command 6
     bool deferred_close_ = false;
     bool deferred_ = false;
-    bool pushing_ = false;                          // pushed_.front() is being written
-    std::deque<std::vector<std::uint8_t>> pushed_;  // push_frame() packets
-    bool logged_foreign_source_ = false;            // one warning per connection
+    bool logged_foreign_source_ = false;  // one warning per connection
     std::size_t drained_ = 0;
     // Room for two maximal packets so a read never has to wait for the parser.
     std::array<std::uint8_t, 2 * tcp_max_packet> in_{};
@@ -124,6 +124,11 @@ class TcpSession : public std::enable_shared_from_this<TcpSession> {
     std::array<std::uint8_t, tcp_max_packet> out_{};
     std::size_t out_size_pending_ = 0;  // bytes of out_ to send after handle_packet
     std::array<std::uint8_t, tcp_header_size> confirmation_{};
+    // Deferred answers and pushed frames with their envelope; bounded (every gateway
+    // port's queue fits).
+    static constexpr std::size_t max_late = 64;
+    std::deque<std::vector<std::uint8_t>> late_;
+    bool late_writing_ = false;
 };
 
 }  // namespace fins::server

@@ -140,9 +140,10 @@ int UdpSession::serve_batch() {
     counters_.received += static_cast<std::uint64_t>(received);
 
     // One clock reading per batch: its datagrams arrived within microseconds.
-    RequestContext context{Link::udp, std::chrono::system_clock::now()};
+    RequestContext context{Link::udp, std::chrono::system_clock::now(), this};
     unsigned replies = 0;
     for (int i = 0; i < received; ++i) {
+        current_ = static_cast<std::size_t>(i);
         const auto& request = s.in_msgs[static_cast<std::size_t>(i)];
         context.peer = &s.peers[static_cast<std::size_t>(i)];
         // A longer datagram was cut to receive_size (MSG_TRUNC), still more than a frame.
@@ -205,6 +206,30 @@ bool UdpSession::send_to(Bytes frame, const sockaddr* to, socklen_t to_size) noe
     }
     spdlog::debug("fins/udp: instruction frame not sent: {}", std::strerror(errno));
     return false;
+}
+
+Completion UdpSession::defer() {
+    const auto& request = slots_->in_msgs[current_];
+    return [weak = weak_from_this(), peer = slots_->peers[current_],
+            size = request.msg_hdr.msg_namelen](Bytes frame) {
+        if (auto self = weak.lock(); self && self->open()) self->send_late(frame, peer, size);
+    };
+}
+
+void UdpSession::send_late(Bytes frame, const sockaddr_storage& peer, socklen_t size) {
+    const auto sent =
+        ::sendto(socket_.native_handle(), frame.data(), frame.size(), MSG_DONTWAIT | MSG_NOSIGNAL,
+                 reinterpret_cast<const sockaddr*>(&peer), size);
+    if (sent >= 0) {
+        ++counters_.sent;
+        return;
+    }
+    if (would_block(errno) || errno == ENOBUFS) {
+        note_dropped(1);
+        return;
+    }
+    spdlog::debug("fins/udp: late reply dropped: {}", std::strerror(errno));
+    ++counters_.failed;
 }
 
 void UdpSession::note_dropped(std::uint64_t count) {

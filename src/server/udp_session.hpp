@@ -31,12 +31,13 @@
 #include <asio/generic/datagram_protocol.hpp>
 
 #include "fins/frame.hpp"
+#include "server/dispatcher.hpp"
 
 namespace fins::server {
 
-class Dispatcher;
-
-class UdpSession : public std::enable_shared_from_this<UdpSession> {
+// A deferred answer (a Serial Gateway port's) goes out later with one non-blocking
+// sendto() to the request's source address; a full send buffer drops it like any reply.
+class UdpSession : public std::enable_shared_from_this<UdpSession>, private ReplyPath {
   public:
     static constexpr std::size_t batch_size = 32;
     static constexpr unsigned rounds_per_turn = 4;
@@ -85,11 +86,14 @@ class UdpSession : public std::enable_shared_from_this<UdpSession> {
     int serve_batch();
     void send_replies(unsigned count);
     void note_dropped(std::uint64_t count);
+    Completion defer() override;
+    void send_late(Bytes frame, const sockaddr_storage& peer, socklen_t size);
 
     asio::generic::datagram_protocol::socket socket_;
     Dispatcher& dispatcher_;
     std::unique_ptr<Slots> slots_;
     Counters counters_;
+    std::size_t current_ = 0;  // the datagram being dispatched (defer() answers it)
     ResponseHook response_hook_;
     std::uint64_t dropped_unlogged_ = 0;
     std::chrono::steady_clock::time_point last_drop_log_{};

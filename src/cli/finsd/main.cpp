@@ -28,16 +28,18 @@
 #include <asio/io_context.hpp>
 #include <asio/signal_set.hpp>
 
-#include "cli/finsd/serial_ports.hpp"
 #include "cli/finsd/config.hpp"
 #include "cli/finsd/config_plant.hpp"
 #include "cli/finsd/ctl.hpp"
+#include "cli/finsd/serial_gateway_setup.hpp"
+#include "cli/finsd/serial_ports.hpp"
 #include "plc/plc.hpp"
 #include "plc/profile.hpp"
 #include "plc/storage.hpp"
 #include "plc/storage_format.hpp"
 #include "server/control.hpp"
 #include "server/instruction_schedule.hpp"
+#include "server/serial_ports.hpp"
 #include "server/server.hpp"
 
 namespace {
@@ -270,6 +272,8 @@ int serve(const Settings& s) {
     std::signal(SIGXFSZ, SIG_IGN);
     fins::plc::Profile profile = *fins::plc::find_profile(s.profile);
     if (s.dip_write_protection) profile.dip_switch |= fins::plc::dip_pin1;
+    if (auto r = fins::cli::finsd::mount_serial_units(s.serial, profile); !r)
+        return fail(2, r.error());
 
     std::unique_ptr<fins::plc::Plc> plc_owner;
     if (const int rc = open_plc(s, profile, plc_owner); rc >= 0) return rc;
@@ -334,6 +338,10 @@ int serve(const Settings& s) {
     fins::server::InstructionSchedule schedule(io.get_executor(), (*server)->instructions(),
                                                std::move(scheduled));
     schedule.start();
+    // Serial Gateway ports (scuN.P / board.P in mode gateway): serial_gateway_setup.hpp.
+    fins::server::SerialPorts gateway_ports;
+    fins::cli::finsd::open_gateway_ports(io, s.serial, gateway_ports);
+    (*server)->attach_serial_ports(&gateway_ports);
     std::unique_ptr<fins::server::ControlServer> control;
     if (s.control_socket) {
         auto started = fins::server::ControlServer::start(io, plc, *s.control_socket,
@@ -362,6 +370,7 @@ int serve(const Settings& s) {
         spdlog::info("finsd: signal {}, shutting down", signal);
         schedule.stop();
         (*server)->stop();
+        gateway_ports.close_all();
         if (control) control->stop();
         serial.stop();
         plc.storage().flush();

@@ -9,10 +9,12 @@ tl::expected<void, std::string> start_serial_ports(asio::io_context& io,
                                                    const std::vector<SerialPortConfig>& ports,
                                                    SerialPorts& out) {
     for (const auto& p : ports) {
+        if (p.mode == "gateway") continue;  // a Serial Gateway port: serial_gateway_setup.cpp
         if (p.mode != "hostlink")
-            return tl::unexpected(fmt::format(
-                "{}: serial port {}: mode '{}' is not served by this build (mode=hostlink is)",
-                p.where, p.name, p.mode));
+            return tl::unexpected(
+                fmt::format("{}: serial port {}: mode '{}' is not served by this build (hostlink "
+                            "and gateway are)",
+                            p.where, p.name, p.mode));
         server::SerialSessionOptions o;
         o.name = p.name;
         o.line = p.line;

@@ -23,6 +23,10 @@ namespace fins::plc {
 class Plc;
 }
 
+namespace fins::server {
+class SerialGatewayPort;
+}
+
 namespace fins::server::handlers {
 
 struct HandlerContext {
@@ -35,6 +39,12 @@ struct HandlerContext {
     // Set by a handler whose variant is a FINS write although its command's row is not
     // (09 20 MESSAGE CLEAR): the dispatcher logs it in the write access log (5-3-30).
     bool write = false;
+    // The Serial Gateway ports (28 xx handlers) and this node's address.
+    SerialPorts* serial = nullptr;
+    NodeAddress self{};
+    // Set by a handler that handed the request on (a serial port): no answer now, its
+    // completion sends it later.
+    bool deferred = false;
 };
 
 using HandlerFunction = EndCode (*)(HandlerContext& context, Bytes parameters, ByteWriter& out);
@@ -63,6 +73,14 @@ std::span<const HandlerEntry> access_right_handlers() noexcept;    // 0C xx  acc
 std::span<const HandlerEntry> error_log_handlers() noexcept;       // 21 xx  error_log.cpp
 std::span<const HandlerEntry> forced_handlers() noexcept;          // 23 xx  forced.cpp
 std::span<const HandlerEntry> file_memory_handlers() noexcept;     // 22 xx  file_memory.cpp
+std::span<const HandlerEntry> serial_gateway_handlers() noexcept;  // 28 xx  serial_gateway.cpp
+
+// Host Link FINS conversion (W342 5-1-1, host_link_relay.cpp): sends the whole request
+// frame on `port` as Host Link FINS and answers later; returns the length of an answer
+// written to `out` now (an error end code), or 0 (deferred, or no answer wanted).
+std::size_t relay_to_host_link(SerialGatewayPort& port, Bytes request, const Header& header,
+                               const NodeAddress& self, MutableBytes out,
+                               const RequestContext& context);
 
 // The execution conditions of W342 5-1-2, checked in this order: operating mode
 // (RUN 2206, MONITOR 2205, PROGRAM 2203), network write protection (2102, only for

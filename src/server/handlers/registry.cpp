@@ -16,7 +16,7 @@ std::vector<HandlerEntry> build() {
                        operating_mode_handlers(), configuration_handlers(), status_handlers(),
                        cpu_status_handlers(), clock_handlers(), message_handlers(),
                        access_right_handlers(), error_log_handlers(), forced_handlers(),
-                       file_memory_handlers()})
+                       file_memory_handlers(), serial_gateway_handlers()})
         all.insert(all.end(), group.begin(), group.end());
     std::sort(all.begin(), all.end(), [](const HandlerEntry& a, const HandlerEntry& b) {
         return a.code.value() < b.code.value();
