@@ -128,7 +128,8 @@ class FileMemory {
     [[nodiscard]] std::size_t open_files() const noexcept { return open_files_.size(); }
 
   private:
-    // A file that 22 03 extended, kept open with its directory so that the next chunk
+    // A file that 22 02 read or 22 03 extended, kept open (read-write) with its
+    // directory so that the next chunk
     // skips the path walk and the open: found by device and "\DIR\NAME" key, used only
     // while statx(dir, name, AT_SYMLINK_NOFOLLOW) still names the same regular file
     // (a host-side rename, delete or symlink swap falls back to the checked walk). Its
@@ -148,6 +149,8 @@ class FileMemory {
         std::uint64_t last_use = 0;  // LRU order
         bool undated = false;        // written since last dated: date it last_write
     };
+    // "\DIR\SUB\NAME": what find_open_file() looks for.
+    static std::string open_file_key(const std::vector<std::string>& path, const std::string& name);
     OpenFile* find_open_file(std::size_t device, const std::string& key) noexcept;
     // Takes ownership of `directory` on success; nullptr when `name` cannot be opened.
     OpenFile* keep_open(std::size_t device, std::string key, int directory,

@@ -11,6 +11,15 @@
 
 namespace fins::plc {
 
+std::string FileMemory::open_file_key(const std::vector<std::string>& path,
+                                      const std::string& name) {
+    std::string key;
+    for (const auto& component : path)
+        key += "\\" + component;
+    key += "\\" + name;
+    return key;
+}
+
 FileMemory::OpenFile* FileMemory::find_open_file(std::size_t device,
                                                  const std::string& key) noexcept {
     for (auto& f : open_files_)
@@ -23,7 +32,8 @@ FileMemory::OpenFile* FileMemory::find_open_file(std::size_t device,
 
 FileMemory::OpenFile* FileMemory::keep_open(std::size_t device, std::string key, int directory,
                                             const std::string& name) {
-    const int fd = ::openat(directory, name.c_str(), O_WRONLY | O_NOFOLLOW | O_CLOEXEC);
+    // Read and write: 22 02 chunks read through it, 22 03 chunks extend it.
+    const int fd = ::openat(directory, name.c_str(), O_RDWR | O_NOFOLLOW | O_CLOEXEC);
     struct stat st {};
     if (fd < 0 || ::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
         if (fd >= 0) ::close(fd);

@@ -25,12 +25,35 @@ Result<SingleFileReadResponse> FileMemory::read(const SingleFileRead& c) {
     if (!name || !path || c.length > max_file_read_bytes) return fail(EndCode::parameter_error);
     auto device = open_device(c.disk);
     if (!device) return Unexpected(device.error());
-    const Fd dir = host::open_path(device->fd, *path);
-    if (!dir.valid()) return fail(EndCode::read_file_missing);
-    const Fd fd(::openat(dir.get(), name->c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC));
+    // The chunks of one transfer read through the descriptor the first one opened (see
+    // write()); a file that is no longer the one the name gives takes the walk again.
+    const std::string key = open_file_key(*path, *name);
     struct stat st {};
-    if (!fd.valid() || ::fstat(fd.get(), &st) != 0 || !S_ISREG(st.st_mode))
-        return fail(EndCode::read_file_missing);
+    int fd = -1;
+    Fd walked_fd;
+    if (OpenFile* cached = find_open_file(device->index, key); cached != nullptr) {
+        if (host::identity_of(cached->directory, *name, &st) == Kind::file &&
+            static_cast<std::uint64_t>(st.st_ino) == cached->inode &&
+            static_cast<std::uint64_t>(st.st_dev) == cached->host_device)
+            fd = cached->fd;
+        else
+            close_open_file(cached);
+    }
+    if (fd < 0) {
+        Fd dir = host::open_path(device->fd, *path);
+        if (!dir.valid()) return fail(EndCode::read_file_missing);
+        if (host::identity_of(dir.get(), *name, &st) != Kind::file)
+            return fail(EndCode::read_file_missing);
+        if (OpenFile* kept = keep_open(device->index, key, dir.get(), *name); kept != nullptr) {
+            static_cast<void>(dir.release());
+            fd = kept->fd;
+        } else {
+            walked_fd = Fd(::openat(dir.get(), name->c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC));
+            if (!walked_fd.valid() || ::fstat(walked_fd.get(), &st) != 0 || !S_ISREG(st.st_mode))
+                return fail(EndCode::read_file_missing);
+            fd = walked_fd.get();
+        }
+    }
     const auto size = static_cast<std::uint64_t>(st.st_size);
     if (c.position > size) return fail(EndCode::address_range_error);
     const auto n = static_cast<std::size_t>(std::min<std::uint64_t>(c.length, size - c.position));
@@ -40,8 +63,8 @@ Result<SingleFileReadResponse> FileMemory::read(const SingleFileRead& c) {
     r.data.resize(n);
     std::size_t done = 0;
     while (done < n) {
-        const auto got = ::pread(fd.get(), r.data.data() + done, n - done,
-                                 static_cast<off_t>(c.position + done));
+        const auto got =
+            ::pread(fd, r.data.data() + done, n - done, static_cast<off_t>(c.position + done));
         if (got < 0 && errno == EINTR) continue;
         if (got <= 0) return fail(EndCode::memory_error);
         done += static_cast<std::size_t>(got);
@@ -65,10 +88,7 @@ EndCode FileMemory::write(const SingleFileWrite& c, CivilSeconds now) {
     close_idle_files(now);
     // The chunks of one transfer: the directory and file stay open while the name still
     // names the same regular file (no walk, no open); anything else takes the walk.
-    std::string key;
-    for (const auto& component : *path)
-        key += "\\" + component;
-    key += "\\" + *name;
+    const std::string key = open_file_key(*path, *name);
     struct stat st {};
     auto kind = Kind::missing;
     int dir_fd = -1;

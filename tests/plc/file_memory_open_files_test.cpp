@@ -94,6 +94,39 @@ TEST_F(OpenFilesTest, W342_5_3_34_AppendsReuseOneDescriptor) {
     EXPECT_EQ(st.st_mtime, 1'700'000'009);
 }
 
+// 22 02 chunks read through one kept descriptor too (issue 8 speed), and a file the
+// host replaced under the same name is read afresh, never the old inode's bytes.
+TEST_F(OpenFilesTest, W342_5_3_33_ReadsReuseOneDescriptorWhileTheNameHoldsTheFile) {
+    ASSERT_EQ(write("R.BIN", "abcdef", FileWriteMode::create), EndCode::normal_completion);
+    auto read = [&](std::uint32_t position, std::uint16_t length) {
+        return files.read({disk_memory_card, *FileName::from("R.BIN"), position, length, ""});
+    };
+    auto first = read(0, 3);
+    ASSERT_TRUE(first);
+    EXPECT_EQ(std::string(first->data.begin(), first->data.end()), "abc");
+    EXPECT_EQ(files.open_files(), 1U);
+    const std::size_t descriptors = open_descriptors();
+    auto second = read(3, 3);
+    ASSERT_TRUE(second);
+    EXPECT_EQ(std::string(second->data.begin(), second->data.end()), "def");
+    EXPECT_TRUE(second->last);
+    EXPECT_EQ(open_descriptors(), descriptors);  // no new open
+    // Replaced on the host (new inode): the next read sees the new bytes.
+    {
+        std::ofstream out(card() / "R.BIN.new", std::ios::binary);
+        out << "XYZ";
+    }
+    fs::rename(card() / "R.BIN.new", card() / "R.BIN");
+    auto third = read(0, 3);
+    ASSERT_TRUE(third);
+    EXPECT_EQ(std::string(third->data.begin(), third->data.end()), "XYZ");
+    EXPECT_EQ(third->file_size, 3U);
+    // Deleted on the host: dropped from the cache, and 2006 on the next read.
+    fs::remove(card() / "R.BIN");
+    EXPECT_FALSE(read(0, 1));
+    EXPECT_EQ(files.open_files(), 0U);
+}
+
 TEST_F(OpenFilesTest, W342_5_3_36_DeleteRenameFormatAndCardRemovalDropIt) {
     ASSERT_EQ(write("A.BIN", "a", FileWriteMode::create), EndCode::normal_completion);
     ASSERT_EQ(append("A.BIN", "b"), EndCode::normal_completion);
