@@ -15,6 +15,7 @@
 #include <toml++/toml.h>
 
 #include "cli/finsd/config_plant.hpp"
+#include "cli/finsd/config_values.hpp"
 #include "fins/values.hpp"
 
 namespace fins::cli::finsd {
@@ -281,78 +282,6 @@ class Loader {
         return {};
     }
 
-    // { TYPE = value } or { TYPE = [values] }: the words of each value in Omron's order
-    // (fins/values.hpp, as `fins write --as TYPE`): int16 uint16 int32 uint32 float
-    // double bcd (one word, 0-9999) bcd32 (two words) string (2 characters a word).
-    Expected<std::vector<std::uint32_t>> typed_words(const toml::key& key, const std::string& p,
-                                                     const toml::table& t) const {
-        static constexpr std::string_view types =
-            "int16, uint16, int32, uint32, float, double, bcd, bcd32 or string";
-        if (t.size() != 1) return fail(key, p, fmt::format("a typed value is one key: {}", types));
-        const auto first = t.begin();  // its pair refers into the iterator: keep it alive
-        const std::string type(first->first.str());
-        const toml::node& value = first->second;
-        static constexpr std::string_view known[] = {"int16",  "uint16", "int32", "uint32", "float",
-                                                     "double", "bcd",    "bcd32", "string"};
-        if (std::find(std::begin(known), std::end(known), type) == std::end(known))
-            return fail(key, p, fmt::format("'{}' is not a value type: {}", type, types));
-        std::vector<std::uint32_t> out;
-        const auto add = [&out](const auto& words) {
-            out.insert(out.end(), words.begin(), words.end());
-        };
-        const auto one = [&](const toml::node& n) -> Expected<void> {
-            const auto bad = [&](std::string_view what) {
-                return fail(key, p + "." + type, fmt::format("{}", what));
-            };
-            if (type == "string") {
-                const auto* text = n.as_string();
-                auto w = text ? string_to_words(text->get()) : Result<std::vector<std::uint16_t>>{};
-                if (!text || !w) return bad("must be a string (two characters a word)");
-                add(*w);
-                return {};
-            }
-            if (type == "float" || type == "double") {
-                std::optional<double> v;
-                if (const auto* f = n.as_floating_point()) v = f->get();
-                if (const auto* i = n.as_integer()) v = static_cast<double>(i->get());
-                if (!v) return bad("must be a number");
-                if (type == "float")
-                    add(float_to_words(static_cast<float>(*v)));
-                else
-                    add(double_to_words(*v));
-                return {};
-            }
-            const auto* i = n.as_integer();
-            if (i == nullptr) return bad("must be an integer");
-            const std::int64_t v = i->get();
-            const auto in = [v](std::int64_t lo, std::int64_t hi) { return v >= lo && v <= hi; };
-            if (type == "int16" && in(-32768, 32767))
-                add(int16_to_words(static_cast<std::int16_t>(v)));
-            else if (type == "uint16" && in(0, 0xFFFF))
-                add(uint16_to_words(static_cast<std::uint16_t>(v)));
-            else if (type == "int32" && in(std::numeric_limits<std::int32_t>::min(),
-                                           std::numeric_limits<std::int32_t>::max()))
-                add(int32_to_words(static_cast<std::int32_t>(v)));
-            else if (type == "uint32" && in(0, 0xFFFFFFFF))
-                add(uint32_to_words(static_cast<std::uint32_t>(v)));
-            else if (type == "bcd" && in(0, 9999))
-                add(*bcd16_to_words(static_cast<std::uint16_t>(v)));
-            else if (type == "bcd32" && in(0, 99999999))
-                add(*bcd32_to_words(static_cast<std::uint32_t>(v)));
-            else
-                return bad(fmt::format("{} out of range for {}", v, type));
-            return {};
-        };
-        if (const auto* list = value.as_array()) {
-            if (list->empty()) return fail(key, p + "." + type, "empty array");
-            for (const auto& n : *list)
-                if (auto r = one(n); !r) return tl::unexpected<Error>(r.error());
-        } else if (auto r = one(value); !r) {
-            return tl::unexpected<Error>(r.error());
-        }
-        return out;
-    }
-
     Expected<void> memory(const toml::key& key, const toml::node& node, const std::string&) {
         const std::string p = "memory.\"" + std::string(key.str()) + "\"";
         MemoryInit entry;
@@ -376,8 +305,8 @@ class Loader {
         if (const auto* typed = node.as_table()) {
             if (bit || wide)
                 return fail(key, p, "typed values ({ float = ... }) are for word addresses");
-            auto words = typed_words(key, p, *typed);
-            if (!words) return tl::unexpected<Error>(words.error());
+            auto words = typed_words(*typed);
+            if (!words) return fail(key, p + words.error().path_suffix, words.error().message);
             entry.values = std::move(*words);
         } else if (const auto* list = node.as_array()) {
             if (list->empty()) return fail(key, p, "empty array");
