@@ -69,10 +69,10 @@ struct Storage::Impl {
     sf::Header* header = nullptr;
     std::vector<std::pair<void*, std::size_t>> maps;
     std::vector<std::pair<void*, std::size_t>> anonymous;  // heap sections, lazily backed
-    std::vector<std::span<std::byte>> sections;  // by entry index
-    std::vector<bool> claimed;                   // per existing entry
-    bool existing = false;                       // restored from finsd.state
-    bool creating = false;                       // building finsd.state.new
+    std::vector<std::span<std::byte>> sections;            // by entry index
+    std::vector<bool> claimed;                             // per existing entry
+    bool existing = false;                                 // restored from finsd.state
+    bool creating = false;                                 // building finsd.state.new
     bool verified = false;
     bool sealed = false;
     bool closed = false;

@@ -7,8 +7,8 @@
 #include "fins/command_table.hpp"
 #include "plc/plc.hpp"
 #include "server/handlers/handlers.hpp"
-#include "server/serial_ports.hpp"
 #include "server/router.hpp"
+#include "server/serial_ports.hpp"
 
 namespace fins::server {
 

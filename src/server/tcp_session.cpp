@@ -317,8 +317,7 @@ void TcpSession::send_confirmation() {
 }
 
 bool TcpSession::push_frame(Bytes frame) {
-    if (state_ != State::established || late_.size() >= max_late ||
-        frame.size() > max_frame_size)
+    if (state_ != State::established || late_.size() >= max_late || frame.size() > max_frame_size)
         return false;
     queue_late(frame);
     return true;

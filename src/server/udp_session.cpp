@@ -152,8 +152,7 @@ int UdpSession::serve_batch() {
         // An answer to one of this node's own Send/Rcv/SendCmd instructions.
         // One it did not wait for goes on to the dispatcher: in a plant the router
         // relays answers for other nodes; a single node drops them there.
-        if (response_hook_ && size > 0 && (frame[0] & icf_response) != 0 &&
-            response_hook_(frame))
+        if (response_hook_ && size > 0 && (frame[0] & icf_response) != 0 && response_hook_(frame))
             continue;
         const std::size_t n = dispatcher_.handle(
             Bytes{s.in[static_cast<std::size_t>(i)].data(), size}, s.out[replies], context);

@@ -17,8 +17,8 @@
 
 #include <tl/expected.hpp>
 
-#include "cli/finsd/config_serial.hpp"
 #include "cli/finsd/config_schedule.hpp"
+#include "cli/finsd/config_serial.hpp"
 #include "fins/address.hpp"
 #include "plc/injections.hpp"
 #include "plc/io_memory.hpp"
