@@ -9,6 +9,7 @@
 #include <memory>
 #include <string>
 #include <thread>
+#include <utility>
 
 #include <gtest/gtest.h>
 #include <asio/io_context.hpp>
@@ -47,6 +48,21 @@ inline server::PlantConfig three_networks() {
     line.relays = {{1, 3, 2}, {2, 3, 2}};
     c.cpus = {a, b, line};
     return c;
+}
+
+// three_networks() as two processes would run it: the two routers, and line-3 alone,
+// every unit on the same fixed `port` (as on a real network), so router-b reaches
+// 127.0.3.5 over FINS/UDP by its node-address table.
+inline std::pair<server::PlantConfig, server::PlantConfig> routers_and_line(std::uint16_t port) {
+    auto routers = three_networks();
+    routers.cpus.pop_back();
+    auto line = three_networks();
+    line.cpus.erase(line.cpus.begin(), line.cpus.begin() + 2);
+    for (auto* c : {&routers, &line})
+        for (auto& cpu : c->cpus)
+            for (auto& p : cpu.ports)
+                p.port = port;
+    return {std::move(routers), std::move(line)};
 }
 
 class PlantThread {

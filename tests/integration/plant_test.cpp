@@ -209,14 +209,7 @@ TEST(Plant, W596_2_4_BetweenTwoProcessesTheRelayIsFinsUdp) {
     // the answer comes back as datagrams routed by DNA through both routers to the
     // client's learned address. All units share one port, as on a real network.
     constexpr std::uint16_t port = 29661;
-    auto routers = three_networks();
-    routers.cpus.pop_back();
-    auto line = three_networks();
-    line.cpus.erase(line.cpus.begin(), line.cpus.begin() + 2);
-    for (auto* c : {&routers, &line})
-        for (auto& cpu : c->cpus)
-            for (auto& p : cpu.ports)
-                p.port = port;
+    const auto [routers, line] = routers_and_line(port);
     PlantThread a(routers);
     PlantThread b(line);
     // FINS/UDP from node 77 of network 1 (no router uses it); FINS/TCP from the node the

@@ -17,14 +17,7 @@ namespace {
 
 TEST(TsharkPlant, RelayedFramesAndRelayErrorsDecodeWithoutMalformedFlag) {
     constexpr std::uint16_t port = 29663;
-    auto routers = three_networks();
-    routers.cpus.pop_back();
-    auto line = three_networks();
-    line.cpus.erase(line.cpus.begin(), line.cpus.begin() + 2);
-    for (auto* c : {&routers, &line})
-        for (auto& cpu : c->cpus)
-            for (auto& p : cpu.ports)
-                p.port = port;
+    const auto [routers, line] = routers_and_line(port);
     PlantThread a(routers);
     PlantThread b(line);
     tshark::Capture capture(port, "plant");
