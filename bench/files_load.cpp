@@ -30,50 +30,11 @@
 #include "plc/plc.hpp"
 #include "server/server.hpp"
 
+#include "echo_server.hpp"
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-// Answers every datagram with `reply_size` bytes.
-class Echo {
-  public:
-    explicit Echo(std::size_t reply_size) : reply_(reply_size, 0xC0) {
-        fd_ = ::socket(AF_INET, SOCK_DGRAM, 0);
-        sockaddr_in a{};
-        a.sin_family = AF_INET;
-        a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-        ::bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a);
-        socklen_t len = sizeof a;
-        ::getsockname(fd_, reinterpret_cast<sockaddr*>(&a), &len);
-        port_ = ntohs(a.sin_port);
-        thread_ = std::thread([this] {
-            std::array<std::uint8_t, 4096> buf{};
-            for (;;) {
-                sockaddr_storage peer{};
-                socklen_t n = sizeof peer;
-                const auto r = ::recvfrom(fd_, buf.data(), buf.size(), 0,
-                                          reinterpret_cast<sockaddr*>(&peer), &n);
-                if (r <= 0 || stop_) return;
-                ::sendto(fd_, reply_.data(), reply_.size(), 0, reinterpret_cast<sockaddr*>(&peer),
-                         n);
-            }
-        });
-    }
-    ~Echo() {
-        stop_ = true;
-        ::shutdown(fd_, SHUT_RDWR);
-        ::close(fd_);
-        thread_.join();
-    }
-    [[nodiscard]] std::uint16_t port() const { return port_; }
-
-  private:
-    std::vector<std::uint8_t> reply_;
-    int fd_ = -1;
-    std::uint16_t port_ = 0;
-    std::atomic<bool> stop_{false};
-    std::thread thread_;
-};
 
 int connect_udp(std::uint16_t port) {
     const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
@@ -119,7 +80,8 @@ double drive(std::uint16_t port, std::size_t count, std::size_t window, FrameOf 
 // `count` requests of `request_size` bytes, `window` in flight, to the echo: seconds.
 double drive_echo(std::size_t request_size, std::size_t reply_size, std::size_t count,
                   std::size_t window) {
-    Echo echo(reply_size);
+    // One recvfrom and one sendto per datagram (fins_load --udp-echo per-datagram).
+    fins_bench::EchoServer echo(false, request_size, reply_size, {.udp_batched = false});
     const std::vector<std::uint8_t> request(request_size, 0x80);
     return drive(
         echo.port(), count, window, [&](std::size_t) { return fins::Bytes{request}; }, false);
