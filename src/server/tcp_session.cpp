@@ -5,9 +5,11 @@
 #include <sys/socket.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstring>
 
 #include <spdlog/spdlog.h>
+#include <asio/post.hpp>
 #include <asio/write.hpp>
 
 #include "fins/frame.hpp"
@@ -17,8 +19,6 @@ namespace fins::server {
 
 namespace {
 
-// A refused peer may keep sending; past this many bytes it is closed without waiting.
-constexpr std::size_t drain_limit = 256 * 1024;
 // FINS header offsets of the source network and node (W342 3-3-3: ICF RSV GCT DNA DA1
 // DA2 SNA SA1 SA2 SID).
 constexpr std::size_t source_network_offset = 6;
@@ -26,39 +26,7 @@ constexpr std::size_t source_node_offset = 7;
 
 using quick_ack = asio::detail::socket_option::boolean<IPPROTO_TCP, TCP_QUICKACK>;
 
-// Must what the client sent be acknowledged now? When `buffer` ends inside a FINS/TCP
-// packet the client may be holding the rest (Nagle) until it is; when its last packet
-// is a frame that asks for no response, no answer will carry the ACK. Otherwise the
-// answer we are about to send carries it.
-bool needs_prompt_ack(Bytes buffer) noexcept {
-    bool answered = true;
-    while (!buffer.empty()) {
-        const TcpParse parsed = parse_tcp_frame(buffer);
-        if (parsed.status != TcpParse::Status::packet)
-            return parsed.status == TcpParse::Status::need_more;
-        answered = parsed.packet.command != static_cast<std::uint32_t>(TcpCommand::frame) ||
-                   parsed.packet.data.empty() || (parsed.packet.data[0] & icf_no_response) == 0;
-        buffer = buffer.subspan(parsed.consumed);
-    }
-    return !answered;
-}
-
 }  // namespace
-
-std::error_code set_keepalive(asio::ip::tcp::socket& socket, std::chrono::seconds idle) noexcept {
-    std::error_code ec;
-    socket.set_option(asio::socket_base::keep_alive(idle.count() > 0), ec);
-    if (ec || idle.count() <= 0) return ec;
-    const int fd = socket.native_handle();
-    const int idle_s = static_cast<int>(std::min<std::chrono::seconds::rep>(idle.count(), 32767));
-    const int interval_s = std::max(1, idle_s / 3);
-    const int probes = 3;
-    if (::setsockopt(fd, IPPROTO_TCP, TCP_KEEPIDLE, &idle_s, sizeof idle_s) != 0 ||
-        ::setsockopt(fd, IPPROTO_TCP, TCP_KEEPINTVL, &interval_s, sizeof interval_s) != 0 ||
-        ::setsockopt(fd, IPPROTO_TCP, TCP_KEEPCNT, &probes, sizeof probes) != 0)
-        return {errno, std::system_category()};
-    return {};
-}
 
 TcpSession::TcpSession(asio::ip::tcp::socket socket, Dispatcher& dispatcher, TcpNodeTable& nodes,
                        const TcpLimits& limits)
@@ -82,7 +50,7 @@ void TcpSession::start() {
     if (const auto ec = set_keepalive(socket_, limits_.keepalive))
         spdlog::debug("fins/tcp: keep-alive: {}", ec.message());
     set_deadline(Deadline::handshake, limits_.handshake_timeout);
-    read_more();
+    on_readable();
 }
 
 void TcpSession::close() {
@@ -97,71 +65,120 @@ void TcpSession::close() {
     socket_.close(ignored);
 }
 
-void TcpSession::read_more() {
-    auto self = shared_from_this();
-    socket_.async_read_some(
-        asio::buffer(in_.data() + in_size_, in_.size() - in_size_),
-        [self](std::error_code ec, std::size_t n) {
-            if (!self->open()) return;
-            if (ec) {
-                if (ec != asio::error::operation_aborted && ec != asio::error::eof)
-                    spdlog::debug("fins/tcp: read failed: {}", ec.message());
-                self->close();
-                return;
-            }
-            self->in_size_ += n;
-            // A client that writes the FINS/TCP header and the frame separately without
-            // TCP_NODELAY holds the frame until its header is acknowledged. Linux delays
-            // that ACK (~40 ms) once we answer promptly; quick-ack mode does not stick,
-            // so re-arm it after a read that no answer follows (issue 6 item 13).
-            if (needs_prompt_ack({self->in_.data(), self->in_size_})) {
-                std::error_code ignored;
-                self->socket_.set_option(quick_ack(true), ignored);
-            }
-            self->process();
-        });
+void TcpSession::wait_readable() {
+    socket_.async_wait(asio::socket_base::wait_read,
+                       [self = shared_from_this()](std::error_code ec) {
+                           if (ec == asio::error::operation_aborted) return;
+                           self->on_readable();
+                       });
 }
 
-void TcpSession::process() {
-    if (state_ != State::handshake && state_ != State::established) return;
-    const Bytes available{in_.data(), in_size_};
-    const TcpParse parsed = parse_tcp_frame(available);
-    switch (parsed.status) {
-        case TcpParse::Status::need_more:
-            // The handshake deadline runs from accept; afterwards a packet that has begun
-            // must end within frame_timeout, and silence is bounded by idle_timeout.
-            if (state_ == State::established) {
-                if (in_size_ == 0)
-                    set_deadline(Deadline::idle, limits_.idle_timeout);
-                else if (deadline_kind_ != Deadline::frame)
-                    set_deadline(Deadline::frame, limits_.frame_timeout);
-            }
-            // Keep the partial packet at the front so the next read appends to it.
-            read_more();
+void TcpSession::on_readable() {
+    const int fd = socket_.native_handle();
+    for (unsigned round = 0; round < rounds_per_turn; ++round) {
+        if (state_ != State::handshake && state_ != State::established) return;
+        // serve_buffered() leaves at most one partial packet, so there is room for one.
+        const std::size_t room = in_.size() - in_size_;
+        const ssize_t n = ::recv(fd, in_.data() + in_size_, room, MSG_DONTWAIT);
+        if (n < 0) {
+            if (errno == EINTR) continue;
+            if (errno == EAGAIN || errno == EWOULDBLOCK) break;
+            spdlog::debug("fins/tcp: read failed: {}", std::strerror(errno));
+            close();
             return;
-        case TcpParse::Status::error: {
+        }
+        if (n == 0) {  // the peer closed its side
+            close();
+            return;
+        }
+        in_size_ += static_cast<std::size_t>(n);
+        if (!serve_buffered()) return;
+        // A lone request is the one-in-flight client: the next cannot come before it has
+        // this answer, so reading again would only find nothing. The wait's re-arm
+        // (EPOLL_CTL_MOD) reports data that does come meanwhile.
+        if (served_ <= 1 && static_cast<std::size_t>(n) < room) break;
+        if (round + 1 == rounds_per_turn) {
+            // Still busy: let the other sessions' ready handlers run, then go on.
+            asio::post(socket_.get_executor(), [self = shared_from_this()] {
+                if (self->open()) self->on_readable();
+            });
+            return;
+        }
+    }
+    wait_readable();
+}
+
+void TcpSession::resume() {
+    if (serve_buffered()) on_readable();
+}
+
+bool TcpSession::serve_buffered() {
+    served_ = 0;
+    std::size_t start = 0;
+    bool go_on = true;
+    bool answered = true;  // the last packet brings an answer, which carries our ACK
+    while (go_on && (state_ == State::handshake || state_ == State::established)) {
+        const TcpParse parsed = parse_tcp_frame({in_.data() + start, in_size_ - start});
+        if (parsed.status == TcpParse::Status::need_more) break;
+        if (parsed.status == TcpParse::Status::error) {
             ByteWriter w{out_};
             write_tcp_error(w, TcpCommand::frame_error, parsed.error);
             spdlog::warn("fins/tcp: {}: envelope error {:#04x}, closing", peer_.to_string(),
                          static_cast<int>(parsed.error));
-            in_size_ = 0;
-            send_and_continue(w.size(), true);
-            return;
-        }
-        case TcpParse::Status::packet:
+            start = in_size_;
+            go_on = send_answer(w.size(), true);
             break;
+        }
+        const bool keep_open = handle_packet(parsed.packet);
+        answered = out_size_pending_ > 0;
+        start += parsed.consumed;
+        ++served_;
+        // A complete packet: what follows is a new packet with its own frame deadline.
+        if (state_ == State::established) deadline_kind_ = Deadline::idle;
+        if (out_size_pending_ > 0 || !keep_open) go_on = send_answer(out_size_pending_, !keep_open);
     }
-    const bool keep_open = handle_packet(parsed.packet);
-    // The packet's data view points into in_; only now may it move.
-    std::memmove(in_.data(), in_.data() + parsed.consumed, in_size_ - parsed.consumed);
-    in_size_ -= parsed.consumed;
-    // A complete packet: what follows is a new packet with its own frame deadline.
-    if (state_ == State::established) deadline_kind_ = Deadline::idle;
-    if (out_size_pending_ > 0 || !keep_open) {
-        send_and_continue(out_size_pending_, !keep_open);
-        return;
+    // The packets' data views pointed into in_; only now may the rest move to the front.
+    std::memmove(in_.data(), in_.data() + start, in_size_ - start);
+    in_size_ -= start;
+    if (!go_on || state_ != State::established) return go_on;
+    // The handshake deadline runs from accept; afterwards a packet that has begun must
+    // end within frame_timeout, and silence is bounded by idle_timeout.
+    if (in_size_ == 0)
+        set_deadline(Deadline::idle, limits_.idle_timeout);
+    else if (deadline_kind_ != Deadline::frame)
+        set_deadline(Deadline::frame, limits_.frame_timeout);
+    // A client that writes the FINS/TCP header and the frame separately without
+    // TCP_NODELAY holds the frame until its header is acknowledged, and a frame that
+    // asks for no response gets no answer to carry the ACK. Linux delays that ACK
+    // (~40 ms); quick-ack mode does not stick, so re-arm it (issue 6 item 13).
+    if (in_size_ > 0 || !answered) {
+        std::error_code ignored;
+        socket_.set_option(quick_ack(true), ignored);
     }
-    process();
+    return true;
+}
+
+bool TcpSession::send_answer(std::size_t size, bool close_after) {
+    if (close_after || writing_ || confirming_ || late_writing_) {
+        send_and_continue(size, close_after);
+        return false;
+    }
+    ssize_t sent = -1;
+    for (int attempt = 0; attempt < 4 && sent < 0; ++attempt) {
+        sent = ::send(socket_.native_handle(), out_.data(), size, MSG_DONTWAIT | MSG_NOSIGNAL);
+        if (sent < 0 && errno != EINTR) break;
+    }
+    if (sent == static_cast<ssize_t>(size)) return true;
+    if (sent < 0 && errno != EAGAIN && errno != EWOULDBLOCK) {
+        spdlog::debug("fins/tcp: write failed: {}", std::strerror(errno));
+        close();
+        return false;
+    }
+    // The send buffer is full: the rest goes out asynchronously, reading waits for it.
+    const std::size_t done = sent > 0 ? static_cast<std::size_t>(sent) : 0;
+    std::memmove(out_.data(), out_.data() + done, size - done);
+    send_and_continue(size - done, false);
+    return false;
 }
 
 bool TcpSession::handle_packet(const TcpPacket& packet) {
@@ -279,7 +296,7 @@ void TcpSession::send_and_continue(std::size_t size, bool close_after) {
                           } else if (!self->late_.empty()) {
                               self->write_late();
                           }
-                          self->process();
+                          self->resume();
                       });
 }
 
@@ -365,75 +382,6 @@ void TcpSession::write_late() {
                               self->write_late();
                           }
                       });
-}
-
-void TcpSession::close_after_notice() {
-    // The node is free at once; only the socket lingers while it drains.
-    nodes_.release(client_node_, this);
-    client_node_ = 0;
-    state_ = State::draining;
-    std::error_code ec;
-    socket_.shutdown(asio::ip::tcp::socket::shutdown_send, ec);
-    if (ec) {
-        close();
-        return;
-    }
-    set_deadline(Deadline::drain, limits_.drain_timeout);
-    drained_ = 0;
-    in_size_ = 0;
-    drain();
-}
-
-void TcpSession::drain() {
-    auto self = shared_from_this();
-    socket_.async_read_some(asio::buffer(in_), [self](std::error_code ec, std::size_t n) {
-        if (self->state_ != State::draining) return;
-        self->drained_ += n;
-        // End of the peer's data (it read our notice and closed), an error, or too much.
-        if (ec || self->drained_ > drain_limit) {
-            self->close();
-            return;
-        }
-        self->drain();
-    });
-}
-
-void TcpSession::set_deadline(Deadline kind, Clock::duration after) {
-    deadline_kind_ = kind;
-    if (after <= Clock::duration::zero()) {
-        deadline_ = Clock::time_point::max();  // idle_timeout 0: never
-        return;
-    }
-    deadline_ = Clock::now() + after;
-    if (!timer_armed_ || deadline_ < timer_at_) arm_timer(deadline_);
-}
-
-void TcpSession::arm_timer(Clock::time_point at) {
-    timer_at_ = at;
-    timer_armed_ = true;
-    const auto generation = ++timer_generation_;
-    timer_.expires_at(at);
-    auto self = shared_from_this();
-    timer_.async_wait([self, generation](std::error_code) {
-        // A newer arm or close() superseded this wait (its cancel may race the expiry).
-        if (generation != self->timer_generation_) return;
-        self->timer_armed_ = false;
-        self->on_timer();
-    });
-}
-
-void TcpSession::on_timer() {
-    if (!open() || deadline_ == Clock::time_point::max()) return;
-    if (Clock::now() < deadline_) {
-        arm_timer(deadline_);
-        return;
-    }
-    const char* what = deadline_kind_ == Deadline::handshake ? "handshake"
-                       : deadline_kind_ == Deadline::frame   ? "frame"
-                       : deadline_kind_ == Deadline::idle    ? "idle"
-                                                             : "drain";
-    spdlog::info("fins/tcp: {}: {} timeout, closing", peer_.to_string(), what);
-    close();
 }
 
 }  // namespace fins::server

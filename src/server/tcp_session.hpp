@@ -17,6 +17,14 @@
 // Limits (TcpLimits): a deadline for the handshake (from accept), for a packet once its
 // first byte arrived and for a response to be taken by the peer, an idle timeout and TCP
 // keep-alive. The server caps connections that have not finished the handshake.
+//
+// The request path does its own non-blocking I/O, as UdpSession does (issue 6 item 12):
+//   wait until readable (Asio) -> recv() what is there -> answer every complete packet,
+//   each with one send() of its own -> recv() again while requests keep coming (at most
+//   `rounds_per_turn` reads, then the other sessions' turn) -> wait again.
+// Asio's own reads and writes cost two extra polls of the reactor per request. Only an
+// answer the kernel does not take at once (a full send buffer) goes through an
+// asynchronous write; reading stops until it is written.
 #pragma once
 
 #include <array>
@@ -76,8 +84,17 @@ class TcpSession : public std::enable_shared_from_this<TcpSession>, private Repl
     enum class Deadline : std::uint8_t { handshake, frame, idle, drain };
     using Clock = std::chrono::steady_clock;
 
-    void read_more();
-    void process();
+    void wait_readable();
+    void on_readable();
+    // Answers the complete packets in in_ and keeps the partial one. False when serving
+    // must stop: an answer waits for an asynchronous write (whose completion resumes)
+    // or the connection is closing.
+    bool serve_buffered();
+    // After an asynchronous write: serve what is buffered, then read again.
+    void resume();
+    // Sends the first `size` bytes of out_ now when nothing else is being written. False
+    // when serving must stop (see serve_buffered).
+    bool send_answer(std::size_t size, bool close_after);
     // Returns false when the connection must close after `out_` is written.
     bool handle_packet(const TcpPacket& packet);
     bool handshake(const TcpPacket& packet);
@@ -118,6 +135,8 @@ class TcpSession : public std::enable_shared_from_this<TcpSession>, private Repl
     bool deferred_ = false;
     bool logged_foreign_source_ = false;  // one warning per connection
     std::size_t drained_ = 0;
+    std::size_t served_ = 0;  // packets answered by the last serve_buffered()
+    static constexpr unsigned rounds_per_turn = 8;
     // Room for two maximal packets so a read never has to wait for the parser.
     std::array<std::uint8_t, 2 * tcp_max_packet> in_{};
     std::size_t in_size_ = 0;

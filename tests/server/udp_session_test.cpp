@@ -26,6 +26,7 @@
 #include "fins/tcp.hpp"
 #include "server/frame_builder.hpp"
 #include "server/server.hpp"
+#include "server/tcp_peer.hpp"
 #include "server/udp_session.hpp"
 
 namespace fins::test {
@@ -121,65 +122,6 @@ TEST(UdpSession, BatchAnswersEachDatagramToItsOwnSenderInOrder) {
     EXPECT_EQ(session->counters().dropped, 0U);
     session->close();
 }
-
-// A FINS/TCP client by hand: handshake, then 1-word reads; every receive has a timeout.
-class TcpPeer {
-  public:
-    explicit TcpPeer(std::uint16_t port) {
-        fd_ = ::socket(AF_INET, SOCK_STREAM, 0);
-        set_timeouts(fd_, 5);
-        sockaddr_in a{};
-        a.sin_family = AF_INET;
-        a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-        a.sin_port = htons(port);
-        connected_ = ::connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
-    }
-    ~TcpPeer() { ::close(fd_); }
-    bool handshake() {
-        std::array<std::uint8_t, 24> buf{};
-        ByteWriter w{buf};
-        write_node_address_request(w, 0);
-        if (!connected_ || !send_all(buf.data(), w.size()) || !receive(buf.data(), 24))
-            return false;
-        node_ = buf[19];  // the client node the server gave us (frames 3.4)
-        return true;
-    }
-    // Sends one 1-word read, returns the end code (0xFFFF: no answer).
-    std::uint16_t read_word(std::uint8_t sid) {
-        FrameFields f;
-        f.service_id = sid;
-        f.destination = {0, 0, 0};
-        f.source = {0, node_, 0};
-        const auto frame = request_frame("0101 82000000 0001", f);
-        std::vector<std::uint8_t> packet(tcp_header_size + frame.size());
-        ByteWriter w{packet};
-        write_tcp_header(w, TcpCommand::frame, frame.size());
-        w.bytes(frame);
-        std::array<std::uint8_t, tcp_header_size + 16> in{};
-        if (!send_all(packet.data(), packet.size()) || !receive(in.data(), in.size()))
-            return 0xFFFF;
-        if (in[tcp_header_size + 9] != sid) return 0xFFFE;
-        return static_cast<std::uint16_t>((in[tcp_header_size + 12] << 8) |
-                                          in[tcp_header_size + 13]);
-    }
-
-  private:
-    bool send_all(const std::uint8_t* p, std::size_t n) {
-        return ::send(fd_, p, n, MSG_NOSIGNAL) == static_cast<ssize_t>(n);
-    }
-    bool receive(std::uint8_t* p, std::size_t n) {
-        while (n > 0) {
-            const ssize_t r = ::recv(fd_, p, n, 0);
-            if (r <= 0) return false;
-            p += r;
-            n -= static_cast<std::size_t>(r);
-        }
-        return true;
-    }
-    int fd_ = -1;
-    bool connected_ = false;
-    std::uint8_t node_ = 0;
-};
 
 TEST(UdpSession, FullSendBufferDropsRepliesWhileTcpKeepsBeingServed) {
     Harness h;
