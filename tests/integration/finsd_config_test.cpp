@@ -184,7 +184,7 @@ TEST(FinsdConfig, ConfigErrorsExit2NamingKeyAndLine) {
         {"[inject]\nfals = { number = 3, message = \"12345678901234567\" }\n",
          "bad.toml:2:1: ", "inject.fals.message: longer than 16 characters"},
         {"[network]\nudp = false\ntcp = false\n", "",
-         "network: udp and tcp are both off, nothing to serve"},
+         "network: udp and tcp are both off and no serial port is in hostlink mode"},
         {"profile = \n", "bad.toml:1:", ""},  // TOML syntax error
     };
     for (const auto& c : cases) {

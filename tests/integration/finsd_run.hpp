@@ -58,12 +58,13 @@ class Finsd {
         child_ = std::make_unique<Child>(argv);
         const std::string line = child_->read_line(std::chrono::seconds(20));
         if (line.rfind("listening ", 0) == 0) {
+            started_ = true;  // "listening 0": no network port (a serial-only PLC)
             port_ = static_cast<std::uint16_t>(std::stoul(line.substr(10)));
         } else {
             result_ = child_->wait(std::chrono::seconds(20));
         }
     }
-    [[nodiscard]] bool started() const { return port_ != 0; }
+    [[nodiscard]] bool started() const { return started_; }
     [[nodiscard]] std::uint16_t port() const { return port_; }
     [[nodiscard]] const RunResult& result() const { return result_; }
     [[nodiscard]] pid_t pid() const { return child_->pid(); }
@@ -86,6 +87,7 @@ class Finsd {
 
   private:
     std::unique_ptr<Child> child_;
+    bool started_ = false;
     std::uint16_t port_ = 0;
     RunResult result_;
 };

@@ -259,6 +259,23 @@ TEST(HostLinkClient, TypedErrorsFromTheLine) {
     EXPECT_EQ(second.error(), make_error_code(HostLinkError::bad_fcs));
 }
 
+// A PLC reached only through its serial port: UDP and TCP off is a real set-up then
+// (without a Host Link port it is refused: finsd_config_test).
+TEST(HostLinkFinsd, SerialOnlyPlcServesWithUdpAndTcpOff) {
+    PtyPair pty;
+    ASSERT_TRUE(pty.ok()) << "socat did not start";
+    Finsd finsd({"--no-udp", "--no-tcp", "--serial", "cpu=" + pty.a()});
+    ASSERT_TRUE(finsd.started()) << finsd.result().err;
+    EXPECT_EQ(finsd.port(), 0);  // "listening 0": no network port
+    auto c = Client::connect(serial_options(pty.b()));
+    ASSERT_TRUE(c) << c.error().message();
+    const std::vector<std::uint16_t> words{7, 8, 9};
+    ASSERT_TRUE((*c)->write_words(addr("D100"), words));
+    EXPECT_EQ(words_of(**c, "D100", 3), words);
+    c->reset();
+    EXPECT_EQ(finsd.stop().exit_code, 0);
+}
+
 TEST(HostLinkFinsd, VanishingPortIsLoggedOnceAndEthernetKeepsServing) {
     auto pty = std::make_unique<PtyPair>();
     ASSERT_TRUE(pty->ok());

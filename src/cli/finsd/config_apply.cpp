@@ -146,7 +146,14 @@ Expected<void> apply_overrides(const Overrides& o, Settings& s) {
 Expected<void> validate(const Settings& s) {
     if (plc::find_profile(s.profile) == nullptr)
         return error(fmt::format("profile: unknown '{}' (known: {})", s.profile, known_profiles()));
-    if (!s.udp && !s.tcp) return error("network: udp and tcp are both off, nothing to serve");
+    // A Host Link port answers FINS by itself: a serial-only PLC is a real set-up.
+    const bool host_link =
+        std::any_of(s.serial.begin(), s.serial.end(),
+                    [](const SerialPortConfig& p) { return p.mode == "hostlink"; });
+    if (!s.udp && !s.tcp && !host_link)
+        return error(
+            "network: udp and tcp are both off and no serial port is in hostlink mode, nothing "
+            "to serve");
     if (auto r = validate_serial(s.serial); !r) return r;
     static constexpr std::string_view levels[] = {"trace", "debug", "info", "warn", "error", "off"};
     if (std::find(std::begin(levels), std::end(levels), s.log_level) == std::end(levels))
