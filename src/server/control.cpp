@@ -252,12 +252,14 @@ Json handle(plc::Plc& plc, const Json& j) {
         if (!*on) {
             plc.files().remove_card();
         } else {
-            const auto kb = j.contains("kbytes") ? number(j, "kbytes") : std::nullopt;
-            if (j.contains("kbytes") && (!kb || *kb == 0 || *kb > 4194303))
-                return fail("\"kbytes\" must be 1-4194303");
             const std::uint32_t profile_kb = plc.profile().memory_card_kbytes;
-            plc.files().insert_card(kb ? static_cast<std::uint32_t>(*kb)
-                                       : (profile_kb != 0 ? profile_kb : 30720U));
+            std::uint32_t kbytes = profile_kb != 0 ? profile_kb : 30720U;
+            if (j.contains("kbytes")) {
+                const auto kb = number(j, "kbytes");
+                if (!kb || *kb == 0 || *kb > 4194303) return fail("\"kbytes\" must be 1-4194303");
+                kbytes = static_cast<std::uint32_t>(*kb);
+            }
+            plc.files().insert_card(kbytes);
         }
     } else if (cmd == "cassette") {
         // CP1H Memory Cassette (22 20 disk 8003): its files stay on the host while it is out.

@@ -62,8 +62,11 @@ bool transfer_area(std::uint8_t code) noexcept {
 }
 
 std::vector<std::uint8_t> with_header(Bytes data) {
-    std::vector<std::uint8_t> out(plc::data_file_header_size, 0);
-    out.insert(out.end(), data.begin(), data.end());
+    // Sized once (a header-sized vector grown by insert() also trips GCC 12's
+    // -Warray-bounds in Release builds).
+    std::vector<std::uint8_t> out(plc::data_file_header_size + data.size(), 0);
+    std::copy(data.begin(), data.end(),
+              out.begin() + static_cast<std::ptrdiff_t>(plc::data_file_header_size));
     return out;
 }
 
