@@ -196,6 +196,9 @@ int main(int argc, char** argv) {
                    "medians are printed")
         ->capture_default_str()
         ->check(CLI::Range(1u, 101u));
+    std::vector<std::string> cases;
+    app.add_option("--case", cases, "Run only these cases (default all)")
+        ->check(CLI::IsMember({"udp-1", "udp-32", "tcp-1", "tcp-32", "tcp-split-1"}));
     bool client_mode = false;
     app.add_flag("--client", client_mode,
                  "Drive finsd through fins::Client (32 in flight) next to the raw generator");
@@ -257,6 +260,10 @@ int main(int argc, char** argv) {
         const auto shapes = tcp ? std::vector<Shape>{{1, false}, {32, false}, {1, true}}
                                 : std::vector<Shape>{{1, false}, {32, false}};
         for (const auto [depth, split] : shapes) {
+            const std::string name =
+                fmt::format("{}{}-{}", tcp ? "tcp" : "udp", split ? "-split" : "", depth);
+            if (!cases.empty() && std::find(cases.begin(), cases.end(), name) == cases.end())
+                continue;
             EchoServer echo(tcp, f.request.size(), f.response_size,
                             {.udp_batched = udp_echo == "batched", .quickack = split});
             // Rounds alternate which side goes first, so a load that rises or falls during
