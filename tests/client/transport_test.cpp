@@ -3,6 +3,9 @@
 // FINS/TCP reader sees a packet split across reads.
 #include <gtest/gtest.h>
 
+#include <sys/socket.h>
+#include <sys/time.h>
+
 #include <algorithm>
 #include <array>
 #include <optional>
@@ -12,7 +15,6 @@
 #include <asio/ip/address.hpp>
 #include <asio/ip/tcp.hpp>
 #include <asio/ip/udp.hpp>
-#include <asio/read.hpp>
 #include <asio/write.hpp>
 
 #include "client/loopback_servers.hpp"
@@ -150,8 +152,13 @@ TEST(TcpTransport, SeesAPacketSplitAtEveryBytePosition) {
         acceptor.accept(server, ec);
     }
     ASSERT_TRUE(server.is_open());
+    // Plain recv() with a timeout: Asio's blocking read would poll past SO_RCVTIMEO.
+    const timeval five_seconds{5, 0};
+    ::setsockopt(server.native_handle(), SOL_SOCKET, SO_RCVTIMEO, &five_seconds,
+                 sizeof five_seconds);
     std::array<std::uint8_t, 20> hello{};
-    asio::read(server, asio::buffer(hello));
+    ASSERT_EQ(::recv(server.native_handle(), hello.data(), hello.size(), MSG_WAITALL),
+              static_cast<ssize_t>(hello.size()));
     std::array<std::uint8_t, 24> welcome{};
     ByteWriter hw(welcome);
     write_node_address_response(hw, 0x22, 10);
@@ -182,8 +189,8 @@ TEST(TcpTransport, SeesAPacketSplitAtEveryBytePosition) {
         ASSERT_TRUE(run_until_reads(reads + 2)) << split;
         ASSERT_EQ(frames.size(), split) << split;
         EXPECT_EQ(link.reads(), reads + 2) << "the client read the packet in two parts";
-        EXPECT_TRUE(std::equal(frames.back().begin(), frames.back().end(), frame.begin(),
-                               frame.end()));
+        EXPECT_TRUE(
+            std::equal(frames.back().begin(), frames.back().end(), frame.begin(), frame.end()));
     }
 }
 

@@ -6,14 +6,15 @@
 #include <sys/socket.h>
 #include <sys/time.h>
 
+#include <cerrno>
 #include <cstdint>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include <asio/connect.hpp>
 #include <asio/ip/tcp.hpp>
 #include <asio/ip/udp.hpp>
-#include <asio/read.hpp>
 #include <asio/write.hpp>
 
 #include "../fuzz/corpus_dump.hpp"
@@ -68,17 +69,13 @@ class RawTcp {
     // Reads one whole FINS/TCP packet; empty on EOF, error or timeout.
     std::vector<std::uint8_t> receive_packet() {
         std::vector<std::uint8_t> head(tcp_header_size);
-        std::error_code& ec = last_error_;
-        ec.clear();
-        asio::read(socket_, asio::buffer(head), ec);
-        if (ec) return {};
+        if (!read_exact(head.data(), head.size())) return {};
         const std::uint32_t length = (std::uint32_t{head[4]} << 24) |
                                      (std::uint32_t{head[5]} << 16) |
                                      (std::uint32_t{head[6]} << 8) | head[7];
         if (length < 8 || length > tcp_max_length) return head;
         std::vector<std::uint8_t> rest(length - 8);
-        asio::read(socket_, asio::buffer(rest), ec);
-        if (ec) return {};
+        if (!read_exact(rest.data(), rest.size())) return {};
         head.insert(head.end(), rest.begin(), rest.end());
         return head;
     }
@@ -90,12 +87,12 @@ class RawTcp {
         send(req);
         return receive_packet();
     }
-    // True when the server closed the connection (EOF) within the receive timeout.
+    // True when the server closed the connection (EOF or reset) within the receive
+    // timeout; false on a byte or on the timeout.
     bool closed_by_peer() {
         std::uint8_t b = 0;
-        std::error_code ec;
-        socket_.read_some(asio::buffer(&b, 1), ec);
-        return ec == asio::error::eof || ec == asio::error::connection_reset;
+        const ssize_t n = ::recv(socket_.native_handle(), &b, 1, 0);
+        return n == 0 || (n < 0 && errno == ECONNRESET);
     }
     void close() {
         std::error_code ec;
@@ -106,6 +103,29 @@ class RawTcp {
     [[nodiscard]] std::error_code last_error() const { return last_error_; }
 
   private:
+    // Plain recv(): Asio's blocking read turns SO_RCVTIMEO's EAGAIN into an endless
+    // poll(), which would hang a test instead of failing it.
+    bool read_exact(std::uint8_t* p, std::size_t n) {
+        last_error_.clear();
+        while (n > 0) {
+            const ssize_t r = ::recv(socket_.native_handle(), p, n, 0);
+            if (r == 0) {
+                last_error_ = asio::error::eof;
+                return false;
+            }
+            if (r < 0) {
+                if (errno == EINTR) continue;
+                last_error_ = errno == EAGAIN || errno == EWOULDBLOCK
+                                  ? std::make_error_code(std::errc::timed_out)
+                                  : std::error_code(errno, std::system_category());
+                return false;
+            }
+            p += r;
+            n -= static_cast<std::size_t>(r);
+        }
+        return true;
+    }
+
     asio::ip::tcp::socket socket_;
     std::error_code last_error_;
     std::vector<std::uint8_t> sent_;  // everything sent, for the fuzz corpus
