@@ -85,6 +85,40 @@ TEST(FinsdPlantConfig, ErrorsNameTheFilePositionAndKey) {
     EXPECT_FALSE(load("[[plc]]\nprofile = \"cj2h\"\n"));  // no name
 }
 
+TEST(FinsdPlantConfig, EachCpuUnitTakesAMemoryTableOfItsOwn) {
+    const auto s = load(R"(
+[[plc]]
+name = "a"
+  [plc.memory]
+  "D100" = 1
+  "W0.03" = true
+  "D200" = { float = 1.5 }
+[[plc]]
+name = "b"
+memory = { "D100" = [2, 3] }
+)");
+    ASSERT_TRUE(s) << s.error();
+    ASSERT_EQ(s->plant_memory.size(), 2u);
+    ASSERT_EQ(s->plant_memory[0].size(), 3u);  // in file order
+    EXPECT_EQ(s->plant_memory[0][0].key, "D100");
+    EXPECT_EQ(s->plant_memory[0][0].values, std::vector<std::uint32_t>{1});
+    EXPECT_EQ(s->plant_memory[0][1].values, std::vector<std::uint32_t>{1});
+    EXPECT_EQ(s->plant_memory[0][2].values, (std::vector<std::uint32_t>{0x0000, 0x3FC0}));
+    EXPECT_EQ(s->plant_memory[0][0].path, "plc[0].memory.\"D100\"");
+    EXPECT_EQ(s->plant_memory[1][0].values, (std::vector<std::uint32_t>{2, 3}));
+    EXPECT_TRUE(s->memory.empty());  // the top-level [memory] is another thing
+
+    const auto bad = load("[[plc]]\nname = \"a\"\n[plc.memory]\n\"Q5\" = 1\n");
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error(),
+              "plant.toml:4:1: plc[0].memory.\"Q5\": not a PLC address (e.g. D100, H0, "
+              "CIO10.13, E3_100)");
+    const auto not_table = load("[[plc]]\nname = \"a\"\nmemory = 5\n");
+    ASSERT_FALSE(not_table);
+    EXPECT_EQ(not_table.error(),
+              "plant.toml:3:10: plc[0].memory: must be a table of ADDRESS = value(s)");
+}
+
 TEST(FinsdPlantConfig, W420_5_2_AutomaticGenerationNeedsNodeEqualToTheLastOctet) {
     auto s = load("[[plc]]\nname = \"a\"\n[[plc.ethernet]]\nbind = \"127.0.1.5\"\nnode = 6\n");
     ASSERT_TRUE(s) << s.error();

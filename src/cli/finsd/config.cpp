@@ -22,21 +22,6 @@ namespace fins::cli::finsd {
 
 namespace {
 
-// A table's entries in file order (toml::table iterates in key order): the first
-// problem reported is the first in the file, and [memory] entries are written in the
-// order they are written down (later ones win where they overlap).
-std::vector<std::pair<const toml::key*, const toml::node*>> in_file_order(const toml::table& t) {
-    std::vector<std::pair<const toml::key*, const toml::node*>> entries;
-    for (auto&& [k, v] : t)
-        entries.emplace_back(&k, &v);
-    std::stable_sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
-        const auto& x = a.first->source().begin;
-        const auto& y = b.first->source().begin;
-        return x.line != y.line ? x.line < y.line : x.column < y.column;
-    });
-    return entries;
-}
-
 class Loader {
   public:
     Loader(std::string_view source, Settings& settings) : source_(source), s_(settings) {}
@@ -283,44 +268,9 @@ class Loader {
     }
 
     Expected<void> memory(const toml::key& key, const toml::node& node, const std::string&) {
-        const std::string p = "memory.\"" + std::string(key.str()) + "\"";
-        MemoryInit entry;
-        entry.key = std::string(key.str());
-        entry.where = position(key);
-        const auto address = parse_address(entry.key);
-        if (!address) return fail(key, p, "not a PLC address (e.g. D100, H0, CIO10.13, E3_100)");
-        entry.address = *address;
-        const bool bit = address->bit.has_value();
-        const bool wide = address->area == Area::index_register;
-        const std::int64_t hi = bit ? 1 : wide ? 0xFFFFFFFF : 0xFFFF;
-        const std::int64_t lo = bit ? 0 : wide ? std::numeric_limits<std::int32_t>::min() : -32768;
-        const auto element = [&](const toml::node& n) -> Expected<std::uint32_t> {
-            if (const auto* b = n.as_boolean(); b != nullptr && bit) return b->get() ? 1U : 0U;
-            if (const auto* i = n.as_integer(); i != nullptr && i->get() >= lo && i->get() <= hi)
-                return static_cast<std::uint32_t>(i->get());
-            return fail(key, p,
-                        bit ? "bit values are true/false (or 0/1)"
-                            : fmt::format("word values are integers {}..{}", lo, hi));
-        };
-        if (const auto* typed = node.as_table()) {
-            if (bit || wide)
-                return fail(key, p, "typed values ({ float = ... }) are for word addresses");
-            auto words = typed_words(*typed);
-            if (!words) return fail(key, p + words.error().path_suffix, words.error().message);
-            entry.values = std::move(*words);
-        } else if (const auto* list = node.as_array()) {
-            if (list->empty()) return fail(key, p, "empty array");
-            for (const auto& n : *list) {
-                const auto v = element(n);
-                if (!v) return tl::unexpected<Error>(v.error());
-                entry.values.push_back(*v);
-            }
-        } else {
-            const auto v = element(node);
-            if (!v) return tl::unexpected<Error>(v.error());
-            entry.values.push_back(*v);
-        }
-        s_.memory.push_back(std::move(entry));
+        auto entry = memory_entry(key, node, source_, "memory");
+        if (!entry) return tl::unexpected<Error>(entry.error());
+        s_.memory.push_back(std::move(*entry));
         return {};
     }
 

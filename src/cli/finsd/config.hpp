@@ -31,6 +31,7 @@ namespace fins::cli::finsd {
 struct MemoryInit {
     std::string key;    // as written, e.g. "D100" (for messages)
     std::string where;  // "file:line:column" of the entry
+    std::string path;   // its dotted key, e.g. memory."D100" or plc[1].memory."D100"
     Address address;
     // Element values: 0/1 for bits, 0-FFFF for words (negative -32768..-1 accepted as
     // two's complement), 0-FFFFFFFF for IR.
@@ -80,6 +81,9 @@ struct Settings {
     plc::Injections inject;                // [inject]
     std::vector<SerialPortConfig> serial;  // [serial], --serial (config_serial.hpp)
     server::PlantConfig plant;             // [[plc]] (config_plant.hpp); empty: one node
+    // Each [[plc]]'s memory table, in the order of plant.cpus (the server layer knows no
+    // config entries; serve_plant writes them into each CPU Unit).
+    std::vector<std::vector<MemoryInit>> plant_memory;
 
     // PLC-initiated messages (config_schedule.hpp).
     std::vector<server::RemoteNode> remotes;  // [[remote]]

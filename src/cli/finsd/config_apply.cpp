@@ -180,14 +180,13 @@ Expected<void> check_initial_memory(const std::vector<MemoryInit>& entries,
     for (const auto& e : entries) {
         const auto address = to_memory_address(e.address);
         if (!address)
-            return error(
-                fmt::format("{}: memory.\"{}\": {}", e.where, e.key, address.error().message()));
+            return error(fmt::format("{}: {}: {}", e.where, e.path, address.error().message()));
         const auto count = static_cast<std::uint32_t>(e.values.size());
         const auto range = memory.locate(*address, count, use_write, plc::Intent::write);
         if (!range)
-            return error(fmt::format(
-                "{}: memory.\"{}\": cannot be written on the {} ({} values): {}", e.where, e.key,
-                memory.profile().model, count, range.error().message()));
+            return error(fmt::format("{}: {}: cannot be written on the {} ({} values): {}", e.where,
+                                     e.path, memory.profile().model, count,
+                                     range.error().message()));
     }
     return {};
 }

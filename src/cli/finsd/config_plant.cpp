@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include "cli/finsd/config_values.hpp"
 #include "server/node_address_table.hpp"
 
 namespace fins::cli::finsd {
@@ -26,8 +27,10 @@ class PlantLoader {
             const std::string path = fmt::format("plc[{}]", i);
             if (table == nullptr) return fail((*array)[i].source(), path, "must be a table");
             PlantCpuConfig cpu;
-            if (auto r = load_cpu(*table, path, cpu); !r) return r;
+            std::vector<MemoryInit> memory;
+            if (auto r = load_cpu(*table, path, cpu, memory); !r) return r;
             settings.plant.cpus.push_back(std::move(cpu));
+            settings.plant_memory.push_back(std::move(memory));
         }
         return {};
     }
@@ -70,7 +73,8 @@ class PlantLoader {
         return {};
     }
 
-    Expected<void> load_cpu(const toml::table& t, const std::string& path, PlantCpuConfig& cpu) {
+    Expected<void> load_cpu(const toml::table& t, const std::string& path, PlantCpuConfig& cpu,
+                            std::vector<MemoryInit>& memory) {
         for (auto&& [k, v] : t) {
             const std::string key(k.str());
             const std::string p = path + "." + key;
@@ -114,6 +118,16 @@ class PlantLoader {
                     cpu.ports.push_back(std::move(port));
                     return Expected<void>{};
                 });
+            } else if (key == "memory") {
+                // As the top-level [memory]: entries written in file order.
+                const auto* table = v.as_table();
+                if (table == nullptr)
+                    return fail(v.source(), p, "must be a table of ADDRESS = value(s)");
+                for (const auto& [ek, ev] : in_file_order(*table)) {
+                    auto entry = memory_entry(*ek, *ev, source_, p);
+                    if (!entry) return tl::unexpected(entry.error());
+                    memory.push_back(std::move(*entry));
+                }
             } else if (key == "relay") {
                 r = tables(v, p, [&](const toml::table& e, const std::string& ep) {
                     return load_relay(e, ep, cpu);

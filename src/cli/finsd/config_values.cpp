@@ -89,4 +89,63 @@ tl::expected<WordList, TypedValueError> typed_words(const toml::table& t) {
     return out;
 }
 
+std::vector<std::pair<const toml::key*, const toml::node*>> in_file_order(const toml::table& t) {
+    std::vector<std::pair<const toml::key*, const toml::node*>> entries;
+    for (auto&& [k, v] : t)
+        entries.emplace_back(&k, &v);
+    std::stable_sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
+        const auto& x = a.first->source().begin;
+        const auto& y = b.first->source().begin;
+        return x.line != y.line ? x.line < y.line : x.column < y.column;
+    });
+    return entries;
+}
+
+Expected<MemoryInit> memory_entry(const toml::key& key, const toml::node& node,
+                                  std::string_view source, std::string_view prefix) {
+    const std::string p = fmt::format("{}.\"{}\"", prefix, key.str());
+    const auto fail = [&](const std::string& path, std::string_view message) {
+        return tl::unexpected<Error>(fmt::format("{}:{}:{}: {}: {}", source,
+                                                 key.source().begin.line, key.source().begin.column,
+                                                 path, message));
+    };
+    MemoryInit entry;
+    entry.key = std::string(key.str());
+    entry.path = p;
+    entry.where =
+        fmt::format("{}:{}:{}", source, key.source().begin.line, key.source().begin.column);
+    const auto address = parse_address(entry.key);
+    if (!address) return fail(p, "not a PLC address (e.g. D100, H0, CIO10.13, E3_100)");
+    entry.address = *address;
+    const bool bit = address->bit.has_value();
+    const bool wide = address->area == Area::index_register;
+    const std::int64_t hi = bit ? 1 : wide ? 0xFFFFFFFF : 0xFFFF;
+    const std::int64_t lo = bit ? 0 : wide ? std::numeric_limits<std::int32_t>::min() : -32768;
+    const auto element = [&](const toml::node& n) -> Expected<std::uint32_t> {
+        if (const auto* b = n.as_boolean(); b != nullptr && bit) return b->get() ? 1U : 0U;
+        if (const auto* i = n.as_integer(); i != nullptr && i->get() >= lo && i->get() <= hi)
+            return static_cast<std::uint32_t>(i->get());
+        return fail(p, bit ? "bit values are true/false (or 0/1)"
+                           : fmt::format("word values are integers {}..{}", lo, hi));
+    };
+    if (const auto* typed = node.as_table()) {
+        if (bit || wide) return fail(p, "typed values ({ float = ... }) are for word addresses");
+        auto words = typed_words(*typed);
+        if (!words) return fail(p + words.error().path_suffix, words.error().message);
+        entry.values = std::move(*words);
+    } else if (const auto* list = node.as_array()) {
+        if (list->empty()) return fail(p, "empty array");
+        for (const auto& n : *list) {
+            const auto v = element(n);
+            if (!v) return tl::unexpected<Error>(v.error());
+            entry.values.push_back(*v);
+        }
+    } else {
+        const auto v = element(node);
+        if (!v) return tl::unexpected<Error>(v.error());
+        entry.values.push_back(*v);
+    }
+    return entry;
+}
+
 }  // namespace fins::cli::finsd

@@ -40,7 +40,7 @@ int serve_plant(const Settings& s) {
     note(s.node != single.node, "node");
     note(s.network != single.network, "network");
     note(s.data_dir.has_value(), "data_dir");
-    note(!s.memory.empty(), "[memory]");
+    note(!s.memory.empty(), "[memory] (a [[plc]] takes a memory table of its own)");
     if (!ignored.empty())
         spdlog::warn(
             "finsd: {} set for a single node: a plant ([[plc]]) sets them per CPU "
@@ -52,6 +52,20 @@ int serve_plant(const Settings& s) {
         std::fprintf(stderr, "finsd: cannot start the plant: %s\n",
                      plant.error().message().c_str());
         return 3;
+    }
+    // Each [[plc]]'s memory table, as [memory] is for a single node: checked against that
+    // CPU Unit's model; retained memory is left alone when its state came from data_dir.
+    for (std::size_t i = 0; i < s.plant_memory.size() && i < (*plant)->cpu_count(); ++i) {
+        auto& plc = (*plant)->plc(i);
+        const auto& entries = s.plant_memory[i];
+        if (auto r = check_initial_memory(entries, plc.memory()); !r) {
+            std::fprintf(stderr, "finsd: %s\n", r.error().c_str());
+            return 2;
+        }
+        const auto written = apply_initial_memory(entries, plc.memory(), plc.storage().restored());
+        if (!entries.empty())
+            spdlog::info("finsd: plc \"{}\": {} memory entries written", s.plant.cpus[i].name,
+                         written);
     }
     // The control channel (`finsd ctl`) drives the first [[plc]] of the plant.
     std::unique_ptr<server::ControlServer> control;
