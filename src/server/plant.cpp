@@ -98,20 +98,62 @@ struct Plant::Impl {
     std::vector<Server*> by_port;  // the router's port index -> its server
 };
 
+namespace {
+
+// A CPU Unit on its state file (or the heap). A file refused for its content stops the
+// plant, naming the CPU Unit and the file, unless `reset_state` moves it aside (once),
+// as finsd --reset-state does for a single node.
+Result<std::unique_ptr<plc::Plc>> open_cpu(const PlantCpuConfig& c, const plc::Profile& profile,
+                                           bool reset_state) {
+    for (bool moved = false;;) {
+        std::error_code error;
+        std::unique_ptr<plc::Storage> storage;
+        if (c.data_dir) {
+            auto opened = plc::Storage::open(*c.data_dir, profile.name);
+            if (opened) storage = std::move(*opened);
+            if (!opened) error = opened.error();
+        }
+        if (!error) {
+            auto plc = std::make_unique<plc::Plc>(profile, std::move(storage));
+            const auto sealed = plc->storage().seal();
+            if (sealed) return plc;
+            error = sealed.error();
+        }  // the refused file is unmapped and unlocked here
+        const std::string file =
+            c.data_dir ? (*c.data_dir / "finsd.state").string() : std::string("(heap)");
+        const bool refused = plc::Storage::is_refusal(error);
+        if (!refused || !reset_state || moved) {
+            spdlog::error("finsd: plc \"{}\": {}: {}{}", c.name, file, error.message(),
+                          refused ? "; finsd never replaces it by itself: start with "
+                                    "--reset-state to move it aside and begin with empty "
+                                    "retained memory"
+                                  : "");
+            return Unexpected(error);
+        }
+        const auto aside = plc::Storage::set_aside(*c.data_dir);
+        if (!aside) {
+            spdlog::error("finsd: plc \"{}\": {}: cannot move it aside: {}", c.name, file,
+                          aside.error().message());
+            return Unexpected(aside.error());
+        }
+        spdlog::warn(
+            "finsd: plc \"{}\": {}: {}; --reset-state moved it to {}: retained memory "
+            "starts empty",
+            c.name, file, error.message(), aside->string());
+        moved = true;
+    }
+}
+
+}  // namespace
+
 Result<std::unique_ptr<Plant>> Plant::start(asio::io_context& io, const PlantConfig& config) {
     auto impl = std::make_unique<Impl>();
     impl->cpus.reserve(config.cpus.size());
     for (const auto& c : config.cpus) {
         const plc::Profile profile = *plc::find_profile(c.profile);
-        std::unique_ptr<plc::Storage> storage;
-        if (c.data_dir) {
-            auto opened = plc::Storage::open(*c.data_dir, profile.name);
-            if (!opened) return Unexpected(opened.error());
-            storage = std::move(*opened);
-        }
-        auto plc = std::make_unique<plc::Plc>(profile, std::move(storage));
-        if (auto sealed = plc->storage().seal(); !sealed) return Unexpected(sealed.error());
-        plc->change_mode(c.mode, std::chrono::system_clock::now());
+        auto plc = open_cpu(c, profile, config.reset_state);
+        if (!plc) return Unexpected(plc.error());
+        (*plc)->change_mode(c.mode, std::chrono::system_clock::now());
 
         plc::RoutingTables tables;
         tables.gateway_count = c.gateway_count;
@@ -120,10 +162,10 @@ Result<std::unique_ptr<Plant>> Plant::start(asio::io_context& io, const PlantCon
         for (const auto& r : c.relays)
             tables.relay[tables.relay_count++] = r;
         if (c.write_routing_tables)
-            plc::encode_routing_tables(tables, plc->parameters().words(plc::routing_table_area));
+            plc::encode_routing_tables(tables, (*plc)->parameters().words(plc::routing_table_area));
 
-        const auto cpu = impl->router.add_cpu(*plc, profile.nx_fixed_values);
-        impl->cpus.push_back(Impl::Cpu{c.name, std::move(plc), {}});
+        const auto cpu = impl->router.add_cpu(**plc, profile.nx_fixed_values);
+        impl->cpus.push_back(Impl::Cpu{c.name, std::move(*plc), {}});
         auto& owner = impl->cpus.back();
         for (const auto& p : c.ports) {
             const NodeAddress self{p.network, port_node(p), cpu_unit};

@@ -64,6 +64,9 @@ struct PlantCpuConfig {
 struct PlantConfig {
     std::vector<PlantCpuConfig> cpus;
     TcpLimits tcp_limits;
+    // A state file refused for its content is moved aside and started empty (finsd
+    // --reset-state); without it the plant does not start.
+    bool reset_state = false;
 };
 
 // Cross-field checks: names, unique unit numbers per CPU Unit (at most 16 ports),

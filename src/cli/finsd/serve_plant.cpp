@@ -18,6 +18,7 @@ int serve_plant(const Settings& s) {
     spdlog::set_level(spdlog::level::from_str(s.log_level));
     std::signal(SIGXFSZ, SIG_IGN);
     server::PlantConfig config = s.plant;
+    config.reset_state = s.reset_state;
     config.tcp_limits.handshake_timeout = std::chrono::seconds(s.tcp_handshake_timeout);
     config.tcp_limits.frame_timeout = std::chrono::seconds(s.tcp_frame_timeout);
     config.tcp_limits.idle_timeout = std::chrono::seconds(s.tcp_idle_timeout);

@@ -1,0 +1,83 @@
+// A plant's state files (README "A plant of several networks"): a file refused for its
+// content stops finsd (exit 3) naming the CPU Unit and the file; --reset-state moves it
+// aside and starts that CPU Unit with empty retained memory, as for a single node.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "fins/address.hpp"
+#include "finsd_run.hpp"
+
+namespace fins::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+bool has(const std::string& text, const std::string& part) {
+    return text.find(part) != std::string::npos;
+}
+
+Client* connect(std::unique_ptr<Client>& holder) {
+    ClientOptions o;
+    o.host = "127.0.63.1";
+    o.port = 9611;
+    o.timeout = std::chrono::milliseconds(3000);
+    auto c = Client::connect(o);
+    EXPECT_TRUE(c) << c.error().message();
+    if (c) holder = std::move(*c);
+    return holder.get();
+}
+
+TEST(PlantStateFile, RefusedFileNamesTheCpuUnitAndResetStateMovesItAside) {
+    ScratchDir dir("plant-state");
+    const fs::path data = dir.path() / "kept";
+    const fs::path file = data / "finsd.state";
+    const auto config = dir.write("plant.toml", R"(
+[[plc]]
+name = "kept"
+data_dir = ")" + data.string() + R"("
+  [[plc.ethernet]]
+  network = 1
+  bind = "127.0.63.1"
+  port = 9611
+)");
+    {
+        Finsd d({"--config", config});
+        ASSERT_TRUE(d.started()) << d.result().err;
+        std::unique_ptr<Client> c;
+        ASSERT_NE(connect(c), nullptr);
+        ASSERT_TRUE(c->write_words(*parse_address("D0"), std::vector<std::uint16_t>{0x1234}));
+        c.reset();
+        EXPECT_EQ(d.stop().exit_code, 0);
+    }
+    fs::resize_file(file, 0);
+    Finsd refused({"--config", config});
+    ASSERT_FALSE(refused.started());
+    EXPECT_EQ(refused.result().exit_code, 3);
+    const std::string& err = refused.result().err;
+    EXPECT_TRUE(has(err, "plc \"kept\": " + file.string() + ": ")) << err;
+    EXPECT_TRUE(has(err, "--reset-state")) << err;
+    EXPECT_EQ(fs::file_size(file), 0u);  // never replaced by itself
+
+    Finsd reset({"--config", config, "--reset-state"});
+    ASSERT_TRUE(reset.started()) << reset.result().err;
+    std::unique_ptr<Client> c;
+    ASSERT_NE(connect(c), nullptr);
+    const auto d0 = c->read_words(*parse_address("D0"), 1);
+    ASSERT_TRUE(d0) << d0.error().message();
+    EXPECT_EQ(*d0, std::vector<std::uint16_t>{0});
+    c.reset();
+    const auto stopped = reset.stop();
+    EXPECT_EQ(stopped.exit_code, 0);
+    EXPECT_TRUE(has(stopped.err, "--reset-state moved it to")) << stopped.err;
+    int aside = 0;
+    for (const auto& e : fs::directory_iterator(data))
+        if (e.path().filename().string().rfind("finsd.state.replaced-", 0) == 0) ++aside;
+    EXPECT_EQ(aside, 1);
+    EXPECT_GT(fs::file_size(file), 4096u);
+}
+
+}  // namespace
+}  // namespace fins::test
