@@ -49,6 +49,10 @@ std::optional<asio::ip::udp::endpoint> UdpInstructionTransport::resolve(
 
 InstructionTransport::Sent UdpInstructionTransport::send_frame(const NodeAddress& destination,
                                                                Bytes frame) {
+    const bool local = destination.network == local_network || destination.network == self_.network;
+    if (local && tcp_route_ && destination.node != 0 && destination.node != broadcast_node &&
+        tcp_route_(destination.node, frame))
+        return Sent::ok;
     if (!udp_ || !udp_->open()) return Sent::no_port;
     const auto to = resolve(destination);
     if (!to) return Sent::no_route;

@@ -1,6 +1,11 @@
 // Where a node's Send/Rcv/SendCmd frames go over FINS/UDP: from the node's own UDP
 // socket (its port, 9600 by default) to the remote node's IP address and port.
 //
+// First, FINS/TCP: a node of the local network that holds a FINS/TCP connection to this
+// node (it is the client of that connection) gets the frame on it, and its answer comes
+// back on it (W421 7-4 pairs each node with one connection; W596 3: with FINS/UDP off,
+// the instructions need an established FINS/TCP connection). Otherwise FINS/UDP:
+//
 // The remote's address (W596 2-3, frames section 2 "IP <-> FINS node address"):
 //   1. a [[remote]] entry for (network, node) of the config: its IP and port;
 //   2. else, on the local network (network 00 or this node's), automatic generation:
@@ -12,6 +17,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -41,6 +47,10 @@ class UdpInstructionTransport final : public InstructionTransport {
     UdpInstructionTransport(std::shared_ptr<UdpSession> udp, asio::ip::address local,
                             NodeAddress self, std::vector<RemoteNode> remotes);
     Sent send_frame(const NodeAddress& destination, Bytes frame) override;
+    // Puts `frame` on the FINS/TCP connection of client node `node`; false when no
+    // connection holds that node (or its queue is full). Set by the server.
+    using TcpRoute = std::function<bool(std::uint8_t node, Bytes frame)>;
+    void set_tcp_route(TcpRoute route) { tcp_route_ = std::move(route); }
     // The endpoint a frame for `destination` goes to, if any.
     [[nodiscard]] std::optional<asio::ip::udp::endpoint> resolve(
         const NodeAddress& destination) const;
@@ -55,6 +65,7 @@ class UdpInstructionTransport final : public InstructionTransport {
     asio::ip::address local_;
     NodeAddress self_;
     std::vector<Remote> remotes_;
+    TcpRoute tcp_route_;
 };
 
 }  // namespace fins::server

@@ -285,7 +285,8 @@ void NetworkInstructions::transmit(std::size_t index) {
                                                   "(see [[remote]])"));
     if (sent == InstructionTransport::Sent::no_port)
         return finish(index, communications_error(EndCode::local_node_not_in_network,
-                                                  "FINS/UDP is off on this node"));
+                                                  "FINS/UDP is off on this node and no FINS/TCP "
+                                                  "connection holds that node"));
     if (sent == InstructionTransport::Sent::failed && p.transmissions > p.request.options.retries)
         return finish(index,
                       communications_error(EndCode::retries_failed, "the frame could not be sent"));

@@ -69,6 +69,8 @@ struct Server::Impl {
             evict_oldest_pending();
             auto session =
                 std::make_shared<TcpSession>(std::move(socket), dispatcher, nodes, limits);
+            session->set_response_hook(
+                [engine = instructions.get()](Bytes frame) { return engine->on_response(frame); });
             sessions.push_back(session);
             session->start();
             accept_tcp();
@@ -124,6 +126,12 @@ struct Server::Impl {
         });
     }
 
+    // The frame on the FINS/TCP connection that holds client node `node`, if one does.
+    bool push_to_tcp_node(std::uint8_t node, Bytes frame) {
+        TcpSession* session = nodes.owner(node);
+        return session != nullptr && session->push_frame(frame);
+    }
+
     Dispatcher dispatcher;
     std::shared_ptr<UdpSession> udp;  // null without FINS/UDP
     // PLC-initiated messages: answers arriving at the UDP session go to `instructions`.
@@ -173,6 +181,9 @@ Result<std::unique_ptr<Server>> Server::start(asio::io_context& io, plc::Plc& pl
     }
     impl->transport =
         std::make_unique<UdpInstructionTransport>(impl->udp, ip, self, options.remotes);
+    impl->transport->set_tcp_route([raw = impl.get()](std::uint8_t client, Bytes frame) {
+        return raw->push_to_tcp_node(client, frame);
+    });
     impl->instructions =
         std::make_unique<NetworkInstructions>(io.get_executor(), plc, self, *impl->transport);
     if (impl->udp)
@@ -222,8 +233,7 @@ bool Server::send_datagram(Bytes frame, const std::array<std::uint8_t, 4>& ip,
 }
 
 bool Server::send_to_tcp_node(std::uint8_t node, Bytes frame) {
-    TcpSession* session = impl_->nodes.owner(node);
-    return session != nullptr && session->push_frame(frame);
+    return impl_->push_to_tcp_node(node, frame);
 }
 
 std::size_t Server::tcp_connections() const noexcept {

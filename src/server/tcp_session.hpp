@@ -32,6 +32,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -78,6 +79,10 @@ class TcpSession : public std::enable_shared_from_this<TcpSession>, private Repl
     // established or max_late frames already wait (the frame is dropped, as a full
     // send buffer drops a datagram). The same queue as the Serial Gateway's late answers.
     bool push_frame(Bytes frame);
+    // A response frame (ICF bit 6) from the client is offered to `hook` first (this
+    // node's Send/Rcv/SendCmd waiting for it); one it does not take goes on to the
+    // dispatcher, as on FINS/UDP.
+    void set_response_hook(std::function<bool(Bytes)> hook) { response_hook_ = std::move(hook); }
 
   private:
     enum class State : std::uint8_t { handshake, established, draining, closed };
@@ -147,6 +152,7 @@ class TcpSession : public std::enable_shared_from_this<TcpSession>, private Repl
     // port's queue fits).
     static constexpr std::size_t max_late = 64;
     std::deque<std::vector<std::uint8_t>> late_;
+    std::function<bool(Bytes)> response_hook_;
     bool late_writing_ = false;
 };
 

@@ -74,6 +74,28 @@ class TcpPeer {
                                           in[tcp_header_size + 13]);
     }
     [[nodiscard]] int fd() const noexcept { return fd_; }
+    // The client node the handshake gave this connection.
+    [[nodiscard]] std::uint8_t node() const noexcept { return node_; }
+    // One whole FINS/TCP packet (header and data); empty on EOF, error or timeout.
+    std::vector<std::uint8_t> receive_packet() {
+        std::vector<std::uint8_t> packet(tcp_header_size);
+        if (!receive(packet.data(), packet.size())) return {};
+        const std::uint32_t length = (std::uint32_t{packet[4]} << 24) |
+                                     (std::uint32_t{packet[5]} << 16) |
+                                     (std::uint32_t{packet[6]} << 8) | packet[7];
+        if (length < 8 || length > tcp_max_length) return {};
+        packet.resize(tcp_header_size + length - 8);
+        if (!receive(packet.data() + tcp_header_size, length - 8)) return {};
+        return packet;
+    }
+    // Sends `frame` in a FRAME SEND packet.
+    bool send_frame(const std::vector<std::uint8_t>& frame) {
+        std::vector<std::uint8_t> packet(tcp_header_size + frame.size());
+        ByteWriter w{packet};
+        write_tcp_header(w, TcpCommand::frame, frame.size());
+        w.bytes(frame);
+        return send_all(packet.data(), packet.size());
+    }
     bool send_all(const std::uint8_t* p, std::size_t n) {
         return ::send(fd_, p, n, MSG_NOSIGNAL) == static_cast<ssize_t>(n);
     }
