@@ -34,10 +34,7 @@ struct TcpOnlyNode {
     std::thread thread;
 
     TcpOnlyNode() {
-        server::ServerOptions options;
-        options.port = 0;
-        options.udp = false;
-        auto started = server::Server::start(io, h.plc, options);
+        auto started = start_tcp_only(io, h.plc);
         if (started) server = std::move(*started);
         thread = std::thread([this] { io.run(); });
     }

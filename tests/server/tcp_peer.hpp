@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <fmt/format.h>
@@ -17,8 +18,17 @@
 #include "fins/byte_io.hpp"
 #include "fins/tcp.hpp"
 #include "server/frame_builder.hpp"
+#include "server/server.hpp"
 
 namespace fins::test {
+
+// finsd on 127.0.0.1, an ephemeral port, FINS/UDP off: FINS/TCP is its only way in or out.
+inline Result<std::unique_ptr<server::Server>> start_tcp_only(asio::io_context& io, plc::Plc& plc) {
+    server::ServerOptions options;
+    options.port = 0;
+    options.udp = false;
+    return server::Server::start(io, plc, options);
+}
 
 class TcpPeer {
   public:

@@ -56,10 +56,7 @@ TEST(TcpSession, FullSendBufferKeepsEveryAnswerInOrderWhileOthersAreServed) {
     }
 
     asio::io_context io{1};
-    server::ServerOptions options;
-    options.port = 0;
-    options.udp = false;
-    auto server = server::Server::start(io, h.plc, options);
+    auto server = start_tcp_only(io, h.plc);
     ASSERT_TRUE(server.has_value());
     const std::uint16_t port = (*server)->tcp_port();
     struct Running {

@@ -126,10 +126,7 @@ TEST(UdpSession, BatchAnswersEachDatagramToItsOwnSenderInOrder) {
 TEST(UdpSession, FullSendBufferDropsRepliesWhileTcpKeepsBeingServed) {
     Harness h;
     asio::io_context io{1};
-    server::ServerOptions options;
-    options.port = 0;
-    options.udp = false;
-    auto tcp = server::Server::start(io, h.plc, options);
+    auto tcp = start_tcp_only(io, h.plc);
     ASSERT_TRUE(tcp.has_value());
     UnixPair pair;
     auto session = std::make_shared<UdpSession>(pair.server_end(io), h.dispatcher);
