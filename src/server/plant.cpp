@@ -116,6 +116,12 @@ Result<std::unique_ptr<plc::Plc>> open_cpu(const PlantCpuConfig& c, const plc::P
         if (!error) {
             auto plc = std::make_unique<plc::Plc>(profile, std::move(storage));
             const auto sealed = plc->storage().seal();
+            if (sealed && plc->storage().restored() && !plc->storage().checksums_verified())
+                spdlog::warn(
+                    "finsd: plc \"{}\": {} was not stopped cleanly (SIGKILL, crash or "
+                    "power loss): its header and section table are intact; its data "
+                    "has no valid checksums to check",
+                    c.name, plc->storage().path().string());
             if (sealed) return plc;
             error = sealed.error();
         }  // the refused file is unmapped and unlocked here

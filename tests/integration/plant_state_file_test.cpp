@@ -1,6 +1,7 @@
 // A plant's state files (README "A plant of several networks"): a file refused for its
 // content stops finsd (exit 3) naming the CPU Unit and the file; --reset-state moves it
 // aside and starts that CPU Unit with empty retained memory, as for a single node.
+#include <csignal>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -51,6 +52,22 @@ data_dir = ")" + data.string() + R"("
         ASSERT_TRUE(c->write_words(*parse_address("D0"), std::vector<std::uint16_t>{0x1234}));
         c.reset();
         EXPECT_EQ(d.stop().exit_code, 0);
+    }
+    {  // A SIGKILL leaves no checksums: the next start says so, naming the CPU Unit.
+        Finsd killed({"--config", config});
+        ASSERT_TRUE(killed.started()) << killed.result().err;
+        EXPECT_EQ(killed.stop(SIGKILL).exit_code, 128 + SIGKILL);
+        Finsd d({"--config", config});
+        ASSERT_TRUE(d.started()) << d.result().err;
+        std::unique_ptr<Client> c;
+        ASSERT_NE(connect(c), nullptr);
+        const auto d0 = c->read_words(*parse_address("D0"), 1);
+        ASSERT_TRUE(d0) << d0.error().message();
+        EXPECT_EQ(*d0, std::vector<std::uint16_t>{0x1234});
+        c.reset();
+        const auto stopped = d.stop();
+        EXPECT_TRUE(has(stopped.err, "plc \"kept\": " + file.string() + " was not stopped cleanly"))
+            << stopped.err;
     }
     fs::resize_file(file, 0);
     Finsd refused({"--config", config});
