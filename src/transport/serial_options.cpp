@@ -69,9 +69,13 @@ std::optional<std::string> apply_serial_key(SerialSpec& spec, std::string_view k
         if (s.empty() || end != s.c_str() + s.size() || !(v > 0.0) || v > 3600.0)
             return bad("seconds, more than 0 and at most 3600");
         spec.timeout_seconds = v;
+    } else if (keys == SerialKeys::port && key == "network") {
+        auto v = parse_unsigned(value);
+        if (!v || *v < 1 || *v > 127) return bad("FINS networks are 1-127");
+        spec.network = *v;
     } else {
         return fmt::format("unknown serial option '{}' (known: baud, parity, data, stop{})", key,
-                           keys == SerialKeys::port ? ", unit, mode, timeout" : "");
+                           keys == SerialKeys::port ? ", unit, mode, timeout, network" : "");
     }
     return std::nullopt;
 }

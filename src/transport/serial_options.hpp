@@ -21,11 +21,12 @@ struct SerialSpec {
     std::optional<unsigned> unit;           // Host Link unit number 0-31
     std::optional<std::string> mode;        // finsd ports: "hostlink", "gateway"
     std::optional<double> timeout_seconds;  // finsd gateway ports: response timeout
+    std::optional<unsigned> network;        // finsd gateway ports: FINS network behind
 };
 
 enum class SerialKeys {
     line,  // baud, parity, data, stop (fins --serial: the unit is --unit)
-    port,  // also unit, mode, timeout (finsd --serial)
+    port,  // also unit, mode, timeout, network (finsd --serial)
 };
 
 // Baud rates accepted (the CS/CJ serial ports' 300 .. 230,400 bit/s).

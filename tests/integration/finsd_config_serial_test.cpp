@@ -64,6 +64,10 @@ TEST(FinsdSerialConfig, ErrorsNameTheFlag) {
     EXPECT_EQ(error("scu0.1=/dev/x,timeout=30"),
               "--serial scu0.1=/dev/x,timeout=30: timeout '30': seconds, 0.1-25.5 (W336)");
     EXPECT_EQ(error("cpu="), "--serial cpu=: no serial device (e.g. /dev/ttyUSB0,baud=9600)");
+    EXPECT_EQ(error("scu0.1=/dev/x,network=128"),
+              "--serial scu0.1=/dev/x,network=128: network '128': FINS networks are 1-127");
+    EXPECT_EQ(error("scu0.1=/dev/x,network=0"),
+              "--serial scu0.1=/dev/x,network=0: network '0': FINS networks are 1-127");
 }
 
 TEST(FinsdSerialConfig, FileTableAndFlagsOverrideByName) {
@@ -118,6 +122,25 @@ TEST(FinsdSerialConfig, CrossChecks) {
     v = validate(t);
     ASSERT_FALSE(v);
     EXPECT_EQ(v.error(), "--serial: serial ports cpu and scu1.1 both use /dev/x");
+
+    // network= (W342 5-1-1): gateway ports only, one port per network, not our own.
+    const auto refused = [](std::vector<std::string> flags, std::uint8_t network = 0) {
+        Settings u;
+        u.network = network;
+        Overrides f;
+        f.serial = std::move(flags);
+        EXPECT_TRUE(apply_overrides(f, u));
+        const auto r = validate(u);
+        return r ? std::string{} : r.error();
+    };
+    EXPECT_EQ(refused({"scu1.1=/dev/a,network=5"}), "");
+    EXPECT_EQ(refused({"cpu=/dev/a,network=5"}),
+              "--serial: serial port cpu: network=5 is for gateway ports (the Host Link PLCs "
+              "behind them)");
+    EXPECT_EQ(refused({"scu1.1=/dev/a,network=5", "scu1.2=/dev/b,network=5"}),
+              "--serial: serial ports scu1.1 and scu1.2 both lead to network 5");
+    EXPECT_EQ(refused({"scu1.1=/dev/a,network=5"}, 5),
+              "--serial: serial port scu1.1: network=5 is this node's own network");
 }
 
 }  // namespace

@@ -133,6 +133,32 @@ TEST(FinsdSerialGateway, W342_5_1_1_HostLinkFinsThroughTheGatewayEndToEnd) {
     EXPECT_EQ(end_code(**nowhere, CommandCode{0x01, 0x01}, {0x82, 0, 100, 0, 0, 1}), 0x0201U);
 }
 
+// network= gives the serial path a FINS network number of its own (W342 5-1-1: with a
+// routing table the destination is that network); the unit address no longer is one.
+TEST(FinsdSerialGateway, W342_5_1_1_NetworkKeyNamesThePlcsBehindThePort) {
+    PtyPair line;
+    ASSERT_TRUE(line.ok());
+    Finsd plc_b({"--serial", "cpu=" + line.b() + ",unit=3"});
+    ASSERT_TRUE(plc_b.started()) << plc_b.result().err;
+    Finsd gateway_a({"--serial", "scu1.1=" + line.a() + ",timeout=3,network=5"});
+    ASSERT_TRUE(gateway_a.started()) << gateway_a.result().err;
+    ClientOptions o;
+    o.port = gateway_a.port();
+    o.destination = NodeAddress{5, 3 + 1, 0x00};
+    o.timeout = std::chrono::milliseconds(5000);
+    auto through = Client::connect(o);
+    ASSERT_TRUE(through.has_value()) << through.error().message();
+    const std::vector<std::uint16_t> values{0x0505};
+    ASSERT_TRUE((*through)->write_words(addr("D7"), values).has_value());
+    EXPECT_EQ(words_of(*plc_b.client(), "D7", 1), values);
+    // DNA 84 (the unit address) is not a way to it any more: a network this node does
+    // not reach answers 0201, as any other.
+    o.destination = NodeAddress{0x84, 3 + 1, 0x00};
+    auto old_way = Client::connect(o);
+    ASSERT_TRUE(old_way.has_value());
+    EXPECT_EQ(end_code(**old_way, CommandCode{0x01, 0x01}, {0x82, 0, 7, 0, 0, 1}), 0x0201U);
+}
+
 }  // namespace
 }  // namespace fins::test
 

@@ -155,6 +155,10 @@ Expected<void> validate(const Settings& s) {
             "network: udp and tcp are both off and no serial port is in hostlink mode, nothing "
             "to serve");
     if (auto r = validate_serial(s.serial); !r) return r;
+    for (const auto& p : s.serial)
+        if (p.network && s.network != 0 && *p.network == s.network)
+            return error(fmt::format("{}: serial port {}: network={} is this node's own network",
+                                     p.where, p.name, *p.network));
     static constexpr std::string_view levels[] = {"trace", "debug", "info", "warn", "error", "off"};
     if (std::find(std::begin(levels), std::end(levels), s.log_level) == std::end(levels))
         return error(fmt::format("log_level: '{}' is not trace, debug, info, warn, error or off",

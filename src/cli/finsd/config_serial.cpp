@@ -27,6 +27,7 @@ tl::expected<void, std::string> take_spec(SerialPortConfig& port,
             return Fail(fmt::format("mode '{}': not hostlink or gateway", *spec.mode));
         port.mode = *spec.mode;
     }
+    if (spec.network) port.network = *spec.network;
     if (spec.timeout_seconds) {
         if (*spec.timeout_seconds < min_serial_timeout ||
             *spec.timeout_seconds > max_serial_timeout)
@@ -171,7 +172,15 @@ tl::expected<void, std::string> validate_serial(const std::vector<SerialPortConf
                 fmt::format("{}: serial port cpu: mode '{}': the CPU Unit's port serves "
                             "Host Link only (mode=hostlink)",
                             p.where, p.mode));
+        if (p.network && p.mode != "gateway")
+            return Fail(
+                fmt::format("{}: serial port {}: network={} is for gateway ports (the "
+                            "Host Link PLCs behind them)",
+                            p.where, p.name, *p.network));
         for (std::size_t j = 0; j < i; ++j) {
+            if (p.network && ports[j].network == p.network)
+                return Fail(fmt::format("{}: serial ports {} and {} both lead to network {}",
+                                        p.where, ports[j].name, p.name, *p.network));
             if (ports[j].name == p.name)
                 return Fail(fmt::format("{}: serial port {} given twice", p.where, p.name));
             if (ports[j].line.device == p.line.device)

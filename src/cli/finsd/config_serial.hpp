@@ -21,6 +21,7 @@
 // file position: "--serial scu16.1=/dev/x: unit number 16: 0-F".
 #pragma once
 
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -42,6 +43,9 @@ struct SerialPortConfig {
     unsigned host_link_unit = 0;  // unit=
     std::string mode;             // "hostlink" or "gateway"
     double timeout_seconds = 5.0;
+    // network=: the FINS network of the Host Link PLCs behind a gateway port (W342 5-1-1,
+    // a routing table naming the serial path); none: the port's unit address.
+    std::optional<unsigned> network;
     std::string where;  // "--serial" or "file:line:column", for messages
 };
 

@@ -67,6 +67,7 @@ server::GatewayPortConfig gateway_port_config(const SerialPortConfig& port) {
                          : server::scu_port_unit_address(port.unit_number, port.port);
     c.line = port.line;
     c.timeout = std::chrono::milliseconds(std::lround(port.timeout_seconds * 1000.0));
+    if (port.network) c.network = static_cast<std::uint8_t>(*port.network);
     return c;
 }
 
