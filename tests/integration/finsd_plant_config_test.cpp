@@ -98,14 +98,14 @@ name = "b"
 memory = { "D100" = [2, 3] }
 )");
     ASSERT_TRUE(s) << s.error();
-    ASSERT_EQ(s->plant_memory.size(), 2u);
-    ASSERT_EQ(s->plant_memory[0].size(), 3u);  // in file order
-    EXPECT_EQ(s->plant_memory[0][0].key, "D100");
-    EXPECT_EQ(s->plant_memory[0][0].values, std::vector<std::uint32_t>{1});
-    EXPECT_EQ(s->plant_memory[0][1].values, std::vector<std::uint32_t>{1});
-    EXPECT_EQ(s->plant_memory[0][2].values, (std::vector<std::uint32_t>{0x0000, 0x3FC0}));
-    EXPECT_EQ(s->plant_memory[0][0].path, "plc[0].memory.\"D100\"");
-    EXPECT_EQ(s->plant_memory[1][0].values, (std::vector<std::uint32_t>{2, 3}));
+    ASSERT_EQ(s->plant_cpu.size(), 2u);
+    ASSERT_EQ(s->plant_cpu[0].memory.size(), 3u);  // in file order
+    EXPECT_EQ(s->plant_cpu[0].memory[0].key, "D100");
+    EXPECT_EQ(s->plant_cpu[0].memory[0].values, std::vector<std::uint32_t>{1});
+    EXPECT_EQ(s->plant_cpu[0].memory[1].values, std::vector<std::uint32_t>{1});
+    EXPECT_EQ(s->plant_cpu[0].memory[2].values, (std::vector<std::uint32_t>{0x0000, 0x3FC0}));
+    EXPECT_EQ(s->plant_cpu[0].memory[0].path, "plc[0].memory.\"D100\"");
+    EXPECT_EQ(s->plant_cpu[1].memory[0].values, (std::vector<std::uint32_t>{2, 3}));
     EXPECT_TRUE(s->memory.empty());  // the top-level [memory] is another thing
 
     const auto bad = load("[[plc]]\nname = \"a\"\n[plc.memory]\n\"Q5\" = 1\n");
@@ -117,6 +117,55 @@ memory = { "D100" = [2, 3] }
     ASSERT_FALSE(not_table);
     EXPECT_EQ(not_table.error(),
               "plant.toml:3:10: plc[0].memory: must be a table of ADDRESS = value(s)");
+}
+
+TEST(FinsdPlantConfig, EachCpuUnitTakesProtectionAndInjectionsOfItsOwn) {
+    const auto s = load(R"(
+[[plc]]
+name = "guarded"
+  [plc.protection]
+  network_write = "listed"
+  nodes = ["1.5"]
+  um_read = true
+  password = "secret"
+  [plc.inject]
+  battery_error = true
+  fal = [{ number = 12, message = "low level" }]
+[[plc]]
+name = "open"
+)");
+    ASSERT_TRUE(s) << s.error();
+    ASSERT_EQ(s->plant_cpu.size(), 2u);
+    const auto& guarded = s->plant_cpu[0];
+    EXPECT_EQ(guarded.network_write_protection.mode, plc::NetworkWriteProtection::listed);
+    ASSERT_EQ(guarded.network_write_protection.nodes.size(), 1u);
+    EXPECT_TRUE(guarded.um_read_protection);
+    EXPECT_EQ(guarded.um_password, "secret");
+    EXPECT_TRUE(guarded.inject.battery_error);
+    ASSERT_EQ(guarded.inject.fal.size(), 1u);
+    EXPECT_EQ(guarded.inject.fal[0].number, 12);
+    const auto& open = s->plant_cpu[1];
+    EXPECT_EQ(open.network_write_protection.mode, plc::NetworkWriteProtection::off);
+    EXPECT_FALSE(open.inject.battery_error);
+    // The top-level tables are the single node's, untouched.
+    EXPECT_FALSE(s->um_read_protection);
+    EXPECT_FALSE(s->inject.battery_error);
+
+    const auto bad_mode = load("[[plc]]\nname = \"a\"\n[plc.protection]\nnetwork_write = \"x\"\n");
+    ASSERT_FALSE(bad_mode);
+    EXPECT_EQ(bad_mode.error(),
+              "plant.toml:4:1: plc[0].protection.network_write: 'x' is not off, "
+              "all, listed or all-except-listed");
+    const auto bad_fal = load("[[plc]]\nname = \"a\"\n[plc.inject]\nfal = [{ number = 600 }]\n");
+    ASSERT_FALSE(bad_fal);
+    EXPECT_NE(bad_fal.error().find("plc[0].inject.fal[0].number: 600 is not 1-511"),
+              std::string::npos)
+        << bad_fal.error();
+    const auto listed_nothing =
+        load("[[plc]]\nname = \"a\"\n[plc.protection]\nnetwork_write = \"listed\"\n");
+    ASSERT_FALSE(listed_nothing);
+    EXPECT_NE(listed_nothing.error().find("protects nothing"), std::string::npos)
+        << listed_nothing.error();
 }
 
 TEST(FinsdPlantConfig, W420_5_2_AutomaticGenerationNeedsNodeEqualToTheLastOctet) {

@@ -344,17 +344,33 @@ class Loader {
         // 16 characters" becomes "inject.fal[0].message: longer than 16 characters".
         if (const auto e = plc::validate(in); !e.empty()) {
             const auto colon = std::min(e.find(": "), e.size());
-            return fail(key, "inject." + e.substr(0, colon),
+            // "inject." or "plc[N].inject.": the path up to this key.
+            const std::string section = p.substr(0, p.rfind('.') + 1);
+            return fail(key, section + e.substr(0, colon),
                         colon < e.size() ? std::string_view(e).substr(colon + 2) : "invalid");
         }
         return {};
     }
 
+  public:
+    // A [[plc]]'s own [protection] or [inject] table.
+    Expected<void> cpu_section(const toml::key& key, const toml::node& node, const std::string& p) {
+        if (key.str() == "protection") return section(key, node, p, &Loader::protection);
+        if (key.str() == "inject") return section(key, node, p, &Loader::inject);
+        return fail(key, p, "unknown key");
+    }
+
+  private:
     std::string_view source_;
     Settings& s_;
 };
 
 }  // namespace
+
+Expected<void> load_cpu_section(const toml::key& key, const toml::node& node,
+                                std::string_view source, const std::string& path, Settings& cpu) {
+    return Loader(source, cpu).cpu_section(key, node, path);
+}
 
 Expected<void> load_config_text(std::string_view text, std::string_view source,
                                 Settings& settings) {

@@ -81,9 +81,18 @@ struct Settings {
     plc::Injections inject;                // [inject]
     std::vector<SerialPortConfig> serial;  // [serial], --serial (config_serial.hpp)
     server::PlantConfig plant;             // [[plc]] (config_plant.hpp); empty: one node
-    // Each [[plc]]'s memory table, in the order of plant.cpus (the server layer knows no
-    // config entries; serve_plant writes them into each CPU Unit).
-    std::vector<std::vector<MemoryInit>> plant_memory;
+    // What each [[plc]] sets beyond server::PlantCpuConfig, in the order of plant.cpus
+    // (the server layer knows no config entries; serve_plant applies them).
+    struct PlantCpuSettings {
+        std::vector<MemoryInit> memory;  // [plc.memory]
+        // [plc.protection], as the single node's [protection]
+        plc::NetworkWriteProtectionSetting network_write_protection;
+        bool um_read_protection = false;
+        std::string um_password;
+        bool dip_write_protection = false;
+        plc::Injections inject;  // [plc.inject]
+    };
+    std::vector<PlantCpuSettings> plant_cpu;
 
     // PLC-initiated messages (config_schedule.hpp).
     std::vector<server::RemoteNode> remotes;  // [[remote]]
@@ -120,6 +129,11 @@ Expected<void> apply_overrides(const Overrides& overrides, Settings& settings);
 // Cross-field checks once everything is in: the profile exists, UDP or TCP is on, the
 // node list fits the mode, the injections are in range.
 Expected<void> validate(const Settings& settings);
+
+// One [[plc]] table's [protection] or [inject] (`key`), parsed exactly as the single
+// node's onto `cpu`; errors name `path` (e.g. plc[1].protection.network_write).
+Expected<void> load_cpu_section(const toml::key& key, const toml::node& node,
+                                std::string_view source, const std::string& path, Settings& cpu);
 
 // "program" / "monitor" / "run" (also "stop" for PROGRAM, as on the front panel).
 std::optional<plc::OperatingMode> parse_mode(std::string_view text) noexcept;

@@ -27,10 +27,10 @@ class PlantLoader {
             const std::string path = fmt::format("plc[{}]", i);
             if (table == nullptr) return fail((*array)[i].source(), path, "must be a table");
             PlantCpuConfig cpu;
-            std::vector<MemoryInit> memory;
-            if (auto r = load_cpu(*table, path, cpu, memory); !r) return r;
+            Settings::PlantCpuSettings extra;
+            if (auto r = load_cpu(*table, path, cpu, extra); !r) return r;
             settings.plant.cpus.push_back(std::move(cpu));
-            settings.plant_memory.push_back(std::move(memory));
+            settings.plant_cpu.push_back(std::move(extra));
         }
         return {};
     }
@@ -74,7 +74,7 @@ class PlantLoader {
     }
 
     Expected<void> load_cpu(const toml::table& t, const std::string& path, PlantCpuConfig& cpu,
-                            std::vector<MemoryInit>& memory) {
+                            Settings::PlantCpuSettings& extra) {
         for (auto&& [k, v] : t) {
             const std::string key(k.str());
             const std::string p = path + "." + key;
@@ -126,8 +126,27 @@ class PlantLoader {
                 for (const auto& [ek, ev] : in_file_order(*table)) {
                     auto entry = memory_entry(*ek, *ev, source_, p);
                     if (!entry) return tl::unexpected(entry.error());
-                    memory.push_back(std::move(*entry));
+                    extra.memory.push_back(std::move(*entry));
                 }
+            } else if (key == "protection" || key == "inject") {
+                // Parsed as the single node's tables, onto a scratch Settings.
+                Settings scratch;
+                scratch.inject = extra.inject;
+                scratch.network_write_protection = extra.network_write_protection;
+                scratch.um_read_protection = extra.um_read_protection;
+                scratch.um_password = extra.um_password;
+                scratch.dip_write_protection = extra.dip_write_protection;
+                if (auto rr = load_cpu_section(k, v, source_, p, scratch); !rr) return rr;
+                extra.network_write_protection = scratch.network_write_protection;
+                extra.um_read_protection = scratch.um_read_protection;
+                extra.um_password = scratch.um_password;
+                extra.dip_write_protection = scratch.dip_write_protection;
+                extra.inject = scratch.inject;
+                if (key == "protection" &&
+                    extra.network_write_protection.mode == plc::NetworkWriteProtection::listed &&
+                    extra.network_write_protection.nodes.empty())
+                    return fail(v.source(), p,
+                                "nodes: empty, so network_write = \"listed\" protects nothing");
             } else if (key == "relay") {
                 r = tables(v, p, [&](const toml::table& e, const std::string& ep) {
                     return load_relay(e, ep, cpu);

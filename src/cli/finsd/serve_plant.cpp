@@ -1,4 +1,6 @@
 // finsd with [[plc]] tables: the plant (server/plant.hpp) on one I/O thread.
+#include <algorithm>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <string>
@@ -8,6 +10,7 @@
 #include <asio/signal_set.hpp>
 
 #include "cli/finsd/config_plant.hpp"
+#include "plc/injections.hpp"
 #include "server/control.hpp"
 #include "server/router.hpp"
 #include "server/server.hpp"
@@ -42,6 +45,14 @@ int serve_plant(const Settings& s) {
     note(s.network != single.network, "network");
     note(s.data_dir.has_value(), "data_dir");
     note(!s.memory.empty(), "[memory] (a [[plc]] takes a memory table of its own)");
+    const bool injects = s.inject.battery_error || !s.inject.fal.empty() ||
+                         s.inject.fals.has_value() || !s.inject.errors.empty() ||
+                         std::any_of(s.inject.messages.begin(), s.inject.messages.end(),
+                                     [](const auto& m) { return m.has_value(); });
+    note(injects, "[inject] (a [[plc]] takes its own)");
+    note(s.network_write_protection.mode != single.network_write_protection.mode ||
+             s.um_read_protection || s.dip_write_protection || !s.um_password.empty(),
+         "[protection] (a [[plc]] takes its own)");
     if (!ignored.empty())
         spdlog::warn(
             "finsd: {} set for a single node: a plant ([[plc]]) sets them per CPU "
@@ -56,9 +67,10 @@ int serve_plant(const Settings& s) {
     }
     // Each [[plc]]'s memory table, as [memory] is for a single node: checked against that
     // CPU Unit's model; retained memory is left alone when its state came from data_dir.
-    for (std::size_t i = 0; i < s.plant_memory.size() && i < (*plant)->cpu_count(); ++i) {
+    for (std::size_t i = 0; i < s.plant_cpu.size() && i < (*plant)->cpu_count(); ++i) {
         auto& plc = (*plant)->plc(i);
-        const auto& entries = s.plant_memory[i];
+        const auto& cpu = s.plant_cpu[i];
+        const auto& entries = cpu.memory;
         if (auto r = check_initial_memory(entries, plc.memory()); !r) {
             std::fprintf(stderr, "finsd: %s\n", r.error().c_str());
             return 2;
@@ -67,6 +79,12 @@ int serve_plant(const Settings& s) {
         if (!entries.empty())
             spdlog::info("finsd: plc \"{}\": {} memory entries written", s.plant.cpus[i].name,
                          written);
+        // [plc.protection] and [plc.inject], as the single node's (main.cpp serve()).
+        plc.set_network_write_protection_setting(cpu.network_write_protection);
+        plc.set_um_read_protection(cpu.um_read_protection);
+        plc.set_um_password(cpu.um_password);
+        plc.set_dip_write_protection(cpu.dip_write_protection);
+        plc::apply(cpu.inject, plc, std::chrono::system_clock::now());
     }
     // The control channel (`finsd ctl`) drives the first [[plc]] of the plant.
     std::unique_ptr<server::ControlServer> control;

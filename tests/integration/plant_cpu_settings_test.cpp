@@ -1,0 +1,109 @@
+// Each [[plc]] of a plant takes a memory table, protections and injections of its own
+// (README "A plant of several networks"): finsd applies them to that CPU Unit at start,
+// and refuses a memory entry the CPU Unit's model cannot hold (exit 2, naming it).
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "fins/address.hpp"
+#include "finsd_run.hpp"
+
+namespace fins::test {
+namespace {
+
+// Two CPU Units, one Ethernet unit each, on loopback addresses no other test binds;
+// `b_extra` and `a_extra` are more keys and tables of each.
+std::string plant(const std::string& b_extra, const std::string& a_extra = "") {
+    return R"(
+[[plc]]
+name = "line-a"
+)" + a_extra +
+           R"(
+  [plc.memory]
+  "D100" = [11, 12]
+  "W3.04" = true
+  [[plc.ethernet]]
+  network = 1
+  bind = "127.0.61.1"
+  port = 9611
+[[plc]]
+name = "line-b"
+profile = "cj1m"
+)" + b_extra +
+           R"(
+  [[plc.ethernet]]
+  network = 2
+  bind = "127.0.62.1"
+  port = 9611
+)";
+}
+
+std::unique_ptr<Client> client_of(const std::string& host) {
+    ClientOptions o;
+    o.host = host;
+    o.port = 9611;
+    o.timeout = std::chrono::milliseconds(3000);
+    auto c = Client::connect(o);
+    EXPECT_TRUE(c) << c.error().message();
+    return c ? std::move(*c) : nullptr;
+}
+
+std::vector<std::uint16_t> words_at(const std::string& host, const std::string& address,
+                                    std::uint16_t count) {
+    auto c = client_of(host);
+    if (!c) return {};
+    auto got = c->read_words(*parse_address(address), count);
+    EXPECT_TRUE(got) << got.error().message();
+    return got ? *got : std::vector<std::uint16_t>{};
+}
+
+TEST(PlantCpuSettings, EachCpuUnitStartsWithItsOwnMemoryTable) {
+    ScratchDir dir("plant-memory");
+    Finsd d(
+        {"--config",
+         dir.write("plant.toml", plant("memory = { \"D100\" = 21, \"D101\" = { int16 = -2 } }"))});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    EXPECT_EQ(words_at("127.0.61.1", "D100", 2), (std::vector<std::uint16_t>{11, 12}));
+    EXPECT_EQ(words_at("127.0.61.1", "W3", 1), std::vector<std::uint16_t>{0x0010});
+    EXPECT_EQ(words_at("127.0.62.1", "D100", 2), (std::vector<std::uint16_t>{21, 0xFFFE}));
+    EXPECT_EQ(words_at("127.0.62.1", "W3", 1), std::vector<std::uint16_t>{0});
+}
+
+TEST(PlantCpuSettings, EntryTheCpuUnitCannotHoldIsRefusedWithItsName) {
+    ScratchDir dir("plant-memory");
+    // The CJ1M has no EM area: the entry is refused for line-b, naming it and the model.
+    const auto file = dir.write("plant.toml", plant("memory = { \"E0_0\" = 1 }"));
+    Finsd d({"--config", file});
+    ASSERT_FALSE(d.started());
+    EXPECT_EQ(d.result().exit_code, 2) << d.result().err;
+    EXPECT_NE(d.result().err.find("plc[1].memory.\"E0_0\": "), std::string::npos) << d.result().err;
+}
+
+TEST(PlantCpuSettings, EachCpuUnitHasItsOwnProtectionAndInjections) {
+    ScratchDir dir("plant-settings");
+    // line-a: network write protection for every node; line-b: a battery error.
+    const auto config = plant("  [plc.inject]\n  battery_error = true\n",
+                              "  [plc.protection]\n  network_write = \"all\"\n");
+    Finsd d({"--config", dir.write("plant.toml", config)});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    const std::vector<std::uint8_t> write_d0{0x82, 0, 0, 0, 0, 1, 0x12, 0x34};
+    auto a = client_of("127.0.61.1");
+    ASSERT_NE(a, nullptr);
+    EXPECT_EQ(end_code(*a, CommandCode{0x01, 0x02}, write_d0), 0x2102u);  // W342 5-1-2
+    auto b = client_of("127.0.62.1");
+    ASSERT_NE(b, nullptr);
+    // Written, with the battery error's flag on the answer (end code bit 6, W342 5-1-3);
+    // line-a has no error to flag.
+    const auto written = b->send_raw(CommandCode{0x01, 0x02}, write_d0);
+    ASSERT_TRUE(written) << written.error().message();
+    EXPECT_EQ(static_cast<unsigned>(written->code.end_code()), 0x0000u);
+    EXPECT_TRUE(written->code.non_fatal_cpu_error());
+    const std::vector<std::uint8_t> read_d0{0x82, 0, 0, 0, 0, 1};
+    const auto read = a->send_raw(CommandCode{0x01, 0x01}, read_d0);
+    ASSERT_TRUE(read) << read.error().message();
+    EXPECT_FALSE(read->code.non_fatal_cpu_error());
+}
+
+}  // namespace
+}  // namespace fins::test
