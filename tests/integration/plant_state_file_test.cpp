@@ -20,15 +20,23 @@ bool has(const std::string& text, const std::string& part) {
     return text.find(part) != std::string::npos;
 }
 
-Client* connect(std::unique_ptr<Client>& holder) {
+std::unique_ptr<Client> connect() {
     ClientOptions o;
     o.host = "127.0.63.1";
     o.port = 9611;
     o.timeout = std::chrono::milliseconds(3000);
     auto c = Client::connect(o);
     EXPECT_TRUE(c) << c.error().message();
-    if (c) holder = std::move(*c);
-    return holder.get();
+    return c ? std::move(*c) : nullptr;
+}
+
+// D0 of the plant's CPU Unit; 0xFFFF when it cannot be read.
+std::uint16_t d0() {
+    auto c = connect();
+    if (!c) return 0xFFFF;
+    const auto words = c->read_words(*parse_address("D0"), 1);
+    EXPECT_TRUE(words) << words.error().message();
+    return words && words->size() == 1 ? (*words)[0] : 0xFFFF;
 }
 
 TEST(PlantStateFile, RefusedFileNamesTheCpuUnitAndResetStateMovesItAside) {
@@ -47,8 +55,8 @@ data_dir = ")" + data.string() + R"("
     {
         Finsd d({"--config", config});
         ASSERT_TRUE(d.started()) << d.result().err;
-        std::unique_ptr<Client> c;
-        ASSERT_NE(connect(c), nullptr);
+        auto c = connect();
+        ASSERT_NE(c, nullptr);
         ASSERT_TRUE(c->write_words(*parse_address("D0"), std::vector<std::uint16_t>{0x1234}));
         c.reset();
         EXPECT_EQ(d.stop().exit_code, 0);
@@ -59,12 +67,7 @@ data_dir = ")" + data.string() + R"("
         EXPECT_EQ(killed.stop(SIGKILL).exit_code, 128 + SIGKILL);
         Finsd d({"--config", config});
         ASSERT_TRUE(d.started()) << d.result().err;
-        std::unique_ptr<Client> c;
-        ASSERT_NE(connect(c), nullptr);
-        const auto d0 = c->read_words(*parse_address("D0"), 1);
-        ASSERT_TRUE(d0) << d0.error().message();
-        EXPECT_EQ(*d0, std::vector<std::uint16_t>{0x1234});
-        c.reset();
+        EXPECT_EQ(d0(), 0x1234);
         const auto stopped = d.stop();
         EXPECT_TRUE(has(stopped.err, "plc \"kept\": " + file.string() + " was not stopped cleanly"))
             << stopped.err;
@@ -80,12 +83,7 @@ data_dir = ")" + data.string() + R"("
 
     Finsd reset({"--config", config, "--reset-state"});
     ASSERT_TRUE(reset.started()) << reset.result().err;
-    std::unique_ptr<Client> c;
-    ASSERT_NE(connect(c), nullptr);
-    const auto d0 = c->read_words(*parse_address("D0"), 1);
-    ASSERT_TRUE(d0) << d0.error().message();
-    EXPECT_EQ(*d0, std::vector<std::uint16_t>{0});
-    c.reset();
+    EXPECT_EQ(d0(), 0);
     const auto stopped = reset.stop();
     EXPECT_EQ(stopped.exit_code, 0);
     EXPECT_TRUE(has(stopped.err, "--reset-state moved it to")) << stopped.err;

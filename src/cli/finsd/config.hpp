@@ -38,7 +38,17 @@ struct MemoryInit {
     std::vector<std::uint32_t> values;
 };
 
-struct Settings {
+// What a CPU Unit is given at start that a plant's [[plc]] also sets for itself:
+// [protection] and [inject] (one loader, one apply_cpu_options for both).
+struct CpuUnitOptions {
+    plc::NetworkWriteProtectionSetting network_write_protection;
+    bool um_read_protection = false;
+    std::string um_password;            // [protection] password: releases UM read protection (ctl)
+    bool dip_write_protection = false;  // DIP switch pin 1 ON
+    plc::Injections inject;             // [inject]
+};
+
+struct Settings : CpuUnitOptions {
     std::string profile = "cj2h";
     plc::OperatingMode mode = plc::OperatingMode::run;
     std::optional<std::filesystem::path> data_dir;
@@ -60,12 +70,6 @@ struct Settings {
     unsigned tcp_keepalive = 60;
     std::size_t tcp_max_pending = 16;
 
-    // [protection]
-    plc::NetworkWriteProtectionSetting network_write_protection;
-    bool um_read_protection = false;
-    std::string um_password;            // [protection] password: releases UM read protection (ctl)
-    bool dip_write_protection = false;  // DIP switch pin 1 ON
-
     // [storage]
     plc::Durability durability = plc::Durability::process;
     bool reset_state = false;  // --reset-state only: a refused state file is moved aside
@@ -78,19 +82,12 @@ struct Settings {
     std::optional<bool> cassette;
 
     std::vector<MemoryInit> memory;        // [memory]
-    plc::Injections inject;                // [inject]
     std::vector<SerialPortConfig> serial;  // [serial], --serial (config_serial.hpp)
     server::PlantConfig plant;             // [[plc]] (config_plant.hpp); empty: one node
     // What each [[plc]] sets beyond server::PlantCpuConfig, in the order of plant.cpus
     // (the server layer knows no config entries; serve_plant applies them).
-    struct PlantCpuSettings {
-        std::vector<MemoryInit> memory;  // [plc.memory]
-        // [plc.protection], as the single node's [protection]
-        plc::NetworkWriteProtectionSetting network_write_protection;
-        bool um_read_protection = false;
-        std::string um_password;
-        bool dip_write_protection = false;
-        plc::Injections inject;  // [plc.inject]
+    struct PlantCpuSettings : CpuUnitOptions {  // [plc.protection], [plc.inject]
+        std::vector<MemoryInit> memory;         // [plc.memory]
     };
     std::vector<PlantCpuSettings> plant_cpu;
 
@@ -129,6 +126,9 @@ Expected<void> apply_overrides(const Overrides& overrides, Settings& settings);
 // Cross-field checks once everything is in: the profile exists, UDP or TCP is on, the
 // node list fits the mode, the injections are in range.
 Expected<void> validate(const Settings& settings);
+
+// Protections and injections onto the model at start (after the mode is set).
+void apply_cpu_options(const CpuUnitOptions& options, plc::Plc& plc);
 
 // One [[plc]] table's [protection] or [inject] (`key`), parsed exactly as the single
 // node's onto `cpu`; errors name `path` (e.g. plc[1].protection.network_write).

@@ -2,6 +2,7 @@
 // the [memory] initial values (config.hpp).
 #include <algorithm>
 #include <charconv>
+#include <chrono>
 
 #include <fmt/format.h>
 
@@ -233,6 +234,14 @@ std::size_t apply_initial_memory(const std::vector<MemoryInit>& entries, plc::Io
         if (memory.write(*range, data) == EndCode::normal_completion) ++written;
     }
     return written;
+}
+
+void apply_cpu_options(const CpuUnitOptions& options, plc::Plc& plc) {
+    plc.set_network_write_protection_setting(options.network_write_protection);
+    plc.set_um_read_protection(options.um_read_protection);
+    plc.set_um_password(options.um_password);
+    plc.set_dip_write_protection(options.dip_write_protection);
+    plc::apply(options.inject, plc, std::chrono::system_clock::now());
 }
 
 }  // namespace fins::cli::finsd

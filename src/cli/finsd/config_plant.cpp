@@ -131,17 +131,9 @@ class PlantLoader {
             } else if (key == "protection" || key == "inject") {
                 // Parsed as the single node's tables, onto a scratch Settings.
                 Settings scratch;
-                scratch.inject = extra.inject;
-                scratch.network_write_protection = extra.network_write_protection;
-                scratch.um_read_protection = extra.um_read_protection;
-                scratch.um_password = extra.um_password;
-                scratch.dip_write_protection = extra.dip_write_protection;
+                static_cast<CpuUnitOptions&>(scratch) = extra;
                 if (auto rr = load_cpu_section(k, v, source_, p, scratch); !rr) return rr;
-                extra.network_write_protection = scratch.network_write_protection;
-                extra.um_read_protection = scratch.um_read_protection;
-                extra.um_password = scratch.um_password;
-                extra.dip_write_protection = scratch.dip_write_protection;
-                extra.inject = scratch.inject;
+                static_cast<CpuUnitOptions&>(extra) = scratch;
                 if (key == "protection" &&
                     extra.network_write_protection.mode == plc::NetworkWriteProtection::listed &&
                     extra.network_write_protection.nodes.empty())

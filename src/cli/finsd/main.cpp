@@ -294,11 +294,7 @@ int serve(const Settings& s) {
     const auto written = apply_initial_memory(s.memory, plc.memory(), restored);
     if (!s.memory.empty()) spdlog::info("finsd: {} [memory] entries written", written);
     plc.change_mode(s.mode, std::chrono::system_clock::now());
-    plc.set_network_write_protection_setting(s.network_write_protection);
-    plc.set_um_read_protection(s.um_read_protection);
-    plc.set_um_password(s.um_password);
-    plc.set_dip_write_protection(s.dip_write_protection);
-    fins::plc::apply(s.inject, plc, std::chrono::system_clock::now());
+    fins::cli::finsd::apply_cpu_options(s, plc);
     // File memory (22 xx): <data_dir>/card and <data_dir>/em; else a temp dir removed at exit.
     if (s.card_kbytes) {
         if (*s.card_kbytes == 0)

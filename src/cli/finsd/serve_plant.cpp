@@ -79,12 +79,7 @@ int serve_plant(const Settings& s) {
         if (!entries.empty())
             spdlog::info("finsd: plc \"{}\": {} memory entries written", s.plant.cpus[i].name,
                          written);
-        // [plc.protection] and [plc.inject], as the single node's (main.cpp serve()).
-        plc.set_network_write_protection_setting(cpu.network_write_protection);
-        plc.set_um_read_protection(cpu.um_read_protection);
-        plc.set_um_password(cpu.um_password);
-        plc.set_dip_write_protection(cpu.dip_write_protection);
-        plc::apply(cpu.inject, plc, std::chrono::system_clock::now());
+        apply_cpu_options(cpu, plc);  // [plc.protection], [plc.inject]
     }
     // The control channel (`finsd ctl`) drives the first [[plc]] of the plant.
     std::unique_ptr<server::ControlServer> control;
