@@ -56,4 +56,32 @@ void Plc::change_mode(OperatingMode mode, std::chrono::system_clock::time_point 
     mode_ = mode;
 }
 
+tl::expected<OpenedPlc, PlcOpenError> open_plc(const Profile& profile,
+                                               const std::optional<std::filesystem::path>& data_dir,
+                                               StorageOptions options, bool reset_state) {
+    OpenedPlc opened;
+    for (;;) {
+        std::error_code error;
+        std::unique_ptr<Storage> storage;
+        if (data_dir) {
+            auto file = Storage::open(*data_dir, profile.name, options);
+            if (file) storage = std::move(*file);
+            if (!file) error = file.error();
+        }
+        if (!error) {
+            opened.plc = std::make_unique<Plc>(profile, std::move(storage));
+            const auto sealed = opened.plc->storage().seal();
+            if (sealed) return opened;
+            error = sealed.error();
+            opened.plc.reset();  // unmaps and unlocks the refused file
+        }
+        if (!Storage::is_refusal(error) || !reset_state || opened.moved_aside)
+            return tl::unexpected(PlcOpenError{error});
+        auto aside = Storage::set_aside(*data_dir);
+        if (!aside) return tl::unexpected(PlcOpenError{aside.error(), true});
+        opened.moved_aside = std::move(*aside);
+        opened.refusal = error;
+    }
+}
+
 }  // namespace fins::plc

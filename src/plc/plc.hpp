@@ -10,10 +10,13 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include <tl/expected.hpp>
 
 #include "fins/frame.hpp"
 #include "plc/clock.hpp"
@@ -150,5 +153,22 @@ class Plc {
     std::string um_password_;
     bool dip_write_protection_ = false;
 };
+
+// A CPU Unit on its state file in `data_dir` (on the heap without one), sealed. A file
+// refused for its content (Storage::is_refusal) fails, unless `reset_state`: then it is
+// moved aside once and the CPU Unit starts with empty retained memory. The finsd of one
+// node and each CPU Unit of a plant open through here and only word the outcome.
+struct OpenedPlc {
+    std::unique_ptr<Plc> plc;
+    std::optional<std::filesystem::path> moved_aside;  // where the refused file went
+    std::error_code refusal;                           // why it was refused
+};
+struct PlcOpenError {
+    std::error_code error;
+    bool setting_aside = false;  // the refused file could not be moved aside
+};
+tl::expected<OpenedPlc, PlcOpenError> open_plc(const Profile& profile,
+                                               const std::optional<std::filesystem::path>& data_dir,
+                                               StorageOptions options, bool reset_state);
 
 }  // namespace fins::plc

@@ -100,54 +100,40 @@ struct Plant::Impl {
 
 namespace {
 
-// A CPU Unit on its state file (or the heap). A file refused for its content stops the
-// plant, naming the CPU Unit and the file, unless `reset_state` moves it aside (once),
-// as finsd --reset-state does for a single node.
+// A CPU Unit on its state file (plc::open_plc), each outcome in a line naming the CPU
+// Unit and the file, as finsd --reset-state words them for a single node.
 Result<std::unique_ptr<plc::Plc>> open_cpu(const PlantCpuConfig& c, const plc::Profile& profile,
                                            bool reset_state) {
-    for (bool moved = false;;) {
-        std::error_code error;
-        std::unique_ptr<plc::Storage> storage;
-        if (c.data_dir) {
-            auto opened = plc::Storage::open(*c.data_dir, profile.name);
-            if (opened) storage = std::move(*opened);
-            if (!opened) error = opened.error();
-        }
-        if (!error) {
-            auto plc = std::make_unique<plc::Plc>(profile, std::move(storage));
-            const auto sealed = plc->storage().seal();
-            if (sealed && plc->storage().restored() && !plc->storage().checksums_verified())
-                spdlog::warn(
-                    "finsd: plc \"{}\": {} was not stopped cleanly (SIGKILL, crash or "
-                    "power loss): its header and section table are intact; its data "
-                    "has no valid checksums to check",
-                    c.name, plc->storage().path().string());
-            if (sealed) return plc;
-            error = sealed.error();
-        }  // the refused file is unmapped and unlocked here
-        const std::string file =
-            c.data_dir ? (*c.data_dir / "finsd.state").string() : std::string("(heap)");
-        const bool refused = plc::Storage::is_refusal(error);
-        if (!refused || !reset_state || moved) {
-            spdlog::error("finsd: plc \"{}\": {}: {}{}", c.name, file, error.message(),
-                          refused ? "; finsd never replaces it by itself: start with "
-                                    "--reset-state to move it aside and begin with empty "
-                                    "retained memory"
-                                  : "");
-            return Unexpected(error);
-        }
-        const auto aside = plc::Storage::set_aside(*c.data_dir);
-        if (!aside) {
+    auto opened = plc::open_plc(profile, c.data_dir, {}, reset_state);
+    const std::string file =
+        c.data_dir ? (*c.data_dir / "finsd.state").string() : std::string("(heap)");
+    if (!opened) {
+        const std::error_code error = opened.error().error;
+        if (opened.error().setting_aside)
             spdlog::error("finsd: plc \"{}\": {}: cannot move it aside: {}", c.name, file,
-                          aside.error().message());
-            return Unexpected(aside.error());
-        }
+                          error.message());
+        else
+            spdlog::error("finsd: plc \"{}\": {}: {}{}", c.name, file, error.message(),
+                          plc::Storage::is_refusal(error)
+                              ? "; finsd never replaces it by itself: start with "
+                                "--reset-state to move it aside and begin with empty "
+                                "retained memory"
+                              : "");
+        return Unexpected(error);
+    }
+    if (opened->moved_aside)
         spdlog::warn(
             "finsd: plc \"{}\": {}: {}; --reset-state moved it to {}: retained memory "
             "starts empty",
-            c.name, file, error.message(), aside->string());
-        moved = true;
-    }
+            c.name, file, opened->refusal.message(), opened->moved_aside->string());
+    auto& storage = opened->plc->storage();
+    if (storage.restored() && !storage.checksums_verified())
+        spdlog::warn(
+            "finsd: plc \"{}\": {} was not stopped cleanly (SIGKILL, crash or power "
+            "loss): its header and section table are intact; its data has no valid "
+            "checksums to check",
+            c.name, storage.path().string());
+    return std::move(opened->plc);
 }
 
 }  // namespace

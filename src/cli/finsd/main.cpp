@@ -220,49 +220,38 @@ int configure(int argc, char** argv, Settings& settings) {
     return -1;
 }
 
-// The PLC on its state file (or the heap) into `plc`; -1, or the exit code. A state
-// file refused for its content stops finsd unless --reset-state moves it aside (once).
+// The PLC on its state file (or the heap) into `plc` (plc::open_plc); -1, or the exit
+// code. A state file refused for its content stops finsd unless --reset-state.
 int open_plc(const Settings& s, const fins::plc::Profile& profile,
              std::unique_ptr<fins::plc::Plc>& plc) {
     using fins::plc::Storage;
-    for (bool moved = false;;) {
-        std::error_code error;
-        std::unique_ptr<Storage> storage;
-        if (s.data_dir) {
-            auto opened = Storage::open(*s.data_dir, profile.name, {s.durability});
-            if (opened) storage = std::move(*opened);
-            if (!opened) error = opened.error();
-        }
-        if (!error) {
-            plc = std::make_unique<fins::plc::Plc>(profile, std::move(storage));
-            const auto sealed = plc->storage().seal();
-            if (sealed) return -1;
-            error = sealed.error();
-            plc.reset();  // unmaps and unlocks the refused file
-        }
-        const std::string file =
-            s.data_dir ? (*s.data_dir / "finsd.state").string() : std::string("(heap)");
+    auto opened = fins::plc::open_plc(profile, s.data_dir, {s.durability}, s.reset_state);
+    const std::string file =
+        s.data_dir ? (*s.data_dir / "finsd.state").string() : std::string("(heap)");
+    if (!opened) {
+        const std::error_code error = opened.error().error;
+        if (opened.error().setting_aside)
+            return fail(3, file + ": cannot move it aside: " + error.message());
         const bool refused = Storage::is_refusal(error);
         std::string why = error.message();
         if (error == fins::plc::state_file::make_error(fins::plc::state_file::Error::other_profile))
             why += fmt::format(": the file is for profile '{}', this finsd runs '{}'",
                                state_file_profile(*s.data_dir), profile.name);
-        if (!refused || !s.reset_state || moved)
-            return fail(3, file + ": " + why +
-                               (refused ? "; finsd never replaces it by itself: start with "
-                                          "--reset-state to move it aside and begin with "
-                                          "empty retained memory"
-                                        : ""));
-        const auto aside = Storage::set_aside(*s.data_dir);
-        if (!aside) return fail(3, file + ": cannot move it aside: " + aside.error().message());
-        // Warnings about the operator's data go to stderr with the refusals, whatever
-        // the log level (stdout's first line stays "listening <port>" at warn).
+        return fail(3, file + ": " + why +
+                           (refused ? "; finsd never replaces it by itself: start with "
+                                      "--reset-state to move it aside and begin with "
+                                      "empty retained memory"
+                                    : ""));
+    }
+    // Warnings about the operator's data go to stderr with the refusals, whatever the log
+    // level (stdout's first line stays "listening <port>" at warn).
+    if (opened->moved_aside)
         std::fprintf(stderr,
                      "finsd: warning: %s: %s; --reset-state moved it to %s: retained memory "
                      "starts empty\n",
-                     file.c_str(), error.message().c_str(), aside->string().c_str());
-        moved = true;
-    }
+                     file.c_str(), opened->refusal.message().c_str(), opened->moved_aside->c_str());
+    plc = std::move(opened->plc);
+    return -1;
 }
 
 int serve(const Settings& s) {
