@@ -28,7 +28,7 @@
 #include "fins/client.hpp"
 #include "fins/commands/file_memory.hpp"
 #include "plc/plc.hpp"
-#include "server/server.hpp"
+#include "server/sessions/server.hpp"
 
 #include "echo_server.hpp"
 

@@ -26,8 +26,8 @@
 #include "integration/process.hpp"
 #include "integration/pty_pair.hpp"
 #include "plc/plc.hpp"
-#include "server/serial_ports.hpp"
-#include "server/server.hpp"
+#include "server/serial/serial_ports.hpp"
+#include "server/sessions/server.hpp"
 
 int main(int argc, char** argv) {
     CLI::App app{"28 03 request rate through a Serial Gateway port over a pty"};

@@ -35,8 +35,8 @@
 #include "integration/pty_pair.hpp"
 #include "plc/plc.hpp"
 #include "plc/profile.hpp"
-#include "server/dispatcher.hpp"
-#include "server/serial_session.hpp"
+#include "server/dispatch/dispatcher.hpp"
+#include "server/serial/serial_session.hpp"
 
 namespace {
 

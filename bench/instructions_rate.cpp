@@ -19,8 +19,8 @@
 #include <asio/post.hpp>
 
 #include "plc/plc.hpp"
-#include "server/network_instructions.hpp"
-#include "server/server.hpp"
+#include "server/instructions/network_instructions.hpp"
+#include "server/sessions/server.hpp"
 
 namespace {
 

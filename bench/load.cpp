@@ -37,7 +37,7 @@
 #include "fins/tcp.hpp"
 #include "plc/plc.hpp"
 #include "plc/profile.hpp"
-#include "server/server.hpp"
+#include "server/sessions/server.hpp"
 
 #include "echo_server.hpp"
 

@@ -12,7 +12,7 @@
 #include "fins/frame.hpp"
 #include "plc/plc.hpp"
 #include "plc/profile.hpp"
-#include "server/dispatcher.hpp"
+#include "server/dispatch/dispatcher.hpp"
 
 namespace {
 

@@ -17,8 +17,8 @@
 
 #include "fins/client.hpp"
 #include "fins/commands/memory_area.hpp"
-#include "server/plant.hpp"
-#include "server/server.hpp"
+#include "server/routing/plant.hpp"
+#include "server/sessions/server.hpp"
 
 namespace {
 

@@ -10,7 +10,7 @@
 #include "answer_check.hpp"
 #include "fins/frame.hpp"
 #include "plc/plc.hpp"
-#include "server/dispatcher.hpp"
+#include "server/dispatch/dispatcher.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     static fins::plc::Plc plc;

@@ -13,8 +13,8 @@
 #include "fins/frame.hpp"
 #include "plc/plc.hpp"
 #include "plc/routing_tables.hpp"
-#include "server/dispatcher.hpp"
-#include "server/router.hpp"
+#include "server/dispatch/dispatcher.hpp"
+#include "server/routing/router.hpp"
 
 namespace {
 

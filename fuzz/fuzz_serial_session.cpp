@@ -29,8 +29,8 @@
 #include "fins/frame.hpp"
 #include "fins/host_link.hpp"
 #include "plc/plc.hpp"
-#include "server/dispatcher.hpp"
-#include "server/serial_session.hpp"
+#include "server/dispatch/dispatcher.hpp"
+#include "server/serial/serial_session.hpp"
 
 namespace {
 

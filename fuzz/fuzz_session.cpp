@@ -29,7 +29,7 @@
 #include "fins/frame.hpp"
 #include "fins/tcp.hpp"
 #include "plc/plc.hpp"
-#include "server/server.hpp"
+#include "server/sessions/server.hpp"
 
 namespace {
 

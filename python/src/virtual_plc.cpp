@@ -24,7 +24,7 @@
 #include "plc/plc.hpp"
 #include "plc/profile.hpp"
 #include "plc/storage.hpp"
-#include "server/server.hpp"
+#include "server/sessions/server.hpp"
 
 namespace py = pybind11;
 using release = py::call_guard<py::gil_scoped_release>;

@@ -2,7 +2,7 @@
 // cause: a low battery, FAL/FALS errors as if the user program had executed FAL(006)
 // or FALS(007), MSG(046) messages, and any other error code of W342 5-3-27. Filled from
 // the [faults]-style section of the finsd configuration file (or by hand in tests) and
-// applied once at start-up; the control channel (server/control.hpp) injects the same
+// applied once at start-up; the control channel (server/control/control.hpp) injects the same
 // conditions at run time.
 //
 // Data only: no parsing here. validate() names the first bad field so the

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "cli/finsd/config.hpp"
-#include "server/plant.hpp"
+#include "server/routing/plant.hpp"
 
 namespace fins::cli::finsd {
 namespace {

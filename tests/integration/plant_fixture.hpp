@@ -16,9 +16,9 @@
 #include <asio/post.hpp>
 
 #include "fins/client.hpp"
-#include "server/plant.hpp"
-#include "server/router.hpp"
-#include "server/server.hpp"
+#include "server/routing/plant.hpp"
+#include "server/routing/router.hpp"
+#include "server/sessions/server.hpp"
 
 namespace fins::test {
 

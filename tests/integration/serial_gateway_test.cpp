@@ -28,8 +28,8 @@
 #include "integration/pty_pair.hpp"
 #include "integration/raw_socket.hpp"
 #include "plc/plc.hpp"
-#include "server/serial_ports.hpp"
-#include "server/server.hpp"
+#include "server/serial/serial_ports.hpp"
+#include "server/sessions/server.hpp"
 
 namespace fins::test {
 namespace {

@@ -13,7 +13,7 @@
 
 #include "fins/client.hpp"
 #include "plc/plc.hpp"
-#include "server/server.hpp"
+#include "server/sessions/server.hpp"
 
 namespace fins::test {
 

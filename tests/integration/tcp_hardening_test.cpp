@@ -19,7 +19,7 @@
 
 #include "plc/plc.hpp"
 #include "raw_socket.hpp"
-#include "server/server.hpp"
+#include "server/sessions/server.hpp"
 
 namespace fins::test {
 namespace {

@@ -22,7 +22,7 @@
 #include "fins/commands/program_area.hpp"
 #include "plc/plc.hpp"
 #include "process.hpp"
-#include "server/server.hpp"
+#include "server/sessions/server.hpp"
 #include "server_fixture.hpp"
 #include "tshark_support.hpp"
 

@@ -10,7 +10,7 @@
 
 #include "fins/frame.hpp"
 #include "plc/plc.hpp"
-#include "server/dispatcher.hpp"
+#include "server/dispatch/dispatcher.hpp"
 
 namespace fins::test {
 

@@ -23,7 +23,7 @@
 #include "plc/injections.hpp"
 #include "plc/io_memory.hpp"
 #include "plc/plc.hpp"
-#include "server/plant.hpp"
+#include "server/routing/plant.hpp"
 
 namespace fins::cli::finsd {
 
@@ -63,7 +63,7 @@ struct Settings : CpuUnitOptions {
     bool udp = true;
     bool tcp = true;
     std::size_t max_connections = 16;
-    // FINS/TCP limits in seconds (server/tcp_limits.hpp; idle and keep-alive 0 = off).
+    // FINS/TCP limits in seconds (server/sessions/tcp_limits.hpp; idle and keep-alive 0 = off).
     unsigned tcp_handshake_timeout = 10;
     unsigned tcp_frame_timeout = 10;
     unsigned tcp_idle_timeout = 300;

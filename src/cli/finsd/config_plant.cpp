@@ -4,7 +4,7 @@
 #include <fmt/format.h>
 
 #include "cli/finsd/config_values.hpp"
-#include "server/node_address_table.hpp"
+#include "server/routing/node_address_table.hpp"
 
 namespace fins::cli::finsd {
 

@@ -25,8 +25,8 @@
 #include <toml++/toml.h>
 #include <tl/expected.hpp>
 
-#include "server/instruction_schedule.hpp"
-#include "server/instruction_udp.hpp"
+#include "server/instructions/instruction_schedule.hpp"
+#include "server/instructions/instruction_udp.hpp"
 
 namespace fins::plc {
 class IoMemory;

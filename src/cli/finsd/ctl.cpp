@@ -1,5 +1,5 @@
 // `finsd ctl --socket PATH VERB ...` (options before or after the verb): sends one request to a
-// running finsd's control channel (server/control.hpp) and prints the answer line.
+// running finsd's control channel (server/control/control.hpp) and prints the answer line.
 //
 //   status                          the JSON snapshot
 //   battery-error on|off            low battery (error 00F7) / battery replaced

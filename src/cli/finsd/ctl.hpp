@@ -1,4 +1,4 @@
-// `finsd ctl ...`: the client side of the control channel (server/control.hpp).
+// `finsd ctl ...`: the client side of the control channel (server/control/control.hpp).
 // main() calls run_ctl when the first argument is "ctl"; argv starts at "ctl".
 #pragma once
 

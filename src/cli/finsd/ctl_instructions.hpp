@@ -1,5 +1,5 @@
 // `finsd ctl send|recv|sendcmd|instructions`: PLC-initiated messages (W596 3) run by a
-// running finsd (server/control_instructions.hpp).
+// running finsd (server/control/control_instructions.hpp).
 //
 //   send    --dest N.N.U --local D100 --remote D200 [--count 1]   local words -> remote
 //   recv    --dest N.N.U --remote D200 --local D300 [--count 1]   remote words -> local

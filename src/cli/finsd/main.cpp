@@ -37,10 +37,10 @@
 #include "plc/profile.hpp"
 #include "plc/storage.hpp"
 #include "plc/storage_format.hpp"
-#include "server/control.hpp"
-#include "server/instruction_schedule.hpp"
-#include "server/serial_ports.hpp"
-#include "server/server.hpp"
+#include "server/control/control.hpp"
+#include "server/instructions/instruction_schedule.hpp"
+#include "server/serial/serial_ports.hpp"
+#include "server/sessions/server.hpp"
 
 namespace {
 

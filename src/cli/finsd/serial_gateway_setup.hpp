@@ -19,7 +19,7 @@
 
 #include "cli/finsd/config_serial.hpp"
 #include "plc/profile.hpp"
-#include "server/serial_ports.hpp"
+#include "server/serial/serial_ports.hpp"
 
 namespace fins::cli::finsd {
 

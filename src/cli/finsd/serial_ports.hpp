@@ -1,4 +1,4 @@
-// finsd's serial ports at run time: a Host Link slave session (server/serial_session.hpp)
+// finsd's serial ports at run time: a Host Link slave session (server/serial/serial_session.hpp)
 // for each port in mode "hostlink" (the CPU Unit's port, or a unit's port set to Host
 // Link), attached to the server's dispatcher.
 #pragma once
@@ -11,8 +11,8 @@
 #include <tl/expected.hpp>
 
 #include "cli/finsd/config_serial.hpp"
-#include "server/dispatcher.hpp"
-#include "server/serial_session.hpp"
+#include "server/dispatch/dispatcher.hpp"
+#include "server/serial/serial_session.hpp"
 
 namespace fins::cli::finsd {
 

@@ -1,4 +1,4 @@
-// finsd with [[plc]] tables: the plant (server/plant.hpp) on one I/O thread.
+// finsd with [[plc]] tables: the plant (server/routing/plant.hpp) on one I/O thread.
 #include <algorithm>
 #include <chrono>
 #include <csignal>
@@ -11,9 +11,9 @@
 
 #include "cli/finsd/config_plant.hpp"
 #include "plc/injections.hpp"
-#include "server/control.hpp"
-#include "server/router.hpp"
-#include "server/server.hpp"
+#include "server/control/control.hpp"
+#include "server/routing/router.hpp"
+#include "server/sessions/server.hpp"
 
 namespace fins::cli::finsd {
 

@@ -17,7 +17,7 @@
 #include "fins/commands/memory_area.hpp"
 #include "fins/error.hpp"
 #include "fins/frame.hpp"
-#include "server/dispatcher.hpp"
+#include "server/dispatch/dispatcher.hpp"
 
 namespace fins::plc {
 class Plc;

@@ -19,7 +19,7 @@
 
 #include "fins/host_link.hpp"
 #include "server/handlers/handlers.hpp"
-#include "server/serial_ports.hpp"
+#include "server/serial/serial_ports.hpp"
 
 namespace fins::server::handlers {
 

@@ -1,13 +1,13 @@
 // 28 03 CONVERT TO COMPOWAY/F, 28 04 CONVERT TO MODBUS-RTU, 28 05 CONVERT TO MODBUS-ASCII
 // (W342 5-3-46 .. 5-3-48): the port at the destination unit address frames the command
-// for its line and answers later with the slave's reply (server/serial_gateway_port.hpp,
+// for its line and answers later with the slave's reply (server/serial/serial_gateway_port.hpp,
 // docs/architecture.md "Deferred answers").
 #include <array>
 
 #include "fins/commands/serial_gateway.hpp"
 #include "fins/modbus.hpp"
 #include "server/handlers/handlers.hpp"
-#include "server/serial_ports.hpp"
+#include "server/serial/serial_ports.hpp"
 
 namespace fins::server::handlers {
 

@@ -1,0 +1,97 @@
+// The pure request handler: one FINS request frame in, at most one response frame out.
+// No sockets and no clock of its own (the caller passes `now`), so it is unit-tested
+// directly and fuzzed. Sessions (udp_server, tcp_server) only read, call, write.
+//
+// Path of a request: decode header -> address check (is it for this node/unit?) ->
+// command table lookup (unknown -> 0401) -> execution conditions of W342 5-1-2 ->
+// the command's handler (src/server/handlers/<group>.cpp) -> response frame.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+
+#include <sys/socket.h>
+
+#include "fins/byte_io.hpp"
+#include "fins/frame.hpp"
+
+namespace fins::plc {
+class Plc;
+}
+
+namespace fins::server {
+
+class Router;
+
+// serial: the CPU Unit's Host Link port (server/serial/serial_session.hpp).
+enum class Link : std::uint8_t { udp, tcp, local, serial };
+
+// W342 5-1-2 note 5: network write protection covers commands "sent to CPU Units via
+// networks"; in-process requests and the directly connected Host Link port are not.
+constexpr bool via_network(Link link) noexcept {
+    return link == Link::udp || link == Link::tcp;
+}
+
+class SerialPorts;
+
+// Sends one response frame later, to where its request came from; a no-op once the
+// session is gone. Called at most once, on the I/O thread.
+using Completion = std::function<void(Bytes response_frame)>;
+
+// The session's way back for an answer that is not ready when handle() returns (a
+// Serial Gateway port's, docs/architecture.md "Deferred answers"). Only that path calls
+// defer(); the synchronous path never touches it and allocates nothing.
+class ReplyPath {
+  public:
+    // A completion bound to the request being handled now.
+    virtual Completion defer() = 0;
+
+  protected:
+    ~ReplyPath() = default;
+};
+
+// What the session knows about where a request came from.
+struct RequestContext {
+    Link link = Link::udp;
+    std::chrono::system_clock::time_point now{};
+    ReplyPath* reply_path = nullptr;  // nullptr: this session cannot answer later
+    // FINS/UDP: the datagram's source, where the answer goes. In a plant the port's
+    // node-address table may learn from it and redirect the answer (router.hpp).
+    sockaddr_storage* peer = nullptr;
+};
+
+class Dispatcher {
+  public:
+    // `self` is this node's address on the network (network, node, unit 00).
+    Dispatcher(plc::Plc& plc, NodeAddress self) noexcept;
+
+    // Handles one request frame. Writes the response frame into `out` (which must hold
+    // max_frame_size bytes) and returns its length, or 0 when nothing is to be sent:
+    // the ICF no-response bit was set, the frame is itself a response, or it is too
+    // short to carry a header and command code (there is no SID to answer), or the
+    // answer comes later through context.reply_path (a Serial Gateway port's).
+    std::size_t handle(Bytes request, MutableBytes out, const RequestContext& context);
+
+    // The Serial Gateway ports (nullptr: none); they outlive the dispatcher's use.
+    void attach_serial_ports(SerialPorts* ports) noexcept { serial_ = ports; }
+    [[nodiscard]] SerialPorts* serial_ports() const noexcept { return serial_; }
+
+    [[nodiscard]] const NodeAddress& self() const noexcept { return self_; }
+    plc::Plc& plc() noexcept { return plc_; }
+
+    // In a plant (router.hpp) this dispatcher serves port `port` of a CPU Unit: the
+    // router decides whether a frame is for this CPU Unit (any of its ports) and forwards
+    // the others. Without a router only `self` is "me" (the single-node finsd).
+    void attach(Router& router, std::size_t port) noexcept;
+
+  private:
+    plc::Plc& plc_;
+    NodeAddress self_;
+    SerialPorts* serial_ = nullptr;
+    Router* router_ = nullptr;
+    std::size_t port_ = 0;
+};
+
+}  // namespace fins::server

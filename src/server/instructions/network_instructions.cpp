@@ -1,0 +1,429 @@
+// NetworkInstructions: Send, Rcv and SendCmd (network_instructions.hpp, W596 3).
+#include "server/instructions/network_instructions.hpp"
+
+#include <algorithm>
+#include <charconv>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+#include <asio/post.hpp>
+
+#include "fins/commands/memory_area.hpp"
+#include "plc/plc.hpp"
+
+namespace fins::server {
+
+namespace {
+
+// A202: Communications Port Enabled Flags; A203-A210: Completion Codes; A219: Error Flags.
+constexpr std::size_t a_port_enabled = 202;
+constexpr std::size_t a_completion_first = 203;
+constexpr std::size_t a_port_error = 219;
+constexpr std::size_t flagged_ports = 8;
+
+// W596 eAREA: _CIO _WR _HR _TIMER _COUNTER _DM _EM0.._EM18.
+bool remote_area_allowed(const Address& a) noexcept {
+    switch (a.area) {
+        case Area::cio:
+        case Area::work:
+        case Area::holding:
+        case Area::timer:
+        case Area::counter:
+        case Area::dm:
+            return true;
+        case Area::em:
+            return a.bank <= 0x18;
+        default:
+            return false;
+    }
+}
+
+InstructionResult parameter_error(std::string why) {
+    InstructionResult r;
+    r.error_id = instruction_parameter_error;
+    r.detail = std::move(why);
+    return r;
+}
+
+InstructionResult communications_error(EndCode code, std::string why) {
+    InstructionResult r;
+    r.error_id = instruction_communications_error;
+    r.error_id_ex = static_cast<std::uint16_t>(code);
+    r.detail = std::move(why);
+    return r;
+}
+
+std::optional<std::uint16_t> number(std::string_view text, unsigned max) noexcept {
+    int base = 10;
+    if (text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X')) {
+        text.remove_prefix(2);
+        base = 16;
+    }
+    unsigned v = 0;
+    const auto* end = text.data() + text.size();
+    const auto r = std::from_chars(text.data(), end, v, base);
+    if (text.empty() || r.ec != std::errc{} || r.ptr != end || v > max) return std::nullopt;
+    return static_cast<std::uint16_t>(v);
+}
+
+// The local words as a located range (Send reads them, Rcv writes them).
+Result<plc::ElementRange> locate_local(const plc::IoMemory& memory, const InstructionRequest& r) {
+    const auto address = to_memory_address(r.local, Access::word);
+    if (!address) return Unexpected(address.error());
+    const bool recv = r.kind == InstructionKind::recv;
+    return memory.locate(*address, r.count, recv ? use_write : use_read,
+                         recv ? plc::Intent::write : plc::Intent::read);
+}
+
+}  // namespace
+
+std::chrono::milliseconds instruction_timeout(std::uint16_t timeout) noexcept {
+    return std::chrono::milliseconds(100U * (timeout == 0 ? default_instruction_timeout : timeout));
+}
+
+std::optional<InstructionKind> parse_instruction_kind(std::string_view text) noexcept {
+    if (text == "send") return InstructionKind::send;
+    if (text == "recv" || text == "rcv") return InstructionKind::recv;
+    if (text == "sendcmd" || text == "cmnd") return InstructionKind::sendcmd;
+    return std::nullopt;
+}
+
+const char* instruction_kind_name(InstructionKind kind) noexcept {
+    switch (kind) {
+        case InstructionKind::send:
+            return "send";
+        case InstructionKind::recv:
+            return "recv";
+        case InstructionKind::sendcmd:
+            return "sendcmd";
+    }
+    return "send";
+}
+
+std::optional<NodeAddress> parse_destination(std::string_view text) noexcept {
+    std::array<std::uint16_t, 3> parts{0, 0, 0};
+    std::size_t n = 0;
+    while (n < parts.size()) {
+        const auto dot = text.find('.');
+        const auto part = text.substr(0, dot);
+        const auto v = number(part, 255);
+        if (!v) return std::nullopt;
+        parts[n++] = *v;
+        if (dot == std::string_view::npos) break;
+        text.remove_prefix(dot + 1);
+        if (n == parts.size()) return std::nullopt;
+    }
+    if (n < 2 || parts[0] > 127) return std::nullopt;
+    return NodeAddress{static_cast<std::uint8_t>(parts[0]), static_cast<std::uint8_t>(parts[1]),
+                       static_cast<std::uint8_t>(parts[2])};
+}
+
+std::optional<std::string> check_instruction(const InstructionRequest& r,
+                                             const plc::IoMemory& memory) {
+    const auto& o = r.options;
+    if (r.destination.network > 127) return "destination network must be 0-127";
+    if (o.retries > max_instruction_retries) return "retries must be 0-15";
+    const bool broadcast = r.destination.node == broadcast_node;
+    if (r.kind == InstructionKind::sendcmd) {
+        if (r.command.size() == 1) return "a command needs MRC and SRC (2 bytes at least)";
+        if (r.command.size() > max_instruction_command)
+            return fmt::format("a command has at most {} bytes", max_instruction_command);
+        return std::nullopt;
+    }
+    if (r.kind == InstructionKind::recv) {
+        if (broadcast) return "Rcv cannot broadcast (node 255)";
+        if (o.no_response) return "Rcv needs a response (no-response mode is not allowed)";
+    }
+    if (r.count > max_instruction_words)
+        return fmt::format("count must be 0-{} words", max_instruction_words);
+    if (r.local.bit || r.remote.bit) return "addresses must be words (no .bit)";
+    if (!remote_area_allowed(r.remote))
+        return fmt::format("remote area of {} is not CIO, W, H, T, C, D or E0_-E18_ (W596 3)",
+                           format_address(r.remote));
+    if (r.count > 0 && std::uint32_t{r.remote.word} + r.count - 1 > max_word(r.remote.area))
+        return fmt::format("remote words {} + {} run past the area", format_address(r.remote),
+                           r.count);
+    if (r.count == 0) return std::nullopt;
+    const auto local = locate_local(memory, r);
+    if (!local)
+        return fmt::format("local words {} x {}: {}", format_address(r.local), r.count,
+                           local.error().message());
+    if (local->kind != ElementKind::word) return "local address must name words";
+    return std::nullopt;
+}
+
+// One instruction port: its request, frame and retry timer (allocated once).
+struct NetworkInstructions::Port {
+    explicit Port(const asio::any_io_executor& ex) : timer(ex) {}
+    bool busy = false;
+    InstructionRequest request;
+    InstructionCallback done;
+    std::array<std::uint8_t, max_frame_size> frame{};
+    std::size_t frame_size = 0;
+    std::uint8_t sid = 0;
+    CommandCode command;
+    unsigned transmissions = 0;
+    std::uint64_t generation = 0;
+    asio::steady_timer timer;
+};
+
+NetworkInstructions::NetworkInstructions(asio::any_io_executor executor, plc::Plc& plc,
+                                         NodeAddress self, InstructionTransport& transport)
+    : executor_(std::move(executor)), plc_(plc), self_(self), transport_(transport) {
+    ports_.reserve(max_instructions);
+    for (std::size_t i = 0; i < max_instructions; ++i)
+        ports_.push_back(std::make_unique<Port>(executor_));
+    const auto& profile = plc_.profile();
+    flags_ = !profile.nx_fixed_values && profile.auxiliary_words > a_port_error;
+    for (std::size_t i = 0; i < flagged_ports; ++i)
+        show_port(i, false, std::nullopt);
+}
+
+NetworkInstructions::~NetworkInstructions() {
+    stop();
+}
+
+void NetworkInstructions::stop() {
+    *alive_ = false;
+    alive_ = std::make_shared<bool>(true);
+    for (auto& p : ports_) {
+        p->timer.cancel();
+        p->busy = false;
+        p->done = nullptr;
+    }
+    in_flight_ = 0;
+}
+
+std::uint8_t NetworkInstructions::next_sid() noexcept {
+    // A SID comes back only after 224 others: a late answer to a finished instruction
+    // never meets a new one with its SID while fewer than 32 run.
+    for (;;) {
+        ++sid_;
+        const bool used = std::any_of(ports_.begin(), ports_.end(),
+                                      [&](const auto& p) { return p->busy && p->sid == sid_; });
+        if (!used) return sid_;
+    }
+}
+
+void NetworkInstructions::complete_later(InstructionCallback done, InstructionResult result) {
+    if (!done) return;
+    asio::post(executor_, [done = std::move(done), result = std::move(result)] { done(result); });
+}
+
+void NetworkInstructions::start(InstructionRequest request, InstructionCallback done) {
+    ++counters_.started;
+    if (auto why = check_instruction(request, plc_.memory())) {
+        ++counters_.errors;
+        return complete_later(std::move(done), parameter_error(std::move(*why)));
+    }
+    const bool empty =
+        request.kind == InstructionKind::sendcmd ? request.command.empty() : request.count == 0;
+    if (empty) {  // W596: size 0 sends nothing and ends Done.
+        ++counters_.done;
+        InstructionResult r;
+        r.detail = "nothing to send (size 0)";
+        return complete_later(std::move(done), std::move(r));
+    }
+    const auto free = std::find_if(ports_.begin(), ports_.end(), [](auto& p) { return !p->busy; });
+    if (free == ports_.end()) {
+        ++counters_.errors;
+        return complete_later(std::move(done),
+                              communications_error(EndCode::too_many_send_frames,
+                                                   "32 instructions are already running"));
+    }
+    const auto index = static_cast<std::size_t>(free - ports_.begin());
+    Port& p = **free;
+    p.busy = true;
+    p.done = std::move(done);
+    p.transmissions = 0;
+    p.sid = next_sid();
+    ++in_flight_;
+    show_port(index, true, std::nullopt);
+
+    // The frame, once: retries send the same bytes with the same SID.
+    Header h;
+    const bool broadcast = request.destination.node == broadcast_node;
+    if (request.options.no_response || broadcast) h.icf |= icf_no_response;
+    h.destination = request.destination;
+    h.source = NodeAddress{self_.network, self_.node, cpu_unit};
+    h.service_id = p.sid;
+    ByteWriter w{MutableBytes{p.frame.data(), p.frame.size()}};
+    write_header(w, h);
+    if (request.kind == InstructionKind::sendcmd) {
+        p.command = CommandCode{request.command[0], request.command[1]};
+        w.bytes(Bytes{request.command.data(), request.command.size()});
+    } else if (request.kind == InstructionKind::send) {
+        p.command = MemoryAreaWrite::code;
+        w.u8(p.command.main);
+        w.u8(p.command.sub);
+        const auto local = locate_local(plc_.memory(), request);
+        std::array<std::uint8_t, 2 * max_instruction_words> data{};
+        ByteWriter dw{MutableBytes{data.data(), data.size()}};
+        plc_.memory().read(*local, dw, std::chrono::system_clock::now());
+        MemoryAreaWrite{*to_memory_address(request.remote, Access::word), request.count,
+                        Bytes{data.data(), dw.size()}}
+            .encode(w);
+    } else {
+        p.command = MemoryAreaRead::code;
+        w.u8(p.command.main);
+        w.u8(p.command.sub);
+        MemoryAreaRead{*to_memory_address(request.remote, Access::word), request.count}.encode(w);
+    }
+    p.frame_size = w.size();
+    p.request = std::move(request);
+    transmit(index);
+}
+
+void NetworkInstructions::transmit(std::size_t index) {
+    Port& p = *ports_[index];
+    ++p.transmissions;
+    const auto sent =
+        transport_.send_frame(p.request.destination, Bytes{p.frame.data(), p.frame_size});
+    if (sent == InstructionTransport::Sent::no_route)
+        return finish(index, communications_error(EndCode::destination_address_setting_error,
+                                                  "no IP address for that network/node "
+                                                  "(see [[remote]])"));
+    if (sent == InstructionTransport::Sent::no_port)
+        return finish(index, communications_error(EndCode::local_node_not_in_network,
+                                                  "FINS/UDP is off on this node and no FINS/TCP "
+                                                  "connection holds that node"));
+    if (sent == InstructionTransport::Sent::failed && p.transmissions > p.request.options.retries)
+        return finish(index,
+                      communications_error(EndCode::retries_failed, "the frame could not be sent"));
+    const bool no_answer = (p.frame[0] & icf_no_response) != 0;
+    if (no_answer && sent == InstructionTransport::Sent::ok) {
+        InstructionResult r;
+        r.detail = "sent (no response requested)";
+        return finish(index, std::move(r));
+    }
+    arm(index);
+}
+
+void NetworkInstructions::arm(std::size_t index) {
+    Port& p = *ports_[index];
+    const auto generation = ++p.generation;
+    p.timer.expires_after(instruction_timeout(p.request.options.timeout));
+    p.timer.async_wait(
+        [this, index, generation, alive = std::weak_ptr<bool>(alive_)](std::error_code ec) {
+            const auto a = alive.lock();
+            if (ec || !a || !*a) return;
+            on_timeout(index, generation);
+        });
+}
+
+void NetworkInstructions::on_timeout(std::size_t index, std::uint64_t generation) {
+    Port& p = *ports_[index];
+    if (!p.busy || p.generation != generation) return;
+    if (p.transmissions <= p.request.options.retries) {
+        ++counters_.retransmissions;
+        return transmit(index);
+    }
+    ++counters_.timeouts;
+    finish(index, communications_error(
+                      EndCode::response_timeout,
+                      fmt::format("no response after {} transmission(s)", p.transmissions)));
+}
+
+bool NetworkInstructions::on_response(Bytes frame) {
+    const auto view = decode_response(frame);
+    if (!view) {
+        ++counters_.unmatched;
+        return false;
+    }
+    const Header& h = view->header;
+    const auto it = std::find_if(ports_.begin(), ports_.end(), [&](const auto& p) {
+        if (!p->busy || p->sid != h.service_id || p->command != view->command) return false;
+        const auto& dest = p->request.destination;
+        // Node 00 addresses "this PLC": its answer comes from our own node number.
+        const std::uint8_t node = dest.node == 0 ? self_.node : dest.node;
+        return h.source.node == node &&
+               (h.destination.node == self_.node || h.destination.node == 0);
+    });
+    if (it == ports_.end()) {
+        ++counters_.unmatched;
+        return false;
+    }
+    const auto index = static_cast<std::size_t>(it - ports_.begin());
+    Port& p = **it;
+    InstructionResult r;
+    r.end_code = view->code.raw();
+    if (p.request.kind == InstructionKind::sendcmd)
+        r.response.assign(frame.begin() + header_size, frame.end());
+    if (!view->code.ok() || view->code.relay_error()) {
+        r.error_id = instruction_communications_error;
+        r.error_id_ex = view->code.raw();
+        const auto* info = find_end_code(view->code.raw() & 0x7F3F);
+        r.detail = fmt::format("the remote answered {:04X} ({})", view->code.raw(),
+                               info ? info->name : "unknown end code");
+        finish(index, std::move(r));
+        return true;
+    }
+    if (p.request.kind == InstructionKind::recv) {
+        const auto want = std::size_t{p.request.count} * 2;
+        if (view->data.size() != want) {
+            r.error_id = instruction_communications_error;
+            r.error_id_ex = static_cast<std::uint16_t>(EndCode::elements_data_mismatch);
+            r.detail =
+                fmt::format("the answer holds {} bytes, {} expected", view->data.size(), want);
+            finish(index, std::move(r));
+            return true;
+        }
+        auto local = locate_local(plc_.memory(), p.request);
+        if (!local || plc_.memory().write(*local, view->data) != EndCode::normal_completion) {
+            r.error_id = instruction_parameter_error;
+            r.detail = "the local words cannot be written";
+            finish(index, std::move(r));
+            return true;
+        }
+        r.words.reserve(p.request.count);
+        for (std::size_t i = 0; i + 1 < view->data.size(); i += 2)
+            r.words.push_back(static_cast<std::uint16_t>((view->data[i] << 8) | view->data[i + 1]));
+    }
+    const auto kind = p.request.kind;
+    r.detail = kind == InstructionKind::send   ? fmt::format("wrote {} words", p.request.count)
+               : kind == InstructionKind::recv ? fmt::format("read {} words", p.request.count)
+                                               : std::string("answered");
+    finish(index, std::move(r));
+    return true;
+}
+
+void NetworkInstructions::finish(std::size_t index, InstructionResult result) {
+    Port& p = *ports_[index];
+    ++p.generation;
+    p.timer.cancel();
+    p.busy = false;
+    --in_flight_;
+    result.port = static_cast<int>(index);
+    result.transmissions = p.transmissions;
+    ++(result.done() ? counters_.done : counters_.errors);
+    // CS/CJ completion code: the end code (0000 normal), or the local error's code.
+    const std::uint16_t completion = result.done() ? std::uint16_t{0} : result.error_id_ex;
+    show_port(index, false,
+              result.error_id == instruction_parameter_error
+                  ? std::optional<std::uint16_t>{}
+                  : std::optional<std::uint16_t>{completion});
+    if (!result.done())
+        spdlog::debug("finsd: {} to {}.{}.{} port {}: ErrorID {:04X} {:04X}: {}",
+                      instruction_kind_name(p.request.kind), p.request.destination.network,
+                      p.request.destination.node, p.request.destination.unit, index,
+                      result.error_id, result.error_id_ex, result.detail);
+    complete_later(std::move(p.done), std::move(result));
+    p.done = nullptr;
+}
+
+void NetworkInstructions::show_port(std::size_t port, bool busy,
+                                    std::optional<std::uint16_t> completion) {
+    if (!flags_ || port >= flagged_ports) return;
+    auto a = plc_.memory().words(Region::auxiliary);
+    if (a.size() <= a_port_error) return;
+    const auto bit = static_cast<std::uint16_t>(1U << port);
+    a[a_port_enabled] = busy ? static_cast<std::uint16_t>(a[a_port_enabled] & ~bit)
+                             : static_cast<std::uint16_t>(a[a_port_enabled] | bit);
+    if (completion) {
+        a[a_completion_first + port] = *completion;
+        a[a_port_error] = *completion != 0 ? static_cast<std::uint16_t>(a[a_port_error] | bit)
+                                           : static_cast<std::uint16_t>(a[a_port_error] & ~bit);
+    }
+}
+
+}  // namespace fins::server

@@ -1,0 +1,238 @@
+// Plant: start-up of several CPU Units and their ports, glued by the Router (plant.hpp).
+#include "server/routing/plant.hpp"
+
+#include <set>
+#include <utility>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "plc/profile.hpp"
+#include "plc/storage.hpp"
+#include "server/routing/router.hpp"
+#include "server/sessions/server.hpp"
+
+namespace fins::server {
+
+namespace {
+
+bool automatic(AddressMethod m) noexcept {
+    return m == AddressMethod::automatic_dynamic || m == AddressMethod::automatic_static;
+}
+
+std::uint8_t port_node(const PlantPortConfig& p) noexcept {
+    if (p.node != 0) return p.node;
+    const auto ip = parse_ipv4(p.bind);
+    return ip ? node_of(*ip) : 0;
+}
+
+}  // namespace
+
+std::string validate_plant(const PlantConfig& config) {
+    if (config.cpus.empty()) return "plc: no CPU Unit";
+    std::set<std::string> names;
+    std::set<std::pair<int, int>> nodes;
+    for (const auto& cpu : config.cpus) {
+        const std::string who = fmt::format("plc \"{}\"", cpu.name);
+        if (cpu.name.empty()) return "plc: a CPU Unit without a name";
+        if (!names.insert(cpu.name).second) return who + ": the name is used twice";
+        if (plc::find_profile(cpu.profile) == nullptr)
+            return fmt::format("{}: unknown profile '{}'", who, cpu.profile);
+        if (cpu.ports.empty()) return who + ": no [[plc.ethernet]] unit";
+        if (cpu.ports.size() > plc::max_local_networks)
+            return fmt::format("{}: {} units, at most {} (the local network table's size)", who,
+                               cpu.ports.size(), plc::max_local_networks);
+        std::set<int> units, networks;
+        for (const auto& p : cpu.ports) {
+            const auto ip = parse_ipv4(p.bind);
+            if (!ip)
+                return fmt::format("{}: unit {}: bind '{}' is not an IPv4 address", who,
+                                   p.unit_number, p.bind);
+            if (!p.udp && !p.tcp)
+                return fmt::format("{}: unit {}: udp and tcp are both off", who, p.unit_number);
+            if (!units.insert(p.unit_number).second)
+                return fmt::format("{}: unit number {} is used twice", who, p.unit_number);
+            if (!networks.insert(p.network).second)
+                return fmt::format("{}: two units on network {}", who, p.network);
+            const auto node = port_node(p);
+            if (node == 0 || node == 255)
+                return fmt::format("{}: unit {}: no node address 1-254 (bind {})", who,
+                                   p.unit_number, p.bind);
+            // W420 5-2: with automatic generation the node must be the IP host number.
+            if (automatic(p.method) && node != node_of(*ip))
+                return fmt::format(
+                    "{}: unit {}: node {} differs from the last octet of {} (automatic "
+                    "generation: node = host number; use address_method = \"table\" or "
+                    "\"combined\")",
+                    who, p.unit_number, node, p.bind);
+            if (!nodes.insert({p.network, node}).second)
+                return fmt::format("{}: unit {}: node {}.{} exists twice in the plant", who,
+                                   p.unit_number, p.network, node);
+        }
+        if (cpu.relays.size() > plc::max_relay_networks)
+            return fmt::format("{}: {} relay entries, at most {}", who, cpu.relays.size(),
+                               plc::max_relay_networks);
+        std::set<int> destinations;
+        for (const auto& r : cpu.relays) {
+            if (networks.count(r.relay_network) == 0)
+                return fmt::format(
+                    "{}: relay to network {}: relay network {} is not a network "
+                    "of this CPU Unit's units",
+                    who, r.network, r.relay_network);
+            if (networks.count(r.network) != 0 || !destinations.insert(r.network).second)
+                return fmt::format("{}: relay to network {}: a local network or listed twice", who,
+                                   r.network);
+        }
+    }
+    return {};
+}
+
+struct Plant::Impl {
+    struct Cpu {
+        std::string name;
+        std::unique_ptr<plc::Plc> plc;
+        std::vector<std::unique_ptr<Server>> servers;
+    };
+    Router router;
+    std::vector<Cpu> cpus;
+    std::vector<Server*> by_port;  // the router's port index -> its server
+};
+
+namespace {
+
+// A CPU Unit on its state file (plc::open_plc), each outcome in a line naming the CPU
+// Unit and the file, as finsd --reset-state words them for a single node.
+Result<std::unique_ptr<plc::Plc>> open_cpu(const PlantCpuConfig& c, const plc::Profile& profile,
+                                           bool reset_state) {
+    auto opened = plc::open_plc(profile, c.data_dir, {}, reset_state);
+    const std::string file =
+        c.data_dir ? (*c.data_dir / "finsd.state").string() : std::string("(heap)");
+    if (!opened) {
+        const std::error_code error = opened.error().error;
+        if (opened.error().setting_aside)
+            spdlog::error("finsd: plc \"{}\": {}: cannot move it aside: {}", c.name, file,
+                          error.message());
+        else
+            spdlog::error("finsd: plc \"{}\": {}: {}{}", c.name, file, error.message(),
+                          plc::Storage::is_refusal(error)
+                              ? "; finsd never replaces it by itself: start with "
+                                "--reset-state to move it aside and begin with empty "
+                                "retained memory"
+                              : "");
+        return Unexpected(error);
+    }
+    if (opened->moved_aside)
+        spdlog::warn(
+            "finsd: plc \"{}\": {}: {}; --reset-state moved it to {}: retained memory "
+            "starts empty",
+            c.name, file, opened->refusal.message(), opened->moved_aside->string());
+    auto& storage = opened->plc->storage();
+    if (storage.restored() && !storage.checksums_verified())
+        spdlog::warn(
+            "finsd: plc \"{}\": {} was not stopped cleanly (SIGKILL, crash or power "
+            "loss): its header and section table are intact; its data has no valid "
+            "checksums to check",
+            c.name, storage.path().string());
+    return std::move(opened->plc);
+}
+
+}  // namespace
+
+Result<std::unique_ptr<Plant>> Plant::start(asio::io_context& io, const PlantConfig& config) {
+    auto impl = std::make_unique<Impl>();
+    impl->cpus.reserve(config.cpus.size());
+    for (const auto& c : config.cpus) {
+        const plc::Profile profile = *plc::find_profile(c.profile);
+        auto plc = open_cpu(c, profile, config.reset_state);
+        if (!plc) return Unexpected(plc.error());
+        (*plc)->change_mode(c.mode, std::chrono::system_clock::now());
+
+        plc::RoutingTables tables;
+        tables.gateway_count = c.gateway_count;
+        for (const auto& p : c.ports)
+            tables.local[tables.local_count++] = plc::LocalNetwork{p.network, p.unit_number};
+        for (const auto& r : c.relays)
+            tables.relay[tables.relay_count++] = r;
+        if (c.write_routing_tables)
+            plc::encode_routing_tables(tables, (*plc)->parameters().words(plc::routing_table_area));
+
+        const auto cpu = impl->router.add_cpu(**plc, profile.nx_fixed_values);
+        impl->cpus.push_back(Impl::Cpu{c.name, std::move(*plc), {}});
+        auto& owner = impl->cpus.back();
+        for (const auto& p : c.ports) {
+            const NodeAddress self{p.network, port_node(p), cpu_unit};
+            const auto index = impl->router.add_port(cpu, p.unit_number, self);
+            ServerOptions options;
+            options.bind_address = p.bind;
+            options.port = p.port;
+            options.udp = p.udp;
+            options.tcp = p.tcp;
+            options.node = self.node;
+            options.network = self.network;
+            options.max_tcp_connections = p.max_connections;
+            options.tcp_limits = config.tcp_limits;
+            options.router = &impl->router;
+            options.router_port = index;
+            auto server = Server::start(io, *owner.plc, options);
+            if (!server) {
+                spdlog::error("finsd: plc \"{}\" unit {}: cannot listen on {} port {}: {}", c.name,
+                              p.unit_number, p.bind, p.port, server.error().message());
+                return Unexpected(server.error());
+            }
+            impl->router.set_dispatcher(index, (*server)->dispatcher());
+            const Ipv4Endpoint own{*parse_ipv4(p.bind), (*server)->udp_port()};
+            impl->router.set_addresses(
+                index, NodeAddressTable(p.method, p.dynamic_remote_ip, own, p.ip_table));
+            impl->by_port.push_back(server->get());
+            owner.servers.push_back(std::move(*server));
+        }
+    }
+    auto* raw = impl.get();
+    impl->router.set_wire([raw](std::size_t port, std::uint8_t node, Bytes frame) {
+        // A FINS/TCP client holding that node gets it on its connection (W421 7-4 pairs
+        // each node with one connection); anything else goes by FINS/UDP.
+        if (raw->by_port[port]->send_to_tcp_node(node, frame)) return true;
+        const auto to = raw->router.port(port).addresses.lookup(node);
+        if (!to) return false;
+        return raw->by_port[port]->send_datagram(frame, to->ip, to->port);
+    });
+    return std::unique_ptr<Plant>(new Plant(std::move(impl)));
+}
+
+Plant::Plant(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+Plant::~Plant() {
+    stop();
+}
+
+std::size_t Plant::cpu_count() const noexcept {
+    return impl_->cpus.size();
+}
+
+plc::Plc& Plant::plc(std::size_t cpu) noexcept {
+    return *impl_->cpus[cpu].plc;
+}
+
+std::optional<std::size_t> Plant::find(std::string_view name) const noexcept {
+    for (std::size_t i = 0; i < impl_->cpus.size(); ++i)
+        if (impl_->cpus[i].name == name) return i;
+    return std::nullopt;
+}
+
+Router& Plant::router() noexcept {
+    return impl_->router;
+}
+
+Server& Plant::server(std::size_t cpu, std::size_t port) noexcept {
+    return *impl_->cpus[cpu].servers[port];
+}
+
+void Plant::stop() {
+    for (auto& cpu : impl_->cpus) {
+        for (auto& s : cpu.servers)
+            s->stop();
+        cpu.plc->storage().flush();
+    }
+}
+
+}  // namespace fins::server

@@ -1,0 +1,103 @@
+// A plant in one process: several CPU Units, each with its Communications Units on FINS
+// networks, joined by the Router (router.hpp). Each Communications Unit ("port") is one
+// Server (FINS/UDP and FINS/TCP on its own bind address and port, its own 16 FINS/TCP
+// connections, handshake and limits) whose Dispatcher is attached to the router.
+//
+// Start-up per CPU Unit: its Storage (data_dir/finsd.state, or memory that costs
+// nothing until touched), the Plc, the operating mode, the routing tables written into
+// parameter area 8013 from the configuration (local network table from the ports,
+// relay network table from `relays`), then one Server per port.
+//
+// Node addresses (W596 2-3, W420 5-2): with the automatic methods a port's node is the
+// last octet of its bind address (127.0.1.5 is node 5); the IP-address-table and
+// combined methods take the configured node. A frame for a node outside this process is
+// sent as a datagram to the address the sending port's node-address table gives
+// (node_address_table.hpp).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <asio/io_context.hpp>
+
+#include "fins/error.hpp"
+#include "plc/plc.hpp"
+#include "plc/routing_tables.hpp"
+#include "server/routing/node_address_table.hpp"
+#include "server/sessions/tcp_limits.hpp"
+
+namespace fins::server {
+
+class Router;
+class Server;
+
+struct PlantPortConfig {
+    std::uint8_t unit_number = 0;  // 00-0F
+    std::uint8_t network = 1;      // 01-7F
+    std::uint8_t node = 0;         // 0 = the last octet of `bind`
+    std::string bind = "127.0.0.1";
+    std::uint16_t port = 9600;  // FINS/UDP and FINS/TCP (0 = any free port, tests)
+    bool udp = true;
+    bool tcp = true;
+    std::size_t max_connections = 16;  // W596 2-2
+    AddressMethod method = AddressMethod::automatic_dynamic;
+    bool dynamic_remote_ip = true;       // W596 2-3 "Dynamically change remote IP"
+    std::vector<IpTableEntry> ip_table;  // table and combined methods
+};
+
+struct PlantCpuConfig {
+    std::string name;
+    std::string profile = "cj2h";
+    plc::OperatingMode mode = plc::OperatingMode::run;
+    std::optional<std::filesystem::path> data_dir;  // none: nothing kept
+    std::vector<PlantPortConfig> ports;
+    std::vector<plc::RelayNetwork> relays;  // relay network table
+    std::uint8_t gateway_count = 0x02;      // the 02/07 option of the routing tables
+    // false: 8013 is left as the state file holds it (02 02 changes survive restarts).
+    bool write_routing_tables = true;
+};
+
+struct PlantConfig {
+    std::vector<PlantCpuConfig> cpus;
+    TcpLimits tcp_limits;
+    // A state file refused for its content is moved aside and started empty (finsd
+    // --reset-state); without it the plant does not start.
+    bool reset_state = false;
+};
+
+// Cross-field checks: names, unique unit numbers per CPU Unit (at most 16 ports),
+// unique (network, node) in the plant, automatic methods with node = last octet, at
+// most 20 relay entries whose relay network is a local network of that CPU Unit.
+// Empty when the configuration is usable, else one line naming the CPU Unit.
+std::string validate_plant(const PlantConfig& config);
+
+class Plant {
+  public:
+    static Result<std::unique_ptr<Plant>> start(asio::io_context& io, const PlantConfig& config);
+    ~Plant();
+    Plant(const Plant&) = delete;
+    Plant& operator=(const Plant&) = delete;
+
+    [[nodiscard]] std::size_t cpu_count() const noexcept;
+    plc::Plc& plc(std::size_t cpu) noexcept;
+    // The index of the CPU Unit named `name`.
+    [[nodiscard]] std::optional<std::size_t> find(std::string_view name) const noexcept;
+    Router& router() noexcept;
+    // The server of port `port` of CPU Unit `cpu` (in configuration order).
+    Server& server(std::size_t cpu, std::size_t port) noexcept;
+
+    // Closes every socket; flushes and closes the state files.
+    void stop();
+
+    struct Impl;
+
+  private:
+    explicit Plant(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace fins::server

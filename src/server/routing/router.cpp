@@ -1,0 +1,189 @@
+// Router: "is it for me" per port, and forwarding by the 8013 routing tables (see
+// router.hpp for the rules and end codes).
+#include "server/routing/router.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+
+#include <netinet/in.h>
+
+#include "plc/plc.hpp"
+#include "plc/routing_tables.hpp"
+
+namespace fins::server {
+
+namespace {
+
+constexpr std::size_t gateway_count_offset = 2;
+constexpr std::size_t source_network_offset = 6;
+constexpr std::uint32_t address_slots = 128 * 256;
+
+std::uint32_t slot(std::uint8_t network, std::uint8_t node) noexcept {
+    return static_cast<std::uint32_t>(((network & 0x7F) << 8) | node);
+}
+
+}  // namespace
+
+Router::Router() : by_address_(address_slots, 0) {}
+
+std::size_t Router::add_cpu(plc::Plc& plc, bool nx) {
+    cpus_.push_back(Cpu{&plc, nx, {}});
+    return cpus_.size() - 1;
+}
+
+std::size_t Router::add_port(std::size_t cpu, std::uint8_t unit_number, NodeAddress address) {
+    const std::size_t index = ports_.size();
+    ports_.push_back(Port{cpu, unit_number, address, nullptr, {}});
+    cpus_[cpu].ports.push_back(index);
+    by_address_[slot(address.network, address.node)] = static_cast<std::uint32_t>(index + 1);
+    return index;
+}
+
+void Router::set_dispatcher(std::size_t port, Dispatcher& dispatcher) noexcept {
+    ports_[port].dispatcher = &dispatcher;
+}
+
+void Router::set_addresses(std::size_t port, const NodeAddressTable& table) noexcept {
+    ports_[port].addresses = table;
+}
+
+bool Router::note_source(std::size_t port, const Header& header,
+                         const RequestContext& context) noexcept {
+    if (context.peer == nullptr || context.peer->ss_family != AF_INET) return true;
+    Port& arrival = ports_[port];
+    const auto& source = header.source;
+    if (source.network != local_network && source.network != arrival.address.network)
+        return true;  // relayed: the answer goes back the way the frame came
+    sockaddr_in peer{};
+    std::memcpy(&peer, context.peer, sizeof peer);
+    Ipv4Endpoint from{{}, ntohs(peer.sin_port)};
+    std::memcpy(from.ip.data(), &peer.sin_addr.s_addr, 4);
+    arrival.addresses.learn(source.node, from);
+    if (header.is_response()) return true;
+    const auto to = arrival.addresses.lookup(source.node);
+    if (!to) return false;
+    if (*to == from) return true;
+    peer.sin_port = htons(to->port);
+    std::memcpy(&peer.sin_addr.s_addr, to->ip.data(), 4);
+    std::memcpy(context.peer, &peer, sizeof peer);
+    return true;
+}
+
+std::optional<std::size_t> Router::find_port(std::uint8_t network,
+                                             std::uint8_t node) const noexcept {
+    if (network > 0x7F) return std::nullopt;
+    const auto index = by_address_[slot(network, node)];
+    if (index == 0) return std::nullopt;
+    return index - 1;
+}
+
+std::optional<NodeAddress> Router::local_address(std::size_t port,
+                                                 const NodeAddress& destination) const noexcept {
+    const Port& arrival = ports_[port];
+    if (destination.network == local_network || destination.network == arrival.address.network)
+        return arrival.address;
+    for (const std::size_t other : cpus_[arrival.cpu].ports) {
+        const auto& a = ports_[other].address;
+        if (a.network != destination.network) continue;
+        if (destination.node == 0 || destination.node == a.node) return a;
+    }
+    return std::nullopt;
+}
+
+std::uint8_t Router::network_for_local(std::size_t cpu) const noexcept {
+    const auto& c = cpus_[cpu];
+    if (c.ports.empty()) return local_network;
+    if (c.nx) return ports_[c.ports.front()].address.network;
+    const auto smallest = std::min_element(c.ports.begin(), c.ports.end(), [&](auto a, auto b) {
+        return ports_[a].unit_number < ports_[b].unit_number;
+    });
+    return ports_[*smallest].address.network;
+}
+
+std::size_t Router::relay_error(const Header& request, CommandCode command, const Port& arrival,
+                                EndCode code, MutableBytes out) const noexcept {
+    if (!request.response_required()) return 0;
+    // The answer names the node the command was sent to as its source, so the requester
+    // matches it with its request; the relay word names the router that failed.
+    Header response = response_header(request, request.destination);
+    response.gateway_count = default_gateway_count;
+    ByteWriter w(out);
+    write_response_prefix(w, response, command,
+                          static_cast<std::uint16_t>(static_cast<std::uint16_t>(code) |
+                                                     ResponseCode::relay_error_bit));
+    w.u8(arrival.address.network);
+    w.u8(arrival.address.node);
+    return w.overflowed() ? 0 : w.size();
+}
+
+std::size_t Router::forward(std::size_t port, Bytes frame, MutableBytes out,
+                            const RequestContext& context) {
+    // Without a header and command code there is no SID to answer (as the dispatcher).
+    if (frame.size() < header_size + command_code_size) return 0;
+    ByteReader reader(frame);
+    const Header header = read_header(reader);
+    const CommandCode command{reader.u8(), reader.u8()};
+    const Port& arrival = ports_[port];
+    const Cpu& cpu = cpus_[arrival.cpu];
+    const auto fail = [&](EndCode code) {
+        // An answer that cannot be delivered is not answered (there is no one to tell).
+        if (header.is_response()) return std::size_t{0};
+        return relay_error(header, command, arrival, code, out);
+    };
+    // Longer than a FINS frame (W596 1-2: 2,012 bytes): not passed on; 1001 as a node
+    // answers it, from the router that received it.
+    if (frame.size() > max_frame_size) return fail(EndCode::command_too_long);
+
+    const auto decoded =
+        plc::decode_routing_tables(cpu.plc->parameters().words(plc::routing_table_area));
+    if (decoded.state == plc::RoutingTablesState::none) return fail(EndCode::no_routing_tables);
+    if (decoded.state == plc::RoutingTablesState::broken) return fail(EndCode::routing_table_error);
+    const auto& tables = decoded.tables;
+
+    const std::uint8_t target = header.destination.network;
+    std::uint8_t hop_network = target;
+    std::uint8_t hop_node = header.destination.node;
+    if (tables.find_local(target) == nullptr) {
+        const auto* relay = tables.find_relay(target);
+        if (relay == nullptr) return fail(EndCode::destination_address_setting_error);
+        hop_network = relay->relay_network;
+        hop_node = relay->relay_node;
+    }
+    // The local network table names the unit on the next hop's network: it must be a
+    // port of this CPU Unit on that very network.
+    const auto* local = tables.find_local(hop_network);
+    const auto out_port = std::find_if(cpu.ports.begin(), cpu.ports.end(), [&](std::size_t p) {
+        return ports_[p].unit_number == local->unit && ports_[p].address.network == hop_network;
+    });
+    if (out_port == cpu.ports.end()) return fail(EndCode::routing_table_error);
+    // An answer is never refused for its GCT: it started from whatever the command had
+    // left, and dropping it would only make the requester time out.
+    if (header.gateway_count == 0 && !header.is_response()) return fail(EndCode::too_many_relays);
+
+    std::array<std::uint8_t, max_frame_size> copy{};
+    std::memcpy(copy.data(), frame.data(), frame.size());
+    const std::uint8_t gateway_count = std::min(header.gateway_count, max_gateway_count);
+    copy[gateway_count_offset] =
+        static_cast<std::uint8_t>(gateway_count > 0 ? gateway_count - 1 : 0);
+    if (header.source.network == local_network)
+        copy[source_network_offset] = arrival.address.network;
+    const Bytes relayed{copy.data(), frame.size()};
+
+    const auto next = find_port(hop_network, hop_node);
+    if (!next) {
+        if (wire_ && wire_(*out_port, hop_node, relayed)) return 0;
+        return fail(EndCode::destination_node_not_in_network);
+    }
+    Dispatcher* dispatcher = ports_[*next].dispatcher;
+    if (dispatcher == nullptr) return fail(EndCode::destination_node_not_in_network);
+    // The hand-off is not a datagram: the next node learns no address from it.
+    RequestContext inner = context;
+    inner.peer = nullptr;
+    const std::size_t n = dispatcher->handle(relayed, out, inner);
+    // The answer crosses this router on its way back.
+    if (n > gateway_count_offset && out[gateway_count_offset] > 0) --out[gateway_count_offset];
+    return n;
+}
+
+}  // namespace fins::server

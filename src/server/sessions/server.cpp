@@ -1,0 +1,258 @@
+#include "server/sessions/server.hpp"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cstring>
+#include <list>
+#include <optional>
+
+#include <spdlog/spdlog.h>
+#include <asio/ip/tcp.hpp>
+#include <asio/ip/udp.hpp>
+#include <asio/steady_timer.hpp>
+
+#include "fins/node_address.hpp"
+#include "server/dispatch/dispatcher.hpp"
+#include "server/sessions/tcp_session.hpp"
+#include "server/sessions/udp_session.hpp"
+
+namespace fins::server {
+
+std::uint8_t derive_node(const std::string& bind_address) noexcept {
+    std::error_code ec;
+    const auto ip = asio::ip::make_address(bind_address, ec);
+    if (ec || ip.is_unspecified()) return 1;
+    // The same rule as the client's default destination (fins/node_address.hpp).
+    const auto node =
+        ip.is_v4() ? node_from_ip(ip.to_v4().to_bytes()) : node_from_ip(ip.to_v6().to_bytes());
+    // .0 and .255 are not host numbers; a FINS node must be 1-254.
+    return (node == 0 || node == 255) ? 1 : node;
+}
+
+struct Server::Impl {
+    Impl(asio::io_context& context, plc::Plc& plc, NodeAddress self, const ServerOptions& options)
+        : dispatcher(plc, self),
+          acceptor(context),
+          nodes(self.node, options.max_tcp_connections),
+          limits(options.tcp_limits),
+          accept_retry_max(options.accept_retry_max),
+          accept_log_interval(options.accept_log_interval),
+          accept_timer(context) {
+        if (options.router != nullptr) dispatcher.attach(*options.router, options.router_port);
+    }
+
+    void accept_tcp() {
+        acceptor.async_accept([this](std::error_code ec, asio::ip::tcp::socket socket) {
+            if (ec == asio::error::operation_aborted || !acceptor.is_open()) return;
+            if (ec == asio::error::connection_aborted) {
+                // The peer gave up while queued: nothing is wrong with us.
+                accept_tcp();
+                return;
+            }
+            if (ec) {
+                accept_failed(ec);
+                return;
+            }
+            if (accept_failures > 0) {
+                if (accept_episode_logged)
+                    spdlog::warn("fins/tcp: accepting again after {} failed attempts",
+                                 accept_failures);
+                accept_failures = 0;
+                accept_episode_logged = false;
+                accept_delay = std::chrono::milliseconds(0);
+            }
+            sessions.remove_if([](const std::weak_ptr<TcpSession>& w) {
+                auto s = w.lock();
+                return !s || !s->open();
+            });
+            evict_oldest_pending();
+            auto session =
+                std::make_shared<TcpSession>(std::move(socket), dispatcher, nodes, limits);
+            session->set_response_hook(
+                [engine = instructions.get()](Bytes frame) { return engine->on_response(frame); });
+            sessions.push_back(session);
+            session->start();
+            accept_tcp();
+        });
+    }
+
+    // At the cap of connections without a finished handshake, the oldest one goes: a
+    // real client finishes its handshake within a round trip, so the oldest is the one
+    // most likely stalled, and a flood of new sockets cannot keep every slot.
+    void evict_oldest_pending() {
+        std::size_t pending = 0;
+        for (const auto& weak : sessions)
+            if (auto s = weak.lock(); s && s->pending()) ++pending;
+        if (pending < limits.max_pending) return;
+        for (const auto& weak : sessions)
+            if (auto s = weak.lock(); s && s->pending()) {
+                spdlog::info("fins/tcp: {} connections without a handshake, closing the oldest",
+                             pending);
+                s->close();
+                return;
+            }
+    }
+
+    // EMFILE/ENFILE and the like leave the connection queued, so an immediate retry
+    // fails again at once (a busy loop writing a log line each time). Back off instead,
+    // doubling up to accept_retry_max; UDP and open connections are served meanwhile,
+    // and accepting resumes by itself. At most one failure line per accept_log_interval
+    // (a failure that flaps with short recoveries included); the recovery of a logged
+    // failure is logged once.
+    void accept_failed(std::error_code ec) {
+        const auto now = std::chrono::steady_clock::now();
+        const bool new_episode = accept_failures++ == 0;
+        ++accept_unreported;
+        if (!accept_logged || now - *accept_logged >= accept_log_interval) {
+            if (new_episode)
+                spdlog::warn("fins/tcp: accept failed: {}; retrying with a back-off of up to {} ms",
+                             ec.message(), accept_retry_max.count());
+            else
+                spdlog::warn(
+                    "fins/tcp: accept still failing: {} ({} failures since the last "
+                    "report)",
+                    ec.message(), accept_unreported);
+            accept_logged = now;
+            accept_unreported = 0;
+            accept_episode_logged = true;
+        }
+        accept_delay =
+            std::clamp(accept_delay * 2, std::chrono::milliseconds(10), accept_retry_max);
+        accept_timer.expires_after(accept_delay);
+        accept_timer.async_wait([this](std::error_code timer_ec) {
+            if (timer_ec || !acceptor.is_open()) return;
+            accept_tcp();
+        });
+    }
+
+    // The frame on the FINS/TCP connection that holds client node `node`, if one does.
+    bool push_to_tcp_node(std::uint8_t node, Bytes frame) {
+        TcpSession* session = nodes.owner(node);
+        return session != nullptr && session->push_frame(frame);
+    }
+
+    Dispatcher dispatcher;
+    std::shared_ptr<UdpSession> udp;  // null without FINS/UDP
+    // PLC-initiated messages: answers arriving at the UDP session go to `instructions`.
+    std::unique_ptr<UdpInstructionTransport> transport;
+    std::unique_ptr<NetworkInstructions> instructions;
+    asio::ip::tcp::acceptor acceptor;
+    TcpNodeTable nodes;
+    TcpLimits limits;
+    std::list<std::weak_ptr<TcpSession>> sessions;  // in accept order
+    std::chrono::milliseconds accept_retry_max;
+    std::chrono::milliseconds accept_log_interval;
+    asio::steady_timer accept_timer;
+    std::chrono::milliseconds accept_delay{0};
+    std::size_t accept_failures = 0;    // since the last successful accept
+    std::size_t accept_unreported = 0;  // failures not yet counted in a log line
+    bool accept_episode_logged = false;
+    std::optional<std::chrono::steady_clock::time_point> accept_logged;
+};
+
+Result<std::unique_ptr<Server>> Server::start(asio::io_context& io, plc::Plc& plc,
+                                              const ServerOptions& options) {
+    std::error_code ec;
+    const auto ip = asio::ip::make_address(options.bind_address, ec);
+    if (ec) return Unexpected(ec);
+    const std::uint8_t node = options.node != 0 ? options.node : derive_node(options.bind_address);
+    const NodeAddress self{options.network, node, cpu_unit};
+    auto impl = std::make_unique<Impl>(io, plc, self, options);
+
+    std::uint16_t port = options.port;
+    if (options.tcp) {
+        const asio::ip::tcp::endpoint ep{ip, port};
+        impl->acceptor.open(ep.protocol(), ec);
+        if (!ec) impl->acceptor.set_option(asio::socket_base::reuse_address(true), ec);
+        if (!ec) impl->acceptor.bind(ep, ec);
+        if (!ec) impl->acceptor.listen(asio::socket_base::max_listen_connections, ec);
+        if (ec) return Unexpected(ec);
+        // With port 0 the UDP socket takes the same number TCP was given.
+        port = impl->acceptor.local_endpoint().port();
+    }
+    if (options.udp) {
+        const asio::ip::udp::endpoint ep{ip, port};
+        asio::ip::udp::socket socket{io};
+        socket.open(ep.protocol(), ec);
+        if (!ec) socket.bind(ep, ec);
+        if (ec) return Unexpected(ec);
+        impl->udp = std::make_shared<UdpSession>(std::move(socket), impl->dispatcher);
+    }
+    impl->transport =
+        std::make_unique<UdpInstructionTransport>(impl->udp, ip, self, options.remotes);
+    impl->transport->set_tcp_route([raw = impl.get()](std::uint8_t client, Bytes frame) {
+        return raw->push_to_tcp_node(client, frame);
+    });
+    impl->instructions =
+        std::make_unique<NetworkInstructions>(io.get_executor(), plc, self, *impl->transport);
+    if (impl->udp)
+        impl->udp->set_response_hook([engine = impl->instructions.get()](Bytes frame) {
+            return engine->on_response(frame);
+        });
+    if (options.tcp) impl->accept_tcp();
+    if (impl->udp) impl->udp->start();
+    return std::unique_ptr<Server>(new Server(std::move(impl)));
+}
+
+Server::Server(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+Server::~Server() {
+    stop();
+}
+
+std::uint16_t Server::udp_port() const noexcept {
+    return impl_->udp ? impl_->udp->local_port() : 0;
+}
+
+std::uint16_t Server::tcp_port() const noexcept {
+    std::error_code ec;
+    return impl_->acceptor.is_open() ? impl_->acceptor.local_endpoint(ec).port() : 0;
+}
+
+NodeAddress Server::address() const noexcept {
+    return impl_->dispatcher.self();
+}
+
+void Server::attach_serial_ports(SerialPorts* ports) noexcept {
+    impl_->dispatcher.attach_serial_ports(ports);
+}
+
+Dispatcher& Server::dispatcher() noexcept {
+    return impl_->dispatcher;
+}
+
+bool Server::send_datagram(Bytes frame, const std::array<std::uint8_t, 4>& ip,
+                           std::uint16_t port) noexcept {
+    if (!impl_->udp) return false;
+    sockaddr_in to{};
+    to.sin_family = AF_INET;
+    to.sin_port = htons(port);
+    std::memcpy(&to.sin_addr.s_addr, ip.data(), ip.size());
+    return impl_->udp->send_to(frame, to);
+}
+
+bool Server::send_to_tcp_node(std::uint8_t node, Bytes frame) {
+    return impl_->push_to_tcp_node(node, frame);
+}
+
+std::size_t Server::tcp_connections() const noexcept {
+    return impl_->nodes.in_use();
+}
+
+NetworkInstructions& Server::instructions() noexcept {
+    return *impl_->instructions;
+}
+
+void Server::stop() {
+    std::error_code ignored;
+    impl_->instructions->stop();
+    if (impl_->udp) impl_->udp->close();
+    impl_->acceptor.close(ignored);
+    impl_->accept_timer.cancel();
+    for (auto& weak : impl_->sessions)
+        if (auto s = weak.lock()) s->close();
+    impl_->sessions.clear();
+}
+
+}  // namespace fins::server

@@ -1,0 +1,391 @@
+#include "server/sessions/tcp_session.hpp"
+
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <sys/socket.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+
+#include <spdlog/spdlog.h>
+#include <asio/post.hpp>
+#include <asio/write.hpp>
+
+#include "fins/frame.hpp"
+#include "server/dispatch/dispatcher.hpp"
+
+namespace fins::server {
+
+namespace {
+
+// FINS header offsets of the source network and node (W342 3-3-3: ICF RSV GCT DNA DA1
+// DA2 SNA SA1 SA2 SID).
+constexpr std::size_t source_network_offset = 6;
+constexpr std::size_t source_node_offset = 7;
+
+using quick_ack = asio::detail::socket_option::boolean<IPPROTO_TCP, TCP_QUICKACK>;
+
+}  // namespace
+
+TcpSession::TcpSession(asio::ip::tcp::socket socket, Dispatcher& dispatcher, TcpNodeTable& nodes,
+                       const TcpLimits& limits)
+    : socket_(std::move(socket)),
+      dispatcher_(dispatcher),
+      nodes_(nodes),
+      limits_(limits),
+      timer_(socket_.get_executor()) {
+    std::error_code ignored;
+    peer_ = socket_.remote_endpoint(ignored).address();
+}
+
+TcpSession::~TcpSession() {
+    nodes_.release(client_node_, this);
+}
+
+void TcpSession::start() {
+    std::error_code ignored;
+    // Never let a response sit behind Nagle waiting for the client's delayed ACK.
+    socket_.set_option(asio::ip::tcp::no_delay(true), ignored);
+    if (const auto ec = set_keepalive(socket_, limits_.keepalive))
+        spdlog::debug("fins/tcp: keep-alive: {}", ec.message());
+    set_deadline(Deadline::handshake, limits_.handshake_timeout);
+    on_readable();
+}
+
+void TcpSession::close() {
+    if (state_ == State::closed) return;
+    state_ = State::closed;
+    ++timer_generation_;
+    timer_.cancel();
+    nodes_.release(client_node_, this);
+    client_node_ = 0;
+    std::error_code ignored;
+    socket_.shutdown(asio::ip::tcp::socket::shutdown_both, ignored);
+    socket_.close(ignored);
+}
+
+void TcpSession::wait_readable() {
+    socket_.async_wait(asio::socket_base::wait_read,
+                       [self = shared_from_this()](std::error_code ec) {
+                           if (ec == asio::error::operation_aborted) return;
+                           self->on_readable();
+                       });
+}
+
+void TcpSession::on_readable() {
+    const int fd = socket_.native_handle();
+    for (unsigned round = 0; round < rounds_per_turn; ++round) {
+        if (state_ != State::handshake && state_ != State::established) return;
+        // serve_buffered() leaves at most one partial packet, so there is room for one.
+        const std::size_t room = in_.size() - in_size_;
+        const ssize_t n = ::recv(fd, in_.data() + in_size_, room, MSG_DONTWAIT);
+        if (n < 0) {
+            if (errno == EINTR) continue;
+            if (errno == EAGAIN || errno == EWOULDBLOCK) break;
+            spdlog::debug("fins/tcp: read failed: {}", std::strerror(errno));
+            close();
+            return;
+        }
+        if (n == 0) {  // the peer closed its side
+            close();
+            return;
+        }
+        in_size_ += static_cast<std::size_t>(n);
+        if (!serve_buffered()) return;
+        // A lone request is the one-in-flight client: the next cannot come before it has
+        // this answer, so reading again would only find nothing. The wait's re-arm
+        // (EPOLL_CTL_MOD) reports data that does come meanwhile.
+        if (served_ <= 1 && static_cast<std::size_t>(n) < room) break;
+        if (round + 1 == rounds_per_turn) {
+            // Still busy: let the other sessions' ready handlers run, then go on.
+            asio::post(socket_.get_executor(), [self = shared_from_this()] {
+                if (self->open()) self->on_readable();
+            });
+            return;
+        }
+    }
+    wait_readable();
+}
+
+void TcpSession::resume() {
+    if (serve_buffered()) on_readable();
+}
+
+bool TcpSession::serve_buffered() {
+    served_ = 0;
+    std::size_t start = 0;
+    bool go_on = true;
+    bool answered = true;  // the last packet brings an answer, which carries our ACK
+    while (go_on && (state_ == State::handshake || state_ == State::established)) {
+        const TcpParse parsed = parse_tcp_frame({in_.data() + start, in_size_ - start});
+        if (parsed.status == TcpParse::Status::need_more) break;
+        if (parsed.status == TcpParse::Status::error) {
+            ByteWriter w{out_};
+            write_tcp_error(w, TcpCommand::frame_error, parsed.error);
+            spdlog::warn("fins/tcp: {}: envelope error {:#04x}, closing", peer_.to_string(),
+                         static_cast<int>(parsed.error));
+            start = in_size_;
+            go_on = send_answer(w.size(), true);
+            break;
+        }
+        const bool keep_open = handle_packet(parsed.packet);
+        answered = out_size_pending_ > 0;
+        start += parsed.consumed;
+        ++served_;
+        // A complete packet: what follows is a new packet with its own frame deadline.
+        if (state_ == State::established) deadline_kind_ = Deadline::idle;
+        if (out_size_pending_ > 0 || !keep_open) go_on = send_answer(out_size_pending_, !keep_open);
+    }
+    // The packets' data views pointed into in_; only now may the rest move to the front.
+    std::memmove(in_.data(), in_.data() + start, in_size_ - start);
+    in_size_ -= start;
+    if (!go_on || state_ != State::established) return go_on;
+    // The handshake deadline runs from accept; afterwards a packet that has begun must
+    // end within frame_timeout, and silence is bounded by idle_timeout.
+    if (in_size_ == 0)
+        set_deadline(Deadline::idle, limits_.idle_timeout);
+    else if (deadline_kind_ != Deadline::frame)
+        set_deadline(Deadline::frame, limits_.frame_timeout);
+    // A client that writes the FINS/TCP header and the frame separately without
+    // TCP_NODELAY holds the frame until its header is acknowledged, and a frame that
+    // asks for no response gets no answer to carry the ACK. Linux delays that ACK
+    // (~40 ms); quick-ack mode does not stick, so re-arm it (issue 6 item 13).
+    if (in_size_ > 0 || !answered) {
+        std::error_code ignored;
+        socket_.set_option(quick_ack(true), ignored);
+    }
+    return true;
+}
+
+bool TcpSession::send_answer(std::size_t size, bool close_after) {
+    if (close_after || writing_ || confirming_ || late_writing_) {
+        send_and_continue(size, close_after);
+        return false;
+    }
+    ssize_t sent = -1;
+    for (int attempt = 0; attempt < 4 && sent < 0; ++attempt) {
+        sent = ::send(socket_.native_handle(), out_.data(), size, MSG_DONTWAIT | MSG_NOSIGNAL);
+        if (sent < 0 && errno != EINTR) break;
+    }
+    if (sent == static_cast<ssize_t>(size)) return true;
+    if (sent < 0 && errno != EAGAIN && errno != EWOULDBLOCK) {
+        spdlog::debug("fins/tcp: write failed: {}", std::strerror(errno));
+        close();
+        return false;
+    }
+    // The send buffer is full: the rest goes out asynchronously, reading waits for it.
+    const std::size_t done = sent > 0 ? static_cast<std::size_t>(sent) : 0;
+    std::memmove(out_.data(), out_.data() + done, size - done);
+    send_and_continue(size - done, false);
+    return false;
+}
+
+bool TcpSession::handle_packet(const TcpPacket& packet) {
+    out_size_pending_ = 0;
+    const auto command = static_cast<TcpCommand>(packet.command);
+    if (state_ == State::handshake) {
+        if (command == TcpCommand::node_address_request) return handshake(packet);
+        ByteWriter w{out_};
+        write_tcp_error(w, TcpCommand::frame_error, TcpError::command_not_supported);
+        out_size_pending_ = w.size();
+        return false;
+    }
+    ByteWriter w{out_};
+    if (command != TcpCommand::frame) {
+        // A second handshake or any other command on an open connection (frames 3.4 step 5).
+        write_tcp_error(w, TcpCommand::frame_error, TcpError::command_not_supported);
+        out_size_pending_ = w.size();
+        return false;
+    }
+    if (!from_bound_node(packet.data)) {
+        // Not executed as another node and not answered: W421 sends a node's answers only
+        // on the connection paired with it. One warning per connection, no log flood.
+        const auto level = logged_foreign_source_ ? spdlog::level::debug : spdlog::level::warn;
+        logged_foreign_source_ = true;
+        spdlog::log(level, "fins/tcp: {}: dropped a frame from {}.{} on the connection of node {}",
+                    peer_.to_string(), packet.data[source_network_offset],
+                    packet.data[source_node_offset], client_node_);
+        return true;
+    }
+    // An answer to one of this node's own instructions, sent to the client's node.
+    if (response_hook_ && !packet.data.empty() && (packet.data[0] & icf_response) != 0 &&
+        response_hook_(packet.data))
+        return true;
+    // Reserve the envelope header, let the dispatcher write the FINS response after it.
+    const MutableBytes frame_out{out_.data() + tcp_header_size, max_frame_size};
+    const RequestContext context{Link::tcp, std::chrono::system_clock::now(), this};
+    const std::size_t n = dispatcher_.handle(packet.data, frame_out, context);
+    if (n > 0) {
+        write_tcp_header(w, TcpCommand::frame, n);
+        out_size_pending_ = tcp_header_size + n;
+    }
+    return true;
+}
+
+bool TcpSession::handshake(const TcpPacket& packet) {
+    ByteWriter w{out_};
+    const auto requested = decode_node_address_request(packet.data);
+    // The refusal echoes the requested value whole (00000105 stays 00000105).
+    ByteReader raw(packet.data);
+    const std::uint32_t echoed = packet.data.size() >= 4 ? raw.u32() : 0;
+    Result<std::uint8_t> claimed = requested;
+    if (requested) {
+        claimed = nodes_.claim(*requested, this);
+    } else if (requested.error() != TcpError::client_node_out_of_range) {
+        write_tcp_error(w, TcpCommand::frame_error, TcpError::data_length_too_long);
+        out_size_pending_ = w.size();
+        return false;
+    }
+    if (!claimed) {
+        // W421 7-4: a client with the same IP address and node as an open connection makes
+        // the server probe that connection with command 6; the newcomer is refused (0x21)
+        // whatever the probe shows.
+        if (claimed.error() == TcpError::node_already_connected)
+            if (TcpSession* holder = nodes_.owner(*requested);
+                holder != nullptr && holder->peer_address() == peer_)
+                holder->confirm_connection();
+        // W421 7-4: the error goes back in command 1, then the server closes.
+        write_node_address_response(w, echoed, dispatcher_.self().node,
+                                    static_cast<std::uint32_t>(claimed.error().value()));
+        out_size_pending_ = w.size();
+        spdlog::info("fins/tcp: {}: refused client node {:#010x}: {}", peer_.to_string(), echoed,
+                     claimed.error().message());
+        return false;
+    }
+    client_node_ = *claimed;
+    state_ = State::established;
+    write_node_address_response(w, client_node_, dispatcher_.self().node);
+    out_size_pending_ = w.size();
+    spdlog::info("fins/tcp: {}: client node {} connected", peer_.to_string(), client_node_);
+    return true;
+}
+
+bool TcpSession::from_bound_node(Bytes frame) const noexcept {
+    // Too short to name a source: the dispatcher drops it (there is no SID to answer).
+    if (frame.size() <= source_node_offset) return true;
+    const std::uint8_t network = frame[source_network_offset];
+    const bool local = network == local_network || network == dispatcher_.self().network;
+    return local && frame[source_node_offset] == client_node_;
+}
+
+void TcpSession::send_and_continue(std::size_t size, bool close_after) {
+    if (confirming_ || late_writing_) {
+        // Command 6 is on its way; this packet follows it whole, never interleaved.
+        deferred_ = true;
+        deferred_size_ = size;
+        deferred_close_ = close_after;
+        return;
+    }
+    writing_ = true;
+    // The peer must take the response: a client that stops reading is a stalled frame.
+    if (state_ == State::established) set_deadline(Deadline::frame, limits_.frame_timeout);
+    auto self = shared_from_this();
+    // One write per response: clients that read one response per recv() depend on it.
+    asio::async_write(socket_, asio::buffer(out_.data(), size),
+                      [self, close_after](std::error_code ec, std::size_t) {
+                          self->writing_ = false;
+                          if (!self->open()) return;
+                          if (ec) {
+                              self->close();
+                              return;
+                          }
+                          if (close_after) {
+                              self->close_after_notice();
+                              return;
+                          }
+                          if (self->confirm_wanted_) {
+                              self->confirm_wanted_ = false;
+                              self->send_confirmation();
+                          } else if (!self->late_.empty()) {
+                              self->write_late();
+                          }
+                          self->resume();
+                      });
+}
+
+void TcpSession::confirm_connection() {
+    if (state_ != State::established || confirming_) return;
+    if (writing_ || late_writing_) {
+        confirm_wanted_ = true;
+        return;
+    }
+    send_confirmation();
+}
+
+void TcpSession::send_confirmation() {
+    confirming_ = true;
+    ByteWriter w{confirmation_};
+    write_tcp_header(w, TcpCommand::connection_confirmation, 0);
+    spdlog::info("fins/tcp: {}: node {} asked for again, confirming the connection",
+                 peer_.to_string(), client_node_);
+    auto self = shared_from_this();
+    asio::async_write(socket_, asio::buffer(confirmation_),
+                      [self](std::error_code ec, std::size_t) {
+                          self->confirming_ = false;
+                          if (!self->open()) return;
+                          if (ec) {
+                              self->close();
+                              return;
+                          }
+                          if (self->deferred_) {
+                              self->deferred_ = false;
+                              self->send_and_continue(self->deferred_size_, self->deferred_close_);
+                          } else if (!self->late_.empty() && !self->writing_) {
+                              self->write_late();
+                          }
+                      });
+}
+
+bool TcpSession::push_frame(Bytes frame) {
+    if (state_ != State::established || late_.size() >= max_late || frame.size() > max_frame_size)
+        return false;
+    queue_late(frame);
+    return true;
+}
+
+Completion TcpSession::defer() {
+    return [weak = weak_from_this()](Bytes frame) {
+        if (auto self = weak.lock()) self->queue_late(frame);
+    };
+}
+
+void TcpSession::queue_late(Bytes frame) {
+    if (state_ != State::established) return;
+    if (late_.size() >= max_late) {
+        spdlog::warn("fins/tcp: {}: late answer dropped (peer not reading)", peer_.to_string());
+        return;
+    }
+    std::vector<std::uint8_t> packet(tcp_header_size + frame.size());
+    ByteWriter w{packet};
+    write_tcp_header(w, TcpCommand::frame, frame.size());
+    w.bytes(frame);
+    late_.push_back(std::move(packet));
+    if (!writing_ && !confirming_ && !late_writing_) write_late();
+}
+
+void TcpSession::write_late() {
+    late_writing_ = true;
+    auto self = shared_from_this();
+    asio::async_write(socket_, asio::buffer(late_.front()),
+                      [self](std::error_code ec, std::size_t) {
+                          self->late_writing_ = false;
+                          if (!self->late_.empty()) self->late_.pop_front();
+                          if (!self->open()) return;
+                          if (ec) {
+                              self->close();
+                              return;
+                          }
+                          if (self->deferred_) {
+                              self->deferred_ = false;
+                              self->send_and_continue(self->deferred_size_, self->deferred_close_);
+                          } else if (self->confirm_wanted_) {
+                              self->confirm_wanted_ = false;
+                              self->send_confirmation();
+                          } else if (!self->late_.empty() && !self->writing_) {
+                              self->write_late();
+                          }
+                      });
+}
+
+}  // namespace fins::server
