@@ -88,6 +88,11 @@ struct Settings : CpuUnitOptions {
     // (the server layer knows no config entries; serve_plant applies them).
     struct PlantCpuSettings : CpuUnitOptions {  // [plc.protection], [plc.inject]
         std::vector<MemoryInit> memory;         // [plc.memory]
+        std::vector<SerialPortConfig> serial;   // [plc.serial]
+        std::vector<ScheduleEntry> schedule;    // [[plc.schedule]]
+        // Per [[plc.ethernet]]: true when it sets `port`; the others take `port` above
+        // (--port, [network] port).
+        std::vector<bool> port_given;
     };
     std::vector<PlantCpuSettings> plant_cpu;
 
@@ -130,7 +135,7 @@ Expected<void> validate(const Settings& settings);
 // Protections and injections onto the model at start (after the mode is set).
 void apply_cpu_options(const CpuUnitOptions& options, plc::Plc& plc);
 
-// One [[plc]] table's [protection] or [inject] (`key`), parsed exactly as the single
+// One [[plc]] table's [protection], [inject] or [storage] (`key`), parsed exactly as the single
 // node's onto `cpu`; errors name `path` (e.g. plc[1].protection.network_write).
 Expected<void> load_cpu_section(const toml::key& key, const toml::node& node,
                                 std::string_view source, const std::string& path, Settings& cpu);

@@ -297,19 +297,9 @@ int serve(const Settings& s) {
         if (auto r = plc.files().attach(*s.data_dir); !r)
             return fail(3, "file memory in " + s.data_dir->string() + ": " + r.error().message());
 
-    fins::server::ServerOptions options;
-    options.bind_address = s.bind;
-    options.port = s.port;
-    options.udp = s.udp;
-    options.tcp = s.tcp;
-    options.node = s.node;
-    options.network = s.network;
-    options.max_tcp_connections = s.max_connections;
-    options.tcp_limits.handshake_timeout = std::chrono::seconds(s.tcp_handshake_timeout);
-    options.tcp_limits.frame_timeout = std::chrono::seconds(s.tcp_frame_timeout);
-    options.tcp_limits.idle_timeout = std::chrono::seconds(s.tcp_idle_timeout);
-    options.tcp_limits.keepalive = std::chrono::seconds(s.tcp_keepalive);
-    options.tcp_limits.max_pending = s.tcp_max_pending;
+    // The same translation as each unit of a plant gets (server/routing/plant.hpp).
+    auto options = fins::server::options_for(fins::cli::finsd::single_unit(s),
+                                             fins::cli::finsd::tcp_limits(s));
     options.remotes = s.remotes;
     asio::io_context io{1};
     auto server = fins::server::Server::start(io, plc, options);

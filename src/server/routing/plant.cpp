@@ -28,6 +28,32 @@ std::uint8_t port_node(const PlantPortConfig& p) noexcept {
 
 }  // namespace
 
+ServerOptions options_for(const PlantPortConfig& unit, const TcpLimits& limits) {
+    ServerOptions options;
+    options.bind_address = unit.bind;
+    options.port = unit.port;
+    options.udp = unit.udp;
+    options.tcp = unit.tcp;
+    options.node = unit.node;
+    options.network = unit.network;
+    options.max_tcp_connections = unit.max_connections;
+    options.tcp_limits = limits;
+    return options;
+}
+
+std::size_t unit_toward(const PlantCpuConfig& cpu, std::uint8_t network) noexcept {
+    const auto on = [&](std::uint8_t n) -> std::optional<std::size_t> {
+        for (std::size_t i = 0; i < cpu.ports.size(); ++i)
+            if (cpu.ports[i].network == n) return i;
+        return std::nullopt;
+    };
+    if (const auto local = on(network)) return *local;
+    for (const auto& r : cpu.relays)
+        if (r.network == network)
+            if (const auto via = on(r.relay_network)) return *via;
+    return 0;
+}
+
 std::string validate_plant(const PlantConfig& config) {
     if (config.cpus.empty()) return "plc: no CPU Unit";
     std::set<std::string> names;
@@ -104,7 +130,7 @@ namespace {
 // Unit and the file, as finsd --reset-state words them for a single node.
 Result<std::unique_ptr<plc::Plc>> open_cpu(const PlantCpuConfig& c, const plc::Profile& profile,
                                            bool reset_state) {
-    auto opened = plc::open_plc(profile, c.data_dir, {}, reset_state);
+    auto opened = plc::open_plc(profile, c.data_dir, {c.durability}, reset_state);
     const std::string file =
         c.data_dir ? (*c.data_dir / "finsd.state").string() : std::string("(heap)");
     if (!opened) {
@@ -142,7 +168,8 @@ Result<std::unique_ptr<Plant>> Plant::start(asio::io_context& io, const PlantCon
     auto impl = std::make_unique<Impl>();
     impl->cpus.reserve(config.cpus.size());
     for (const auto& c : config.cpus) {
-        const plc::Profile profile = *plc::find_profile(c.profile);
+        plc::Profile profile = *plc::find_profile(c.profile);
+        if (c.units) profile.units = *c.units;
         auto plc = open_cpu(c, profile, config.reset_state);
         if (!plc) return Unexpected(plc.error());
         (*plc)->change_mode(c.mode, std::chrono::system_clock::now());
@@ -162,17 +189,12 @@ Result<std::unique_ptr<Plant>> Plant::start(asio::io_context& io, const PlantCon
         for (const auto& p : c.ports) {
             const NodeAddress self{p.network, port_node(p), cpu_unit};
             const auto index = impl->router.add_port(cpu, p.unit_number, self);
-            ServerOptions options;
-            options.bind_address = p.bind;
-            options.port = p.port;
-            options.udp = p.udp;
-            options.tcp = p.tcp;
-            options.node = self.node;
-            options.network = self.network;
-            options.max_tcp_connections = p.max_connections;
-            options.tcp_limits = config.tcp_limits;
+            PlantPortConfig unit = p;
+            unit.node = self.node;
+            auto options = options_for(unit, config.tcp_limits);
             options.router = &impl->router;
             options.router_port = index;
+            options.remotes = c.remotes;
             auto server = Server::start(io, *owner.plc, options);
             if (!server) {
                 spdlog::error("finsd: plc \"{}\" unit {}: cannot listen on {} port {}: {}", c.name,

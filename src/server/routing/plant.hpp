@@ -26,8 +26,12 @@
 
 #include "fins/error.hpp"
 #include "plc/plc.hpp"
+#include "plc/profile.hpp"
 #include "plc/routing_tables.hpp"
+#include "plc/storage.hpp"
+#include "server/instructions/instruction_udp.hpp"
 #include "server/routing/node_address_table.hpp"
+#include "server/sessions/server.hpp"
 #include "server/sessions/tcp_limits.hpp"
 
 namespace fins::server {
@@ -59,6 +63,14 @@ struct PlantCpuConfig {
     std::uint8_t gateway_count = 0x02;      // the 02/07 option of the routing tables
     // false: 8013 is left as the state file holds it (02 02 changes survive restarts).
     bool write_routing_tables = true;
+    // What an acknowledged write survives ([storage] durability of a single node).
+    plc::Durability durability = plc::Durability::process;
+    // The units the CPU Unit reports (05 02), when more than its profile's: a Serial
+    // Communications Unit or Board mounted for Serial Gateway ports. None: the profile's.
+    std::optional<std::vector<plc::UnitInfo>> units;
+    // Where remote nodes are for this CPU Unit's Send/Rcv/SendCmd ([[remote]]), on each
+    // of its units.
+    std::vector<RemoteNode> remotes;
 };
 
 struct PlantConfig {
@@ -68,6 +80,17 @@ struct PlantConfig {
     // --reset-state); without it the plant does not start.
     bool reset_state = false;
 };
+
+// The server options of one Ethernet unit (address, ports, transports, FINS/TCP limits):
+// the one translation used for finsd's single node and for each unit of a plant. The
+// caller adds what only it knows (router, remotes). `unit.node` is passed as is (0 =
+// derived by the server, server.hpp).
+ServerOptions options_for(const PlantPortConfig& unit, const TcpLimits& limits);
+
+// The unit through which CPU Unit `cpu` sends a network instruction to `network` (W342
+// 5-1-1 routing tables): the unit on that network, else the unit on the relay network
+// of the relay entry for it, else the first unit (network 00, the local network).
+std::size_t unit_toward(const PlantCpuConfig& cpu, std::uint8_t network) noexcept;
 
 // Cross-field checks: names, unique unit numbers per CPU Unit (at most 16 ports),
 // unique (network, node) in the plant, automatic methods with node = last octet, at
