@@ -111,7 +111,9 @@ int configure(int argc, char** argv, Settings& settings) {
     auto* o_bind =
         app.add_option("--bind", bind, "Address to listen on (IPv4 or IPv6; default 127.0.0.1)");
     auto* o_port =
-        app.add_option("--port", port, "UDP and TCP port (0 = any free port; default 9600)");
+        app.add_option("--port", port,
+                       "UDP and TCP port (0 = any free port; default 9600); in a plant, of each "
+                       "[[plc.ethernet]] unit without a port of its own");
     auto* o_node =
         app.add_option("--node", node,
                        "FINS node address 1-254 (default: last octet of --bind, 1 on loopback)")
