@@ -151,5 +151,29 @@ TEST(PlantCpuSettings, EachCpuUnitHasItsOwnDurability) {
     EXPECT_EQ(plant.plant().plc(1).storage().syncs(), 0u);
 }
 
+// The single node's [storage], [serial], [[remote]] and [[schedule]] describe no CPU Unit
+// of a plant: finsd says they are ignored and where a plant takes them.
+TEST(PlantCpuSettings, SingleNodeTablesInAPlantAreNamedAsIgnored) {
+    ScratchDir dir("plant-ignored");
+    const std::string single = R"(
+[[remote]]
+node = 9
+address = "127.0.0.9"
+[[schedule]]
+every = "1s"
+instruction = "sendcmd"
+dest = "0.9.0"
+command = "0501"
+)";
+    Finsd d({"--config", dir.write("plant.toml", single + plant(""))});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    const auto err = d.stop().err;
+    EXPECT_NE(err.find("[[remote]] (a [[plc]] takes its own [[plc.remote]])"), std::string::npos)
+        << err;
+    EXPECT_NE(err.find("[[schedule]] (a [[plc]] takes its own [[plc.schedule]])"),
+              std::string::npos)
+        << err;
+}
+
 }  // namespace
 }  // namespace fins::test
