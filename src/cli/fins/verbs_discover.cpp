@@ -8,7 +8,7 @@
 //                         broadcast addresses
 // with at most `max_hosts` hosts in all. At most --parallel requests are in flight; each
 // host gets --timeout per attempt and --retries more attempts, so the run is bounded.
-// Prints one line per node that answered (host, node, model, version) in host order; exit
+// Prints one line per node that answered (host, node, model, version) in RANGE's order; exit
 // 0 when at least one did, 3 when none did.
 #include <arpa/inet.h>
 #include <netinet/in.h>
