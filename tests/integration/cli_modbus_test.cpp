@@ -115,6 +115,8 @@ TEST_F(CliModbus, BadArgumentsAreUsageErrorsBeforeAnythingIsSent) {
              {"read", "registers", "0"},
              {"peek", "holding", "0"},
              {"read", "holding", "0", "--gateway", "scu16.1"},
+             {"read", "holding", "0", "--gateway", "scu1.3"},
+             {"read", "holding", "0", "--gateway", "185"},
          }) {
         const auto r = modbus(args);
         EXPECT_EQ(r.exit_code, 2) << args[0] << " " << args[1] << ": " << r.err;
@@ -125,11 +127,17 @@ TEST_F(CliModbus, BadArgumentsAreUsageErrorsBeforeAnythingIsSent) {
     EXPECT_NE(r.err.find("--gateway scu1.2"), std::string::npos) << r.err;
 }
 
-// --dest NET.NODE.UNIT with the port's unit address reaches the same port.
-TEST_F(CliModbus, W342_5_3_47_DestWithThePortUnitAddress) {
-    const auto r = fins(*finsd_, {"--dest", "0.0.0x85", "modbus", "read", "holding", "3"});
-    EXPECT_EQ(r.exit_code, 0) << r.err;
-    EXPECT_EQ(r.out, "holding 3  3\n");
+// The port's unit address (W342 5-3-47 tables: scu1.2 is 85 hex) reaches the same port,
+// in --gateway as the tables print it (hex) or in --dest.
+TEST_F(CliModbus, W342_5_3_47_GatewayOrDestByThePortUnitAddress) {
+    for (const auto& how : std::vector<std::vector<std::string>>{
+             {"--dest", "0.0.0x85"}, {"--gateway", "85"}, {"--gateway", "0x85"}}) {
+        std::vector<std::string> args{"modbus", "read", "holding", "3"};
+        args.insert(args.end(), how.begin(), how.end());
+        const auto r = fins(*finsd_, args);
+        EXPECT_EQ(r.exit_code, 0) << how[1] << ": " << r.err;
+        EXPECT_EQ(r.out, "holding 3  3\n") << how[1];
+    }
 }
 
 // W342 5-3-47 names no timeout; W336 6-6-2 gives the port one, W596 p. 3-16 gives fins 2 s.

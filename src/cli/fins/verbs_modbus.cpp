@@ -5,7 +5,7 @@
 //   fins modbus write coils ADDRESS VALUE...     05 (one value) / 0F (several)
 //   fins modbus write holding ADDRESS VALUE...   06 (one value) / 10 (several)
 // --slave 1-247 (0: broadcast, writes only), --gateway scuN.P | board.P | UNIT (the
-// port's unit address, W342 5-3-47 tables) or --dest NET.NODE.UNIT. Function codes,
+// port's unit address in hex, W342 5-3-47 tables) or --dest NET.NODE.UNIT. Function codes,
 // limits and exception codes: Modbus Application Protocol v1.1b3 6.1-6.12 and 7. The
 // slave's own answer is checked (address, function, byte count); an exception response
 // (a normal 0000 FINS answer carrying function | 80) exits 4 with the exception's name.
@@ -85,23 +85,26 @@ const char* exception_name(std::uint8_t code) {
     }
 }
 
-// scuN.P, board.P, or a unit address (hex with 0x, or with a letter, as --dest takes it).
+// scuN.P, board.P, or the port's unit address in hex as the W342 5-3-47 tables print it
+// (85, E4, FD; 0x85 too).
 std::optional<std::uint8_t> gateway_unit(const std::string& text) {
     const auto dot = text.find('.');
-    if (dot != std::string::npos && dot + 2 == text.size()) {
-        const char port = text[dot + 1];
-        if (port != '1' && port != '2') return std::nullopt;
-        const auto p = static_cast<unsigned>(port - '0');
-        const auto head = text.substr(0, dot);
-        if (head == "board") return board_port_unit_address(p);
-        if (head.size() == 4 && head.rfind("scu", 0) == 0) {
-            const auto n = parse_number("0x" + head.substr(3), 15);
-            if (n) return scu_port_unit_address(*n, p);
-        }
-        return std::nullopt;
+    if (dot == std::string::npos) {
+        const bool prefixed =
+            text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X');
+        const auto unit = parse_number(prefixed ? text : "0x" + text, 0xFF);
+        if (!unit) return std::nullopt;
+        return static_cast<std::uint8_t>(*unit);
     }
-    if (auto a = parse_node_address("0.0." + text)) return a->unit;
-    return std::nullopt;
+    if (dot + 2 != text.size() || (text[dot + 1] != '1' && text[dot + 1] != '2'))
+        return std::nullopt;
+    const auto port = static_cast<unsigned>(text[dot + 1] - '0');
+    const auto head = text.substr(0, dot);
+    if (head == "board") return board_port_unit_address(port);
+    if (head.size() != 4 || head.rfind("scu", 0) != 0) return std::nullopt;
+    const auto n = parse_number("0x" + head.substr(3), 15);
+    if (!n) return std::nullopt;
+    return scu_port_unit_address(*n, port);
 }
 
 struct Exchange {
@@ -208,7 +211,7 @@ int run_modbus(const GlobalOptions& g, const ModbusArgs& a, Output& out) {
         const auto unit = gateway_unit(a.gateway);
         if (!unit)
             return out.usage(fmt::format(
-                "--gateway '{}': scuN.P (N 0-F, P 1 or 2), board.P or a unit address (0x85)",
+                "--gateway '{}': scuN.P (N 0-F, P 1 or 2), board.P or a unit address in hex (85)",
                 a.gateway));
         auto dest =
             g.dest.empty() ? std::optional<NodeAddress>{NodeAddress{}} : parse_node_address(g.dest);
@@ -322,7 +325,7 @@ void add_modbus_verbs(CLI::App& app, const GlobalOptions& g, int& exit_code) {
         ->capture_default_str();
     c->add_flag("--ascii", a->ascii, "Modbus-ASCII (28 05) instead of Modbus-RTU (28 04)");
     c->add_option("--gateway", a->gateway,
-                  "The Serial Gateway port: scuN.P, board.P or its unit address (0x85)");
+                  "The Serial Gateway port: scuN.P, board.P or its unit address in hex (85, E4)");
 }
 
 }  // namespace fins::cli
