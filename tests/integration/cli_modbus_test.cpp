@@ -152,6 +152,23 @@ TEST(CliModbusDefaults, W342_5_3_47_SilentSlaveIsThePorts0205WithBothDefaults) {
         json(finsd, {"modbus", "read", "holding", "0", "--slave", "9", "--gateway", "scu1.1"}, 4);
     EXPECT_EQ(doc["error"]["kind"], "end_code");
     EXPECT_EQ(doc["error"]["end_code"], "0205");
+    EXPECT_NE(doc["error"]["hint"].get<std::string>().find("slave 9 did not answer"),
+              std::string::npos);
+}
+
+// A port finsd does not have answers 0202 (W342 5-1-3): fins says which port is missing
+// instead of the generic "the CPU Unit is unit 0".
+TEST_F(CliModbus, W342_5_3_47_MissingPortIs0202WithAHintAboutThePort) {
+    const auto r = fins(*finsd_, {"modbus", "read", "holding", "0", "--gateway", "scu2.1"});
+    EXPECT_EQ(r.exit_code, 4);
+    EXPECT_NE(r.err.find("fins: modbus read holding 0: the PLC answered unit missing"),
+              std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find("no Serial Gateway port at scu2.1"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("unit 0"), std::string::npos) << r.err;
+    const auto doc = json(*finsd_, {"modbus", "read", "holding", "0", "--gateway", "scu2.1"}, 4);
+    EXPECT_EQ(doc["error"]["end_code"], "0202");
+    EXPECT_EQ(doc["error"]["name"], "unit missing");
 }
 
 TEST(CliModbusAscii, W342_5_3_48_ReadsAndWritesThroughModbusAscii) {

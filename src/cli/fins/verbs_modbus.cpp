@@ -134,21 +134,50 @@ Result<Exchange> exchange(Client& client, bool ascii, const std::vector<std::uin
     return Exchange{std::move(binary)};
 }
 
-// An exception response: printed like a failure, exit 4 (the device refused).
-int exception(Output& out, const std::string& context, unsigned slave, std::uint8_t code) {
-    const auto message =
-        fmt::format("slave {} answered exception {:02X} ({})", slave, code, exception_name(code));
-    if (out.json())
-        std::printf("%s\n", nlohmann::json{{"error",
-                                            {{"kind", "modbus_exception"},
-                                             {"exception", code},
-                                             {"name", exception_name(code)},
-                                             {"message", message},
-                                             {"context", context}}}}
-                                .dump()
-                                .c_str());
-    std::fprintf(stderr, "fins: %s: %s\n", context.c_str(), message.c_str());
+// A failure fins words itself: "fins: CONTEXT: MESSAGE" (and a hint) on stderr, the
+// error object on stdout under --json, exit 4 (the slave or the port refused).
+int refused(Output& out, nlohmann::json error, const std::string& context,
+            const std::string& message, const std::string& hint, const char* said = "") {
+    error["message"] = message;
+    error["context"] = context;
+    if (!hint.empty()) error["hint"] = hint;
+    if (out.json()) std::printf("%s\n", nlohmann::json{{"error", error}}.dump().c_str());
+    std::fprintf(stderr, "fins: %s: %s%s\n", context.c_str(), said, message.c_str());
+    if (!hint.empty()) std::fprintf(stderr, "fins: %s\n", hint.c_str());
     return exit_end_code;
+}
+
+// An exception response (Modbus Application Protocol 7).
+int exception(Output& out, const std::string& context, unsigned slave, std::uint8_t code) {
+    return refused(
+        out, {{"kind", "modbus_exception"}, {"exception", code}, {"name", exception_name(code)}},
+        context,
+        fmt::format("slave {} answered exception {:02X} ({})", slave, code, exception_name(code)),
+        {});
+}
+
+// What the FINS end code means for a Modbus request: 0202/0401 name no serial port (the
+// generic hint about unit 0 would mislead), 0205 a slave that stayed silent.
+int gateway_failure(Output& out, std::error_code ec, const std::string& context,
+                    const ModbusArgs& a, const GlobalOptions& target) {
+    const bool no_port = ec == make_error_code(EndCode::unit_missing) ||
+                         ec == make_error_code(EndCode::undefined_command);
+    if (!no_port && ec != make_error_code(EndCode::response_timeout))
+        return out.failure(ec, context);
+    const auto* info = find_end_code(static_cast<std::uint16_t>(ec.value()));
+    const std::string port = a.gateway.empty() ? "--dest " + target.dest : a.gateway;
+    return refused(out,
+                   {{"kind", "end_code"},
+                    {"end_code", fmt::format("{:04X}", ec.value())},
+                    {"name", info ? std::string(info->name) : "unknown"}},
+                   context, ec.message(),
+                   no_port ? fmt::format("no Serial Gateway port at {} (finsd: --serial "
+                                         "scuN.P=DEVICE; W342 5-3-47 lists the unit addresses)",
+                                         port)
+                           : fmt::format("slave {} did not answer within the gateway port's "
+                                         "timeout: check --slave, the line settings and the slave",
+                                         a.slave),
+                   "the PLC answered ");
 }
 
 std::vector<std::uint8_t> header(unsigned slave, std::uint8_t function, unsigned address,
@@ -260,15 +289,7 @@ int run_modbus(const GlobalOptions& g, const ModbusArgs& a, Output& out) {
         write ? write_request(a.slave, table->bits, *address, values)
               : header(a.slave, table->read_function, *address, static_cast<unsigned>(count));
     auto r = exchange(*client, a.ascii, request, out);
-    if (!r) {
-        const int failed = out.failure(r.error(), context);
-        if (r.error() == make_error_code(EndCode::response_timeout))
-            std::fprintf(stderr,
-                         "fins: slave %u did not answer within the gateway port's timeout: "
-                         "check --slave, the line settings and the slave\n",
-                         a.slave);
-        return failed;
-    }
+    if (!r) return gateway_failure(out, r.error(), context, a, target);
     const auto& answer = r->answer;
     const auto malformed = [&] {
         return out.failure(make_error_code(ClientError::malformed_response), context);
