@@ -15,6 +15,14 @@
 
 #include "cli/fins/commands.hpp"
 
+namespace fins::cli {
+// verbs_modbus.cpp (28 04 / 28 05), verbs_watch.cpp (01 04 polling), verbs_discover.cpp
+// (05 01 over an IPv4 range).
+void add_modbus_verbs(CLI::App& app, const GlobalOptions& g, int& exit_code);
+void add_watch_verbs(CLI::App& app, const GlobalOptions& g, int& exit_code);
+void add_discover_verbs(CLI::App& app, const GlobalOptions& g, int& exit_code);
+}  // namespace fins::cli
+
 int main(int argc, char** argv) {
     using namespace fins::cli;
     CLI::App app{"fins: talk FINS to an Omron CS/CJ/CP/NX PLC or to finsd"};
@@ -80,6 +88,9 @@ int main(int argc, char** argv) {
     add_control_verbs(app, g, group_rc);
     add_diagnostic_verbs(app, g, group_rc);
     add_file_verbs(app, g, group_rc);
+    add_watch_verbs(app, g, group_rc);
+    add_discover_verbs(app, g, group_rc);
+    add_modbus_verbs(app, g, group_rc);
 
     describe_global_options(app);
 

@@ -166,7 +166,7 @@ int configure(int argc, char** argv, Settings& settings) {
             ->check(CLI::IsMember({"process", "power"}));
     app.add_option("--serial", o.serial,
                    "Serial port NAME=DEVICE[,baud=9600,parity=even,data=7,stop=2,unit=0,mode=..."
-                   ",timeout=5]; NAME cpu, scuN.P or board.P (repeatable; README Host Link)");
+                   ",timeout=1]; NAME cpu, scuN.P or board.P (repeatable; README Host Link)");
     app.add_flag("--reset-state", o.reset_state,
                  "Move a refused state file aside (never deleted) and start with a new one");
     try {
