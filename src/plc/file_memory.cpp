@@ -176,8 +176,20 @@ Result<FileNameReadResponse> FileMemory::list(const FileNameRead& c) {
     const Fd dir = host::open_path(device->fd, *path);
     if (!dir.valid()) return fail(EndCode::read_file_missing);
 
+    struct stat volume {};
+    const bool dated = ::fstatat(device->fd, volume_file, &volume, AT_SYMLINK_NOFOLLOW) == 0;
     std::vector<FileEntry> all;
-    if (!path->empty()) {
+    if (path->empty()) {
+        // 5-3-32 "Total Number of Files": "Volume labels ... are all counted as files. (The
+        // root directory can contain a volume label, but not a current directory or parent
+        // directory mark.)" On FAT the label is an entry of the root directory, first here:
+        // attribute 08 (volume label), size 0, the date of the label (the last format).
+        FileEntry label;
+        label.name = *FileName::from(device->label);
+        label.date = dated ? date_of(volume.st_mtime) : 0;
+        label.attribute = attribute_volume;
+        all.push_back(label);
+    } else {
         struct stat st {};
         ::fstat(dir.get(), &st);
         all.push_back(dot_entry(".", st));
@@ -189,9 +201,7 @@ Result<FileNameReadResponse> FileMemory::list(const FileNameRead& c) {
 
     FileNameReadResponse r;
     r.disk.volume_label = *FileName::from(device->label);
-    struct stat volume {};
-    if (::fstatat(device->fd, volume_file, &volume, AT_SYMLINK_NOFOLLOW) == 0)
-        r.disk.date = date_of(volume.st_mtime);
+    if (dated) r.disk.date = date_of(volume.st_mtime);
     const auto used = bytes_in_use(*device);
     r.disk.total_capacity =
         static_cast<std::uint32_t>(std::min<std::uint64_t>(device->capacity, 0xFFFFFFFF));

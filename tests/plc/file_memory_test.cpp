@@ -114,11 +114,11 @@ TEST_F(FileMemoryTest, W342_5_3_34_DatedWithTheCpuClock) {
     ASSERT_EQ(put("A.TXT", "x"), EndCode::normal_completion);
     const auto list = files.list({disk_memory_card, 0, 20, ""});
     ASSERT_TRUE(list);
-    ASSERT_EQ(list->files.size(), 1U);
+    ASSERT_EQ(list->files.size(), 2U);  // the volume label, then the file
     // 1,700,000,000 = 2023-11-14 22:13:20
-    EXPECT_EQ(list->files[0].date, pack_file_date(2023, 11, 14, 22, 13, 20));
-    EXPECT_EQ(list->files[0].size, 1U);
-    EXPECT_EQ(list->files[0].attribute, attribute_archive);
+    EXPECT_EQ(list->files[1].date, pack_file_date(2023, 11, 14, 22, 13, 20));
+    EXPECT_EQ(list->files[1].size, 1U);
+    EXPECT_EQ(list->files[1].attribute, attribute_archive);
 }
 
 TEST_F(FileMemoryTest, HostileNamesNeverLeaveTheDevice) {
@@ -144,7 +144,8 @@ TEST_F(FileMemoryTest, HostileNamesNeverLeaveTheDevice) {
     EXPECT_EQ(put("X.TXT", "x", "\\" + std::string(65, 'A')), EndCode::parameter_error);
     const auto list = files.list({disk_memory_card, 0, 20, ""});
     ASSERT_TRUE(list);
-    EXPECT_TRUE(list->files.empty());  // the symlinks are invisible
+    ASSERT_EQ(list->files.size(), 1U);  // the symlinks are invisible: the volume label only
+    EXPECT_EQ(list->files[0].attribute, attribute_volume);
     EXPECT_EQ(slurp(box.dir / "secret/KEY.TXT"), "secret");
     EXPECT_EQ(box.outside(), before);
     EXPECT_EQ(fs::directory_iterator(box.dir / "secret")->path().filename(), "KEY.TXT");
@@ -184,12 +185,12 @@ TEST_F(FileMemoryTest, W342_5_3_32_ListingAcrossRequests) {
         ASSERT_EQ(put("F" + std::to_string(i), "x"), EndCode::normal_completion);
     const auto first = files.list({disk_memory_card, 0, 20, ""});
     ASSERT_TRUE(first);
-    EXPECT_EQ(first->disk.total_files, 25);
+    EXPECT_EQ(first->disk.total_files, 26);  // with the volume label (5-3-32)
     EXPECT_EQ(first->files.size(), 20U);
     EXPECT_FALSE(first->last);
     const auto rest = files.list({disk_memory_card, 20, 20, ""});
     ASSERT_TRUE(rest);
-    EXPECT_EQ(rest->files.size(), 5U);
+    EXPECT_EQ(rest->files.size(), 6U);
     EXPECT_TRUE(rest->last);
     EXPECT_EQ(files.list({disk_memory_card, 0, 21, ""}).error(), EndCode::parameter_error);
     // A sub-directory lists "." and ".." first.
@@ -200,6 +201,48 @@ TEST_F(FileMemoryTest, W342_5_3_32_ListingAcrossRequests) {
     ASSERT_EQ(sub->files.size(), 2U);
     EXPECT_EQ(sub->files[0].name.text(), ".");
     EXPECT_EQ(sub->files[1].attribute, attribute_directory);
+}
+
+TEST_F(FileMemoryTest, W342_5_3_32_RootCountsTheVolumeLabelAsAFile) {
+    ASSERT_EQ(files.format(disk_memory_card, 0, 1'700'000'000), EndCode::normal_completion);
+    ASSERT_EQ(put("A.TXT", "abc"), EndCode::normal_completion);
+    ASSERT_EQ(files.directory({disk_memory_card, 0, name("SUB"), ""}, 0),
+              EndCode::normal_completion);
+    const auto root = files.list({disk_memory_card, 0, 20, ""});
+    ASSERT_TRUE(root);
+    // "Volume labels ... are all counted as files. (The root directory can contain a
+    // volume label, but not a current directory or parent directory mark.)"
+    EXPECT_EQ(root->disk.total_files, 3);
+    ASSERT_EQ(root->files.size(), 3U);
+    const FileEntry& label = root->files[0];
+    EXPECT_EQ(label.name, root->disk.volume_label);
+    EXPECT_EQ(label.name.text(), "MEMCARD");
+    EXPECT_EQ(label.attribute, attribute_volume);
+    EXPECT_EQ(label.size, 0U);
+    EXPECT_EQ(label.date, root->disk.date);
+    EXPECT_EQ(label.date, pack_file_date(2023, 11, 14, 22, 13, 20));
+    EXPECT_EQ(root->files[1].name.text(), "A.TXT");
+    EXPECT_EQ(root->files[2].name.text(), "SUB");
+    EXPECT_TRUE(root->last);
+    // Positions count the label: the file is entry 1.
+    const auto second = files.list({disk_memory_card, 1, 1, ""});
+    ASSERT_TRUE(second);
+    ASSERT_EQ(second->files.size(), 1U);
+    EXPECT_EQ(second->files[0].name.text(), "A.TXT");
+    // A sub-directory has no label: ".", "..", then its entries.
+    const auto sub = files.list({disk_memory_card, 0, 20, "\\SUB"});
+    ASSERT_TRUE(sub);
+    EXPECT_EQ(sub->disk.total_files, 2);
+    for (const auto& e : sub->files)
+        EXPECT_EQ(e.attribute & attribute_volume, 0);
+    // EM file memory's root has its own label.
+    files.set_em_file_bank(0x10);
+    const auto em = files.list({disk_em_file, 0, 20, ""});
+    ASSERT_TRUE(em);
+    EXPECT_EQ(em->disk.total_files, 1);
+    ASSERT_EQ(em->files.size(), 1U);
+    EXPECT_EQ(em->files[0].name.text(), "EMFILE");
+    EXPECT_EQ(em->files[0].attribute, attribute_volume);
 }
 
 TEST_F(FileMemoryTest, W342_5_3_42_DirectoryRules) {
@@ -236,7 +279,8 @@ TEST_F(FileMemoryTest, W342_5_3_35_DevicesMissingAndFormat) {
     EXPECT_EQ(files.format(disk_memory_card, 0, 1'700'000'000), EndCode::normal_completion);
     const auto after = files.list({disk_memory_card, 0, 20, ""});
     ASSERT_TRUE(after);
-    EXPECT_TRUE(after->files.empty());
+    ASSERT_EQ(after->files.size(), 1U);  // the volume label, dated by the format
+    EXPECT_EQ(after->files[0].date, pack_file_date(2023, 11, 14, 22, 13, 20));
     EXPECT_EQ(after->disk.date, pack_file_date(2023, 11, 14, 22, 13, 20));
     files.remove_card();
     EXPECT_EQ(put("A.TXT", "x"), EndCode::file_device_missing);

@@ -135,6 +135,8 @@ int run_ls(const GlobalOptions& g, const FileArgs& a, Output& out) {
         fmt::format("{} {}  {} of {} bytes free\n", r->disk.volume_label.text(),
                     date_text(r->disk.date), r->disk.free_capacity, r->disk.total_capacity);
     for (const auto& f : r->files) {
+        // The root's volume label entry (5-3-32, attribute 08) is the header line above.
+        if ((f.attribute & attribute_volume) != 0) continue;
         const bool dir = (f.attribute & attribute_directory) != 0;
         files.push_back({{"name", f.name.text()},
                          {"size", f.size},
