@@ -286,5 +286,56 @@ TEST_F(FileMemoryTest, W342_5_3_35_DevicesMissingAndFormat) {
     EXPECT_EQ(put("A.TXT", "x"), EndCode::file_device_missing);
 }
 
+// frames-serial-files 4 "a hostile path never escapes" is about names from the network;
+// <root>/card itself comes from whoever owns the data directory: a symlink there (the card
+// on another disk) is followed at attach() and reported; a broken one fails attach().
+TEST(FileMemoryDeviceLinks, FrameSerialFiles_4_1_CardSymlinkIsFollowedAndReported) {
+    Sandbox box;
+    Profile profile = cj2h();
+    fs::create_directories(box.dir / "disk/cardstore");
+    { std::ofstream(box.dir / "disk/cardstore/.tmp-9-9") << "half"; }
+    fs::create_directory_symlink(box.dir / "disk/cardstore", box.dir / "root/card");
+    FileMemory files(profile);
+    ASSERT_TRUE(files.attach(box.dir / "root"));
+    ASSERT_EQ(files.device_links().size(), 1U);
+    EXPECT_EQ(files.device_links()[0].device, "card");
+    EXPECT_EQ(files.device_links()[0].target, box.dir / "disk/cardstore");
+    EXPECT_FALSE(files.device_links()[0].error);
+    EXPECT_FALSE(fs::exists(box.dir / "disk/cardstore/.tmp-9-9"));  // cleaned like any card
+    const auto data = bytes("on the other disk");
+    EXPECT_EQ(files.write({disk_memory_card, 0, name("A.TXT"), 0, data, ""}, 0),
+              EndCode::normal_completion);
+    EXPECT_EQ(slurp(box.dir / "disk/cardstore/A.TXT"), "on the other disk");
+    const auto list = files.list({disk_memory_card, 0, 20, ""});
+    ASSERT_TRUE(list);
+    EXPECT_EQ(list->disk.total_files, 2);  // the volume label and A.TXT
+    // Below the followed directory, symlinks are still neither followed nor listed.
+    fs::create_directory(box.dir / "secret");
+    fs::create_directory_symlink(box.dir / "secret", box.dir / "disk/cardstore/LINK");
+    EXPECT_EQ(files.write({disk_memory_card, 0, name("X.TXT"), 0, data, "\\LINK"}, 0),
+              EndCode::write_file_missing);
+    EXPECT_TRUE(fs::is_empty(box.dir / "secret"));
+
+    // Dangling, or naming a file: refused at attach, the link named.
+    fs::remove(box.dir / "root/card");
+    fs::create_directory_symlink(box.dir / "disk/none", box.dir / "root/card");
+    FileMemory dangling(profile);
+    EXPECT_FALSE(dangling.attach(box.dir / "root"));
+    ASSERT_EQ(dangling.device_links().size(), 1U);
+    EXPECT_TRUE(dangling.device_links()[0].error);
+    fs::remove(box.dir / "root/card");
+    { std::ofstream(box.dir / "disk/file") << "x"; }
+    fs::create_symlink(box.dir / "disk/file", box.dir / "root/card");
+    FileMemory to_file(profile);
+    const auto r = to_file.attach(box.dir / "root");
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error(), std::errc::not_a_directory);
+    // Without links there is nothing to report.
+    fs::remove(box.dir / "root/card");
+    FileMemory plain(profile);
+    ASSERT_TRUE(plain.attach(box.dir / "root"));
+    EXPECT_TRUE(plain.device_links().empty());
+}
+
 }  // namespace
 }  // namespace fins::plc

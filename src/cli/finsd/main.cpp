@@ -293,9 +293,21 @@ int serve(const Settings& s) {
     }
     if (s.em_file_bank) plc.files().set_em_file_bank(*s.em_file_bank);
     if (s.cassette) plc.files().mount_cassette(*s.cassette);
-    if (s.data_dir)
-        if (auto r = plc.files().attach(*s.data_dir); !r)
+    if (s.data_dir) {
+        const auto r = plc.files().attach(*s.data_dir);
+        // A device directory that is a symlink is followed (plc/file_memory.hpp): say so.
+        for (const auto& link : plc.files().device_links()) {
+            const auto path = (*s.data_dir / link.device).string();
+            if (link.error)
+                return fail(3, "file memory: " + path + " is a symlink to " + link.target.string() +
+                                   ", not a usable directory: " + link.error.message());
+            spdlog::info(
+                "finsd: file memory: {} is a symlink to {}: followed (nothing below it is)", path,
+                link.target.string());
+        }
+        if (!r)
             return fail(3, "file memory in " + s.data_dir->string() + ": " + r.error().message());
+    }
 
     fins::server::ServerOptions options;
     options.bind_address = s.bind;
