@@ -49,9 +49,8 @@ namespace fins::plc {
 
 // EM file memory: one bank of 32,768 words = 64 KiB of file space.
 inline constexpr std::uint32_t em_bank_bytes = 32768 * 2;
-// 5-3-39 .. 5-3-41 data files (.IOM, .STD, .OBJ) start with a 48-byte header
-// (CJ2SW p.269/272); finskit writes zeros there and skips it on load.
-inline constexpr std::size_t data_file_header_size = 48;
+// The data files' header (fins/commands/file_memory.hpp).
+using fins::data_file_header_size;
 // Directories below the root: 5 levels counting the root (CJ2SW p.271).
 inline constexpr std::size_t max_file_directories = 4;
 
