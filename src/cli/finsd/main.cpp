@@ -301,7 +301,9 @@ int serve(const Settings& s) {
             if (link.error)
                 return fail(3, "file memory: " + path + " is a symlink to " + link.target.string() +
                                    ", not a usable directory: " + link.error.message());
-            spdlog::info(
+            // A warning: files then live outside the data directory, which backups of
+            // that directory miss; the operator should see it at any log level but error.
+            spdlog::warn(
                 "finsd: file memory: {} is a symlink to {}: followed (nothing below it is)", path,
                 link.target.string());
         }
