@@ -30,20 +30,44 @@ dpkg -L finskit | grep '^/usr/bin/finsd$' >/dev/null || fail "finsd installed"
 check "finsd installed"
 unit=$(dpkg -L finskit | grep "/systemd/system/finsd.service$")
 for option in NoNewPrivileges=yes PrivateTmp=yes ProtectSystem=strict DynamicUser=yes \
-    StateDirectory=finsd; do
-  grep -qx "$option" "$unit"
+    StateDirectory=finsd RuntimeDirectory=finsd SupplementaryGroups=dialout DevicePolicy=closed \
+    "DeviceAllow=char-ttyS rw" "DeviceAllow=char-ttyUSB rw" "DeviceAllow=char-ttyACM rw" \
+    CapabilityBoundingSet=; do
+  grep -qx "$option" "$unit" || fail "unit option $option"
 done
-check "unit hardening options"
+check "unit hardening options, runtime directory and serial device access"
+# ProtectSystem=strict leaves only the state and runtime directories writable: the
+# control socket must lie in the one, the retained memory in the other.
+grep -E '^ExecStart=.* --control /run/finsd/[^ ]+' "$unit" >/dev/null || fail "control socket under /run/finsd"
+grep -E '^ExecStart=.* --data-dir /var/lib/finsd( |$)' "$unit" >/dev/null || fail "data dir is the StateDirectory"
+check "control socket in the RuntimeDirectory, state in the StateDirectory"
+systemd-analyze verify "$unit" || fail "systemd-analyze verify $unit"
+check "systemd-analyze verify finsd.service"
 grep '^bind = "127.0.0.1"' /etc/finskit/finsd.toml >/dev/null || fail "config binds 127.0.0.1"
 check "config binds 127.0.0.1"
 dpkg-query -W -f='${Conffiles}' finskit | grep /etc/finskit/finsd.toml >/dev/null || fail "config is a conffile"
 check "config is a conffile"
 
-# The unit's command line, run as systemd would (it creates the StateDirectory).
+# Where systemd is PID 1 the postinst has started the service: it runs and answers on
+# its control socket inside the sandbox. Elsewhere (containers, CI) that is skipped.
+control=$(sed -n 's/^ExecStart=.* --control \([^ ]*\).*/\1/p' "$unit")
+if [[ -d /run/systemd/system ]]; then
+  systemctl is-active --quiet finsd.service || fail "finsd.service active after install"
+  /usr/bin/finsd ctl --socket "$control" status >/dev/null || fail "control socket of the service"
+  check "finsd.service runs under systemd and answers on $control"
+else
+  echo "  skipped: finsd.service under systemd (systemd is not PID 1 here)"
+fi
+if [[ -d /run/systemd/system ]]; then systemctl stop finsd.service; fi
+
+# The unit's command line, run as systemd would (it creates the State- and
+# RuntimeDirectory).
 read -r -a exec_start <<<"$(sed -n 's/^ExecStart=//p' "$unit")"
-$sudo mkdir -p /var/lib/finsd
+$sudo mkdir -p /var/lib/finsd /run/finsd
 finsd_start $sudo "${exec_start[@]}"
 check "finsd started from the unit's ExecStart on port $finsd_port"
+$sudo /usr/bin/finsd ctl --socket "$control" status | grep '"mode"' >/dev/null || fail "finsd ctl on $control"
+check "finsd ctl answers on the unit's control socket $control"
 fins=(/usr/bin/fins --port "$finsd_port")
 "${fins[@]}" write D100 11 22 33 >/dev/null
 "${fins[@]}" read D100 3 | grep "D102 *33" >/dev/null || fail "installed fins writes and reads (UDP)"
@@ -51,6 +75,7 @@ check "installed fins writes and reads (UDP)"
 "${fins[@]}" --tcp read D100 1 --json | grep 11 >/dev/null || fail "installed fins over TCP"
 check "installed fins over TCP"
 finsd_stop
+$sudo rm -rf /run/finsd
 ls /var/lib/finsd | grep . >/dev/null || fail "state kept in the StateDirectory"
 check "state kept in the StateDirectory"
 if /usr/bin/python3 -c "import finskit" 2>/dev/null; then
@@ -84,8 +109,13 @@ tmp=$(mktemp -d)
 g++ $(pkg-config --cflags fins) "$root/examples/typed_command.cpp" -o "$tmp/typed_command" \
   $(pkg-config --libs fins) || fail "build against the installed libfins-dev"
 ldd "$tmp/typed_command" | grep -E "libfins\.so\.[0-9.]+ => (/usr)?/lib/" >/dev/null || fail "libfins0.1 used"
-rm -rf "$tmp"
 check "a program builds against libfins-dev and runs on libfins0.1's SONAME"
+# shellcheck disable=SC2046
+g++ $(pkg-config --cflags fins-static) "$root/examples/typed_command.cpp" -o "$tmp/static" \
+  $(pkg-config --libs fins-static) || fail "static build against libfins-dev (fins-static)"
+if ldd "$tmp/static" | grep libfins.so; then fail "pkg-config fins-static links libfins.so"; fi
+rm -rf "$tmp"
+check "pkg-config fins-static links libfins.a: no libfins.so loaded"
 
 $sudo apt-get purge -y -qq "${packages[@]}" >/dev/null
 trap - EXIT
