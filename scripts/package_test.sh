@@ -78,6 +78,37 @@ finsd_stop
 $sudo rm -rf /run/finsd
 ls /var/lib/finsd | grep . >/dev/null || fail "state kept in the StateDirectory"
 check "state kept in the StateDirectory"
+
+# What the installed README says about the installed finsd holds.
+readme=/usr/share/doc/finskit/README.md
+said=$(grep -o 'The cj2h file is [0-9.]* MB' "$readme" | grep -Eo '[0-9.]+')
+size=$(stat -c %s /var/lib/finsd/finsd.state)
+measured=$(awk -v s="$size" 'BEGIN { printf "%.1f", s / 1e6 }')
+[[ "$said" == "$measured" ]] || fail "README says the cj2h state file is $said MB, it is $measured MB"
+check "README's state file size ($said MB) is the default profile's"
+# The README's [serial] configuration example loads on the default profile, its devices
+# replaced by pseudo terminals (socat pairs).
+tmp=$(mktemp -d)
+awk '/^```toml$/ { b = ""; in_block = 1; next }
+     in_block && /^```$/ { if (b ~ /\[serial/) { printf "%s", b; exit } in_block = 0; next }
+     in_block { b = b $0 "\n" }' "$readme" >"$tmp/example.toml"
+grep -q '^\[serial' "$tmp/example.toml" || fail "README's [serial] example found"
+socat_pids=()
+config=$(cat "$tmp/example.toml")
+for device in $(grep -Eo '/dev/tty[A-Za-z]+[0-9]+' "$tmp/example.toml" | sort -u); do
+  pty="$tmp/pty$((${#socat_pids[@]}))"
+  socat pty,raw,echo=0,link="$pty" pty,raw,echo=0,link="$pty.peer" &
+  socat_pids+=($!)
+  for ((n = 0; n < 100 && ! -e "$pty"; n++)); do sleep 0.05; done
+  config=${config//"$device"/"$pty"}
+done
+printf '%s\n' "$config" >"$tmp/example.toml"
+finsd_start /usr/bin/finsd --config "$tmp/example.toml" || fail "README's [serial] example: $(cat "$tmp/example.toml")"
+finsd_stop
+kill "${socat_pids[@]}" 2>/dev/null || true
+wait "${socat_pids[@]}" 2>/dev/null || true
+rm -rf "$tmp"
+check "README's [serial] configuration example starts finsd"
 if /usr/bin/python3 -c "import finskit" 2>/dev/null; then
   /usr/bin/python3 - <<'PY'
 import finskit
