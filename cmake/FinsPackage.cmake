@@ -107,4 +107,5 @@ if(FINS_PYTHON)
   add_subdirectory(${PROJECT_SOURCE_DIR}/python ${PROJECT_BINARY_DIR}/python)
 endif()
 
+include(${CMAKE_CURRENT_LIST_DIR}/FinsDebian.cmake)
 include(${CMAKE_CURRENT_LIST_DIR}/FinsCPack.cmake)

@@ -24,7 +24,11 @@ for package in "${packages[@]}"; do
   fi
 done
 $sudo apt-get install -y -qq --no-install-recommends "${debs[@]}" >/dev/null
-cleanup() { $sudo apt-get purge -y -qq "${packages[@]}" >/dev/null 2>&1 || true; }
+socat_pids=()
+cleanup() {
+  if ((${#socat_pids[@]})); then kill "${socat_pids[@]}" 2>/dev/null || true; fi
+  $sudo apt-get purge -y -qq "${packages[@]}" >/dev/null 2>&1 || true
+}
 trap cleanup EXIT
 dpkg -L finskit | grep '^/usr/bin/finsd$' >/dev/null || fail "finsd installed"
 check "finsd installed"
@@ -60,6 +64,50 @@ else
 fi
 if [[ -d /run/systemd/system ]]; then systemctl stop finsd.service; fi
 
+# Debian policy files: DEP-5 copyright and the gzip'd changelog of this version in every
+# package's doc directory; lintian finds no errors.
+for deb in "${debs[@]}"; do
+  package=$(dpkg-deb -f "$deb" Package)
+  version=$(dpkg-deb -f "$deb" Version)
+  doc=/usr/share/doc/$package
+  head -n 1 "$doc/copyright" | grep -qx 'Format: https://www.debian.org/doc/packaging-manuals/copyright-format/1.0/' \
+    || fail "$doc/copyright is DEP-5"
+  changelog=$(dpkg-parsechangelog -l "$doc/changelog.gz" -S Version 2>/dev/null) || changelog=$(
+    zcat "$doc/changelog.gz" | dpkg-parsechangelog -l - -S Version)
+  [[ "$changelog" == "$version" ]] || fail "$doc/changelog.gz is at $changelog, the package at $version"
+done
+check "every package has a DEP-5 copyright and its version's changelog.gz"
+if command -v lintian >/dev/null; then
+  lintian --fail-on error --tag-display-limit 0 "${debs[@]}" || fail "lintian finds errors"
+  check "lintian: no errors"
+else
+  echo "  skipped: lintian (not installed: scripts/deps.sh installs it)"
+fi
+for page in man1/fins.1.gz man8/finsd.8.gz; do
+  zcat "/usr/share/man/$page" | grep -q '^\.SH' || fail "man page $page"
+done
+if command -v man >/dev/null; then man -w fins finsd >/dev/null || fail "man finds fins and finsd"; fi
+check "man pages fins(1) and finsd(8)"
+# Bash completion: every verb `fins --help` lists (and every `finsd ctl` verb) completes.
+completion_test() {
+  local program=$1 verbs
+  shift
+  # shellcheck disable=SC1090
+  source "/usr/share/bash-completion/completions/$program"
+  verbs=$("$program" "$@" --help | awk '/^Subcommands:/ { s = 1; next } /^[^ ]/ { s = 0 } s && /^  [a-z]/ { print $1 }')
+  [[ -n "$verbs" ]] || fail "$program $* --help lists verbs"
+  for verb in $verbs; do
+    COMP_WORDS=("$program" "$@" "${verb:0:2}")
+    COMP_CWORD=$((${#COMP_WORDS[@]} - 1))
+    _finskit_complete
+    printf '%s\n' "${COMPREPLY[@]}" | grep -qxF -- "$verb" || fail "bash completion of '$program $* ${verb:0:2}' lacks $verb"
+  done
+}
+completion_test fins
+completion_test fins files
+completion_test finsd ctl
+check "bash completion offers every verb of fins, fins files and finsd ctl"
+
 # The unit's command line, run as systemd would (it creates the State- and
 # RuntimeDirectory).
 read -r -a exec_start <<<"$(sed -n 's/^ExecStart=//p' "$unit")"
@@ -81,7 +129,7 @@ check "state kept in the StateDirectory"
 
 # What the installed README says about the installed finsd holds.
 readme=/usr/share/doc/finskit/README.md
-said=$(grep -o 'The cj2h file is [0-9.]* MB' "$readme" | grep -Eo '[0-9.]+')
+said=$(sed -n 's/.*The cj2h file is \([0-9.]*\) MB.*/\1/p' "$readme")
 size=$(stat -c %s /var/lib/finsd/finsd.state)
 measured=$(awk -v s="$size" 'BEGIN { printf "%.1f", s / 1e6 }')
 [[ "$said" == "$measured" ]] || fail "README says the cj2h state file is $said MB, it is $measured MB"
@@ -93,13 +141,15 @@ awk '/^```toml$/ { b = ""; in_block = 1; next }
      in_block && /^```$/ { if (b ~ /\[serial/) { printf "%s", b; exit } in_block = 0; next }
      in_block { b = b $0 "\n" }' "$readme" >"$tmp/example.toml"
 grep -q '^\[serial' "$tmp/example.toml" || fail "README's [serial] example found"
-socat_pids=()
 config=$(cat "$tmp/example.toml")
 for device in $(grep -Eo '/dev/tty[A-Za-z]+[0-9]+' "$tmp/example.toml" | sort -u); do
   pty="$tmp/pty$((${#socat_pids[@]}))"
   socat pty,raw,echo=0,link="$pty" pty,raw,echo=0,link="$pty.peer" &
   socat_pids+=($!)
-  for ((n = 0; n < 100 && ! -e "$pty"; n++)); do sleep 0.05; done
+  for ((n = 0; n < 100; n++)); do
+    if [[ -e "$pty" ]]; then break; fi
+    sleep 0.05
+  done
   config=${config//"$device"/"$pty"}
 done
 printf '%s\n' "$config" >"$tmp/example.toml"
@@ -107,6 +157,7 @@ finsd_start /usr/bin/finsd --config "$tmp/example.toml" || fail "README's [seria
 finsd_stop
 kill "${socat_pids[@]}" 2>/dev/null || true
 wait "${socat_pids[@]}" 2>/dev/null || true
+socat_pids=()
 rm -rf "$tmp"
 check "README's [serial] configuration example starts finsd"
 if /usr/bin/python3 -c "import finskit" 2>/dev/null; then
