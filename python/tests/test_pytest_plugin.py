@@ -5,6 +5,8 @@ import os
 import subprocess
 import sys
 
+import finskit
+
 USER_TEST = '''
 import finskit
 
@@ -22,7 +24,11 @@ def test_marker_options(virtual_plc):
 
 def test_fixture_without_conftest_or_p_option(tmp_path):
     (tmp_path / "test_user.py").write_text(USER_TEST)
-    env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
+    # The directory finskit was imported from (build tree or dist-packages), absolute:
+    # the child runs in tmp_path.
+    here = os.path.dirname(os.path.dirname(os.path.abspath(finskit.__file__)))
+    env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1",
+               PYTHONPATH=os.pathsep.join([here, os.environ.get("PYTHONPATH", "")]))
     result = subprocess.run(
         [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "test_user.py"],
         cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)
