@@ -124,7 +124,7 @@ check "installed fins writes and reads (UDP)"
 check "installed fins over TCP"
 finsd_stop
 $sudo rm -rf /run/finsd
-ls /var/lib/finsd | grep . >/dev/null || fail "state kept in the StateDirectory"
+[[ -s /var/lib/finsd/finsd.state ]] || fail "state kept in the StateDirectory"
 check "state kept in the StateDirectory"
 
 # What the installed README says about the installed finsd holds.
@@ -142,7 +142,8 @@ awk '/^```toml$/ { b = ""; in_block = 1; next }
      in_block { b = b $0 "\n" }' "$readme" >"$tmp/example.toml"
 grep -q '^\[serial' "$tmp/example.toml" || fail "README's [serial] example found"
 config=$(cat "$tmp/example.toml")
-for device in $(grep -Eo '/dev/tty[A-Za-z]+[0-9]+' "$tmp/example.toml" | sort -u); do
+mapfile -t devices < <(grep -Eo '/dev/tty[A-Za-z]+[0-9]+' "$tmp/example.toml" | sort -u)
+for device in "${devices[@]}"; do
   pty="$tmp/pty$((${#socat_pids[@]}))"
   socat pty,raw,echo=0,link="$pty" pty,raw,echo=0,link="$pty.peer" &
   socat_pids+=($!)
@@ -184,7 +185,8 @@ PY
   fi
   rm -rf "$tests"
 fi
-pkg-config --exists fins && test -f /usr/lib/*/cmake/fins/finsConfig.cmake >/dev/null || fail "dev files"
+pkg-config --exists fins fins-static || fail "dev files: pkg-config"
+compgen -G '/usr/lib/*/cmake/fins/finsConfig.cmake' >/dev/null || fail "dev files: CMake package"
 check "dev files"
 tmp=$(mktemp -d)
 # shellcheck disable=SC2046
