@@ -196,7 +196,7 @@ Result<std::unique_ptr<Server>> Server::start(asio::io_context& io, plc::Plc& pl
     for (const auto& remote : options.remotes) {
         if (!remote.tcp) continue;
         auto& client = impl->clients.emplace_back(
-            std::make_unique<TcpClient>(io, remote, self, options.tcp_client_timing));
+            std::make_unique<TcpClient>(io, impl->dispatcher, remote, options.tcp_client_timing));
         // The answer's source node was checked against the connection's remote node;
         // the route checks it came on the connection the command went on.
         client->set_response_hook(

@@ -10,7 +10,8 @@ namespace fins::server {
 
 namespace {
 
-constexpr std::size_t source_node_offset = 7;  // SA1
+constexpr std::size_t destination_node_offset = 4;  // DA1
+constexpr std::size_t source_node_offset = 7;       // SA1
 
 transport::TransportOptions transport_options(const RemoteNode& remote,
                                               const TcpClientTiming& timing) {
@@ -24,10 +25,11 @@ transport::TransportOptions transport_options(const RemoteNode& remote,
 
 }  // namespace
 
-TcpClient::TcpClient(asio::io_context& io, RemoteNode remote, NodeAddress self,
+TcpClient::TcpClient(asio::io_context& io, Dispatcher& dispatcher, RemoteNode remote,
                      TcpClientTiming timing)
-    : remote_(std::move(remote)),
-      self_(self),
+    : dispatcher_(dispatcher),
+      remote_(std::move(remote)),
+      self_(dispatcher.self()),
       timing_(timing),
       transport_(io, transport_options(remote_, timing_)),
       retry_timer_(io),
@@ -93,7 +95,6 @@ void TcpClient::on_open(Result<transport::LinkInfo> link) {
         return retry_later(next_delay());
     }
     established_ = true;
-    warned_commands_ = false;
     client_node_ = link->local_node;
     failures_in_row_ = 0;
     ++counters_.connects;
@@ -147,19 +148,26 @@ void TcpClient::on_frame(Bytes frame) {
         ++counters_.unmatched;
         return;
     }
-    if ((frame[0] & icf_response) == 0) {
-        ++counters_.unmatched;
-        const auto level = warned_commands_ ? spdlog::level::debug : spdlog::level::warn;
-        warned_commands_ = true;
-        spdlog::log(level,
-                    "fins/tcp client: node {} sent a command on the client connection; only "
-                    "answers to this node's instructions are taken there",
-                    remote_.node);
-        return;
-    }
+    if ((frame[0] & icf_response) == 0) return serve(frame);
     // The connection's identity: its answers come from the node it was opened to.
     const bool from_remote = frame[source_node_offset] == remote_.node;
     if (!from_remote || !response_hook_ || !response_hook_(frame, *this)) ++counters_.unmatched;
+}
+
+void TcpClient::serve(Bytes command) {
+    if (command.size() > request_.size()) return;
+    // Our client node is this node's name on the connection: the dispatcher knows the
+    // node by its own number, and the answer goes back under the client node.
+    std::memcpy(request_.data(), command.data(), command.size());
+    if (request_[destination_node_offset] == client_node_)
+        request_[destination_node_offset] = self_.node;
+    const RequestContext context{Link::tcp, std::chrono::system_clock::now(), nullptr};
+    const std::size_t n = dispatcher_.handle(Bytes{request_.data(), command.size()},
+                                             MutableBytes{out_.data(), out_.size()}, context);
+    if (n == 0) return;
+    if (out_[source_node_offset] == self_.node) out_[source_node_offset] = client_node_;
+    ++counters_.served;
+    transport_.send(Bytes{out_.data(), n});
 }
 
 }  // namespace fins::server

@@ -22,8 +22,10 @@
 // retrying the connect every few seconds".
 // Frames this node sends carry the client node as SA1 (W421 7-4: "substituting the
 // value allocated in SA1"). Answers (ICF bit 6) from the remote node go to the
-// response hook; commands the server sends to our client node are not served (a
-// warning per connection; the NX FINS client is its instructions only).
+// response hook. FRAME SEND is full duplex (W421 7-4): a command the server sends to
+// our client node is served by this node's dispatcher as one to this node (its DA1 is
+// the client node, the node's name on this connection), and answered on the connection
+// with the client node as SA1.
 #pragma once
 
 #include <array>
@@ -37,6 +39,7 @@
 #include <asio/steady_timer.hpp>
 
 #include "fins/frame.hpp"
+#include "server/dispatch/dispatcher.hpp"
 #include "server/instructions/instruction_udp.hpp"
 #include "transport/tcp_transport.hpp"
 
@@ -55,12 +58,15 @@ class TcpClient {
         std::uint64_t failures = 0;   // opens that failed (refused, timeout, wrong node)
         std::uint64_t drops = 0;      // established connections that ended
         std::uint64_t unmatched = 0;  // frames received that nobody took
+        std::uint64_t served = 0;     // commands from the server answered
     };
     // Gets each answer received while established; true when it was taken.
     using ResponseHook = std::function<bool(Bytes frame, const TcpClient& connection)>;
 
-    // `remote`: the [[remote]] entry (transport = "tcp"); `self`: this node's address.
-    TcpClient(asio::io_context& io, RemoteNode remote, NodeAddress self, TcpClientTiming timing);
+    // `remote`: the [[remote]] entry (transport = "tcp"); `dispatcher`: this node's, which
+    // serves the commands the server sends on the connection.
+    TcpClient(asio::io_context& io, Dispatcher& dispatcher, RemoteNode remote,
+              TcpClientTiming timing);
     ~TcpClient();
     TcpClient(const TcpClient&) = delete;
     TcpClient& operator=(const TcpClient&) = delete;
@@ -85,10 +91,12 @@ class TcpClient {
     void open();
     void on_open(Result<transport::LinkInfo> link);
     void on_frame(Bytes frame);
+    void serve(Bytes command);
     void on_close(std::error_code reason);
     void retry_later(std::chrono::milliseconds delay);
     [[nodiscard]] std::chrono::milliseconds next_delay() noexcept;
 
+    Dispatcher& dispatcher_;
     RemoteNode remote_;
     NodeAddress self_;
     TcpClientTiming timing_;
@@ -97,12 +105,12 @@ class TcpClient {
     ResponseHook response_hook_;
     bool running_ = false;
     bool established_ = false;
-    bool warned_commands_ = false;  // one warning per connection
     std::uint8_t client_node_ = 0;
     unsigned failures_in_row_ = 0;
     std::minstd_rand random_;
     Counters counters_;
     std::array<std::uint8_t, max_frame_size> out_{};
+    std::array<std::uint8_t, max_frame_size> request_{};
     std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
 

@@ -76,12 +76,14 @@ struct Nodes {
         }
         return false;
     }
-    InstructionResult run(InstructionRequest request) {
+    // Runs `request` on A (on B with `on_b`).
+    InstructionResult run(InstructionRequest request, bool on_b = false) {
         auto done = std::make_shared<std::promise<InstructionResult>>();
         auto result = done->get_future();
-        asio::post(io, [this, request, done] {
-            a->instructions().start(request,
-                                    [done](const InstructionResult& r) { done->set_value(r); });
+        asio::post(io, [this, request, done, on_b] {
+            (on_b ? b : a)->instructions().start(request, [done](const InstructionResult& r) {
+                done->set_value(r);
+            });
         });
         EXPECT_EQ(result.wait_for(std::chrono::seconds(10)), std::future_status::ready);
         return result.get();
@@ -112,7 +114,8 @@ TEST(TcpClient, W596_3_SendAndRcvGoOverTheClientConnection) {
     ASSERT_TRUE(n.wait_client(true));
     const auto sent = n.run(send_to_5());
     EXPECT_TRUE(sent.done()) << sent.detail;
-    EXPECT_EQ(n.on_io([&] { return n.b_plc.send("0101 8200C800 0002").data_hex(); }), "11112222");
+    EXPECT_EQ(n.on_io([&] { return n.b_plc.send("0101 8200C800 0002").data_hex(); }),
+              "11 11 22 22");
     auto rcv = send_to_5();
     rcv.kind = InstructionKind::recv;
     rcv.remote = *parse_address("D110");
@@ -122,6 +125,28 @@ TEST(TcpClient, W596_3_SendAndRcvGoOverTheClientConnection) {
     EXPECT_TRUE(got.done()) << got.detail;
     EXPECT_EQ(got.words, (std::vector<std::uint16_t>{0xABCD}));
     EXPECT_GE(n.on_io([&] { return n.a->tcp_clients()[0]->client_node(); }), 1);
+}
+
+// W421 7-4: FRAME SEND goes both ways. Node 5 reads node 1's words over the connection
+// node 1 opened, addressing node 1 by the client node it gave it; node 1 answers as
+// itself under that node number.
+TEST(TcpClient, W421_7_4_TheServerReadsTheClientNodeOverTheSameConnection) {
+    Nodes n;
+    n.start();
+    ASSERT_NE(n.a, nullptr);
+    ASSERT_EQ(n.on_io([&] { return n.a_plc.send("0102 82006400 0001 BEEF").end_code(); }), 0x0000);
+    ASSERT_TRUE(n.wait_client(true));
+    const auto node = n.on_io([&] { return n.a->tcp_clients()[0]->client_node(); });
+    auto rcv = send_to_5();
+    rcv.kind = InstructionKind::recv;
+    rcv.destination = {0, node, 0};
+    rcv.remote = *parse_address("D100");
+    rcv.local = *parse_address("D300");
+    rcv.count = 1;
+    const auto got = n.run(rcv, true);
+    EXPECT_TRUE(got.done()) << got.detail;
+    EXPECT_EQ(got.words, (std::vector<std::uint16_t>{0xBEEF}));
+    EXPECT_EQ(n.on_io([&] { return n.a->tcp_clients()[0]->counters().served; }), 1u);
 }
 
 // W596 3 (Send error g, Rcv j, SendCmd h): with the connection down the instruction
