@@ -111,14 +111,17 @@ void TcpClient::on_close(std::error_code reason) {
     retry_later(std::chrono::milliseconds(timing_.retry_min));
 }
 
-std::chrono::milliseconds TcpClient::next_delay() noexcept {
-    // retry_min x 2^(failures in a row), at most retry_max.
-    auto delay = timing_.retry_min;
-    for (unsigned i = 0; i < failures_in_row_ && delay < timing_.retry_max; ++i)
+std::chrono::milliseconds tcp_client_retry_delay(unsigned failures,
+                                                 const TcpClientTiming& timing) noexcept {
+    auto delay = timing.retry_min;
+    // Doubling stops at retry_max: no overflow however long the outage.
+    for (unsigned i = 0; i < failures && delay < timing.retry_max; ++i)
         delay *= 2;
-    delay = std::min(delay, timing_.retry_max);
-    ++failures_in_row_;
-    return delay;
+    return std::min(delay, timing.retry_max);
+}
+
+std::chrono::milliseconds TcpClient::next_delay() noexcept {
+    return tcp_client_retry_delay(failures_in_row_++, timing_);
 }
 
 void TcpClient::retry_later(std::chrono::milliseconds delay) {

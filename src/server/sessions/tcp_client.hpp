@@ -51,6 +51,11 @@ struct TcpClientTiming {
     std::chrono::milliseconds retry_max{10'000};
 };
 
+// The back-off before the next attempt after `failures` failed opens in a row:
+// retry_min x 2^failures, at most retry_max (the jitter then draws in [half, all]).
+std::chrono::milliseconds tcp_client_retry_delay(unsigned failures,
+                                                 const TcpClientTiming& timing) noexcept;
+
 class TcpClient {
   public:
     struct Counters {

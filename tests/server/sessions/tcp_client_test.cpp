@@ -204,5 +204,17 @@ TEST(TcpClient, W596_1_4_ClientConnectionsCountInTheLimit) {
     EXPECT_EQ(buf[15], 0x20);  // error: all connections are in use
 }
 
+// W421 7-4: a client unit "keeps retrying the connect"; finsd doubles its back-off from
+// retry_min to retry_max and stays there, however long the outage.
+TEST(TcpClient, RetryBackOffDoublesAndIsBounded) {
+    const server::TcpClientTiming t;  // 100 ms .. 10 s
+    using std::chrono::milliseconds;
+    EXPECT_EQ(server::tcp_client_retry_delay(0, t), milliseconds(100));
+    EXPECT_EQ(server::tcp_client_retry_delay(1, t), milliseconds(200));
+    EXPECT_EQ(server::tcp_client_retry_delay(6, t), milliseconds(6400));
+    EXPECT_EQ(server::tcp_client_retry_delay(7, t), milliseconds(10'000));
+    EXPECT_EQ(server::tcp_client_retry_delay(4'000'000'000U, t), milliseconds(10'000));
+}
+
 }  // namespace
 }  // namespace fins::test
