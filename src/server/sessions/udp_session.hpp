@@ -69,7 +69,8 @@ class UdpSession : public std::enable_shared_from_this<UdpSession>, private Repl
     // PLC-initiated messages (network_instructions.hpp): every received frame whose ICF
     // response bit is set goes to `hook` instead of the dispatcher (which drops
     // responses); the hook returns false for an answer nobody waited for (dropped).
-    using ResponseHook = std::function<bool(Bytes frame)>;
+    // `peer` is the datagram's source address: an answer must come from the node's.
+    using ResponseHook = std::function<bool(Bytes frame, const sockaddr* peer, socklen_t size)>;
     void set_response_hook(ResponseHook hook) { response_hook_ = std::move(hook); }
     // Sends one frame from this socket (the node's own port) to `to`, without blocking.
     // False when the kernel refused it or the send buffer is full.
