@@ -62,6 +62,9 @@ std::size_t relay_to_host_link(SerialGatewayPort& port, Bytes request, const Hea
     if (context.reply_path == nullptr) return refuse(EndCode::destination_node_busy);
 
     std::array<std::uint8_t, max_frame_size> forwarded{};
+    // The dispatcher refuses longer frames before any route (1001); this copy never
+    // relies on it.
+    if (request.size() > forwarded.size()) return refuse(EndCode::command_too_long);
     std::copy(request.begin(), request.end(), forwarded.begin());
     forwarded[2] = static_cast<std::uint8_t>(header.gateway_count - 1);  // GCT
     forwarded[3] = local_network;                                        // DNA

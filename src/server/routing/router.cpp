@@ -10,6 +10,7 @@
 
 #include "plc/plc.hpp"
 #include "plc/routing_tables.hpp"
+#include "server/dispatch/relay_error.hpp"
 
 namespace fins::server {
 
@@ -103,18 +104,7 @@ std::uint8_t Router::network_for_local(std::size_t cpu) const noexcept {
 
 std::size_t Router::relay_error(const Header& request, CommandCode command, const Port& arrival,
                                 EndCode code, MutableBytes out) const noexcept {
-    if (!request.response_required()) return 0;
-    // The answer names the node the command was sent to as its source, so the requester
-    // matches it with its request; the relay word names the router that failed.
-    Header response = response_header(request, request.destination);
-    response.gateway_count = default_gateway_count;
-    ByteWriter w(out);
-    write_response_prefix(w, response, command,
-                          static_cast<std::uint16_t>(static_cast<std::uint16_t>(code) |
-                                                     ResponseCode::relay_error_bit));
-    w.u8(arrival.address.network);
-    w.u8(arrival.address.node);
-    return w.overflowed() ? 0 : w.size();
+    return write_relay_error(request, command, arrival.address, code, out);
 }
 
 std::size_t Router::forward(std::size_t port, Bytes frame, MutableBytes out,
