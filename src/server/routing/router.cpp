@@ -191,6 +191,8 @@ std::size_t Router::forward(std::size_t port, Bytes frame, MutableBytes out,
         copy[source_network_offset] = arrival.address.network;
     const Bytes relayed{copy.data(), frame.size()};
 
+    if (hop_node == broadcast_node) return broadcast(arrival.cpu, hop_network, relayed, context);
+
     const auto next = find_port(hop_network, hop_node);
     if (!next) {
         if (wire_ && wire_(*out_port, hop_node, relayed)) return 0;
