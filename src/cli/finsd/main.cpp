@@ -10,11 +10,13 @@
 //
 // Exit codes: 0 clean shutdown (SIGINT/SIGTERM: the state file is closed cleanly, with
 // checksums), 2 usage or configuration error, 3 start-up failure (cannot bind, state
-// file refused, in use or without room on disk, control socket).
+// file refused, in use or without room on disk, control socket), 4 the state file shrank
+// while finsd ran (truncated from outside: plc/storage_guard.hpp).
 #include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <memory>
 #include <optional>
@@ -27,6 +29,7 @@
 #include <CLI/CLI.hpp>
 #include <asio/io_context.hpp>
 #include <asio/signal_set.hpp>
+#include <asio/steady_timer.hpp>
 
 #include "cli/finsd/config.hpp"
 #include "cli/finsd/config_plant.hpp"
@@ -37,6 +40,7 @@
 #include "plc/profile.hpp"
 #include "plc/storage.hpp"
 #include "plc/storage_format.hpp"
+#include "plc/storage_guard.hpp"
 #include "server/control/control.hpp"
 #include "server/instructions/instruction_schedule.hpp"
 #include "server/serial/serial_ports.hpp"
@@ -90,7 +94,8 @@ int configure(int argc, char** argv, Settings& settings) {
         "finsd ctl --socket PATH VERB ...: change a running finsd through its control channel\n"
         "(--control PATH); `finsd ctl --help` lists the verbs.\n"
         "Logs go to stderr; stdout carries only \"listening <port>\" once serving.\n"
-        "Exit codes: 0 clean shutdown, 2 usage or configuration error, 3 start-up failure.");
+        "Exit codes: 0 clean shutdown, 2 usage or configuration error, 3 start-up failure,\n"
+        "4 the state file shrank (was truncated) while finsd ran.");
     std::string config;
     Overrides o;
     std::string profile, mode, data_dir, control, log_level, bind, protection;
@@ -351,8 +356,7 @@ int serve(const Settings& s) {
     std::printf("listening %u\n", port);
     std::fflush(stdout);
 
-    signals.async_wait([&](std::error_code, int signal) {
-        spdlog::info("finsd: signal {}, shutting down", signal);
+    const auto shut_down = [&] {
         schedule.stop();
         (*server)->stop();
         gateway_ports.close_all();
@@ -360,8 +364,29 @@ int serve(const Settings& s) {
         serial.stop();
         plc.storage().flush();
         io.stop();
+    };
+    signals.async_wait([&](std::error_code, int signal) {
+        spdlog::info("finsd: signal {}, shutting down", signal);
+        shut_down();
     });
+    // A state file truncated from outside is caught by the SIGBUS guard at the next
+    // access; this look once a second also catches it while nothing touches the file.
+    asio::steady_timer file_check{io};
+    std::function<void()> check_file = [&] {
+        file_check.expires_after(std::chrono::seconds(1));
+        file_check.async_wait([&](std::error_code ec) {
+            if (ec) return;
+            if (!plc.storage().intact()) return shut_down();
+            check_file();
+        });
+    };
+    if (s.data_dir) check_file();
     io.run();
+    if (!plc.storage().intact()) {
+        std::fputs(fins::plc::state_file_lost_message(plc.storage().path().string()).c_str(),
+                   stderr);
+        return fins::plc::state_file_lost_exit_code;
+    }
     plc.storage().close();  // sections on disk, then their checksums and "stopped cleanly"
     return 0;
 }
