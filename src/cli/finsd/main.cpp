@@ -33,6 +33,7 @@
 
 #include "cli/finsd/config.hpp"
 #include "cli/finsd/config_plant.hpp"
+#include "cli/finsd/control_setup.hpp"
 #include "cli/finsd/ctl.hpp"
 #include "cli/finsd/serial_gateway_setup.hpp"
 #include "cli/finsd/serial_ports.hpp"
@@ -91,8 +92,9 @@ int configure(int argc, char** argv, Settings& settings) {
     CLI::App app{"finsd: a virtual Omron CPU Unit speaking FINS/UDP and FINS/TCP"};
     app.set_version_flag("--version", std::string("finsd ") + FINSKIT_VERSION);
     app.footer(
-        "finsd ctl --socket PATH VERB ...: change a running finsd through its control channel\n"
-        "(--control PATH); `finsd ctl --help` lists the verbs.\n"
+        "finsd ctl [--socket PATH] VERB ...: change a running finsd through its control channel\n"
+        "(--control PATH, else $FINSD_SOCKET, else $XDG_RUNTIME_DIR/finsd.sock or, for root,\n"
+        "/run/finsd/finsd.sock); `finsd ctl --help` lists the verbs.\n"
         "Logs go to stderr; stdout carries only \"listening <port>\" once serving.\n"
         "Exit codes: 0 clean shutdown, 2 usage or configuration error, 3 start-up failure,\n"
         "4 the state file shrank (was truncated) while finsd ran.");
@@ -112,7 +114,10 @@ int configure(int argc, char** argv, Settings& settings) {
     auto* o_data = app.add_option(
         "--data-dir", data_dir,
         "Keep retained memory in DIR/finsd.state (DIR and its parents are created if missing)");
-    auto* o_control = app.add_option("--control", control, "Control channel socket path");
+    auto* o_control = app.add_option(
+        "--control", control,
+        "Control channel socket path (default $FINSD_SOCKET, $XDG_RUNTIME_DIR/finsd.sock or "
+        "/run/finsd/finsd.sock)");
     auto* o_bind =
         app.add_option("--bind", bind, "Address to listen on (IPv4 or IPv6; default 127.0.0.1)");
     auto* o_port =
@@ -332,15 +337,15 @@ int serve(const Settings& s) {
     fins::server::SerialPorts gateway_ports;
     fins::cli::finsd::open_gateway_ports(io, s.serial, gateway_ports);
     (*server)->attach_serial_ports(&gateway_ports);
-    std::unique_ptr<fins::server::ControlServer> control;
-    if (s.control_socket) {
-        auto started = fins::server::ControlServer::start(io, plc, *s.control_socket,
-                                                          &(*server)->instructions(), &schedule);
-        if (!started)
-            return fail(3, "control channel " + s.control_socket->string() + ": " +
-                               started.error().message());
-        control = std::move(*started);
-    }
+    // --control, FINSD_SOCKET or the default path (control_setup.hpp).
+    fins::server::ControlTarget target;
+    target.plc = &plc;
+    target.addresses = {{(*server)->address().network, (*server)->address().node}};
+    target.instructions = &(*server)->instructions();
+    target.schedule = &schedule;
+    auto control_start = fins::cli::start_control(io, {std::move(target)}, s.control_socket);
+    if (control_start.exit_code >= 0) return fail(control_start.exit_code, control_start.error);
+    auto& control = control_start.server;
     fins::cli::finsd::SerialPorts serial;
     if (auto r = start_serial_ports(io, (*server)->dispatcher(), s.serial, serial); !r)
         return fail(2, r.error());
