@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "fins/error.hpp"
+#include "server/sessions/tcp_session_log.hpp"
 
 namespace fins::server {
 
@@ -27,12 +28,15 @@ class TcpNodeTable {
     [[nodiscard]] TcpSession* owner(std::uint8_t node) const noexcept { return owners_[node]; }
     [[nodiscard]] std::size_t in_use() const noexcept { return count_; }
     [[nodiscard]] bool full() const noexcept { return count_ >= max_connections_; }
+    // The server's FINS/TCP log lines, bounded per interval (tcp_session_log.hpp).
+    TcpSessionLog& log() noexcept { return log_; }
 
   private:
     std::array<TcpSession*, 256> owners_{};
     std::uint8_t server_node_;
     std::size_t max_connections_;
     std::size_t count_ = 0;
+    TcpSessionLog log_;
 };
 
 }  // namespace fins::server

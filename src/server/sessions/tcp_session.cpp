@@ -123,8 +123,9 @@ bool TcpSession::serve_buffered() {
         if (parsed.status == TcpParse::Status::error) {
             ByteWriter w{out_};
             write_tcp_error(w, TcpCommand::frame_error, parsed.error);
-            spdlog::warn("fins/tcp: {}: envelope error {:#04x}, closing", peer_.to_string(),
-                         static_cast<int>(parsed.error));
+            log_summarised(nodes_.log().envelope_errors, spdlog::level::warn,
+                           "fins/tcp: {}: envelope error {:#04x}, closing", peer_.to_string(),
+                           static_cast<int>(parsed.error));
             start = in_size_;
             go_on = send_answer(w.size(), true);
             break;
@@ -200,12 +201,19 @@ bool TcpSession::handle_packet(const TcpPacket& packet) {
     }
     if (!from_bound_node(packet.data)) {
         // Not executed as another node and not answered: W421 sends a node's answers only
-        // on the connection paired with it. One warning per connection, no log flood.
-        const auto level = logged_foreign_source_ ? spdlog::level::debug : spdlog::level::warn;
-        logged_foreign_source_ = true;
-        spdlog::log(level, "fins/tcp: {}: dropped a frame from {}.{} on the connection of node {}",
-                    peer_.to_string(), packet.data[source_network_offset],
-                    packet.data[source_node_offset], client_node_);
+        // on the connection paired with it. One warning per connection, and at most one
+        // per interval for all connections (tcp_session_log.hpp): no log flood.
+        if (logged_foreign_source_) {
+            spdlog::debug("fins/tcp: {}: dropped a frame from {}.{} on the connection of node {}",
+                          peer_.to_string(), packet.data[source_network_offset],
+                          packet.data[source_node_offset], client_node_);
+        } else {
+            logged_foreign_source_ = true;
+            log_summarised(nodes_.log().foreign_sources, spdlog::level::warn,
+                           "fins/tcp: {}: dropped a frame from {}.{} on the connection of node {}",
+                           peer_.to_string(), packet.data[source_network_offset],
+                           packet.data[source_node_offset], client_node_);
+        }
         return true;
     }
     // An answer to one of this node's own instructions, sent to the client's node.
@@ -249,15 +257,18 @@ bool TcpSession::handshake(const TcpPacket& packet) {
         write_node_address_response(w, echoed, dispatcher_.self().node,
                                     static_cast<std::uint32_t>(claimed.error().value()));
         out_size_pending_ = w.size();
-        spdlog::info("fins/tcp: {}: refused client node {:#010x}: {}", peer_.to_string(), echoed,
-                     claimed.error().message());
+        // The node as the client sent it, in decimal (0 asks for one), and why.
+        log_summarised(nodes_.log().refused, spdlog::level::info,
+                       "fins/tcp: {}: refused client node {}{}: {}", peer_.to_string(), echoed,
+                       echoed == 0 ? " (automatic allocation)" : "", claimed.error().message());
         return false;
     }
     client_node_ = *claimed;
     state_ = State::established;
     write_node_address_response(w, client_node_, dispatcher_.self().node);
     out_size_pending_ = w.size();
-    spdlog::info("fins/tcp: {}: client node {} connected", peer_.to_string(), client_node_);
+    log_summarised(nodes_.log().connected, spdlog::level::info,
+                   "fins/tcp: {}: client node {} connected", peer_.to_string(), client_node_);
     return true;
 }
 
@@ -317,8 +328,9 @@ void TcpSession::send_confirmation() {
     confirming_ = true;
     ByteWriter w{confirmation_};
     write_tcp_header(w, TcpCommand::connection_confirmation, 0);
-    spdlog::info("fins/tcp: {}: node {} asked for again, confirming the connection",
-                 peer_.to_string(), client_node_);
+    log_summarised(nodes_.log().confirmations, spdlog::level::info,
+                   "fins/tcp: {}: node {} asked for again, confirming the connection",
+                   peer_.to_string(), client_node_);
     auto self = shared_from_this();
     asio::async_write(socket_, asio::buffer(confirmation_),
                       [self](std::error_code ec, std::size_t) {
@@ -353,7 +365,8 @@ Completion TcpSession::defer() {
 void TcpSession::queue_late(Bytes frame) {
     if (state_ != State::established) return;
     if (late_.size() >= max_late) {
-        spdlog::warn("fins/tcp: {}: late answer dropped (peer not reading)", peer_.to_string());
+        log_summarised(nodes_.log().late_dropped, spdlog::level::warn,
+                       "fins/tcp: {}: late answer dropped (peer not reading)", peer_.to_string());
         return;
     }
     std::vector<std::uint8_t> packet(tcp_header_size + frame.size());
