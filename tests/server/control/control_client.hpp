@@ -17,7 +17,7 @@
 
 namespace fins::test {
 
-std::filesystem::path socket_path() {
+inline std::filesystem::path socket_path() {
     static std::atomic<int> counter{0};
     return std::filesystem::temp_directory_path() /
            ("fins-ctl-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + ".sock");
