@@ -225,7 +225,7 @@ TEST_F(NetworkInstructions, W596_3_NoAnswerRetriesThenExits5) {
     start_node1("");
     Peer silent("127.0.0.7", node1_->port());
     Child cmd({finsd_path, "ctl", "--socket", socket_path(), "send", "--dest", "0.7.0", "--local",
-               "D0", "--remote", "D0", "--timeout", "2", "--retries", "3", "--json"});
+               "D0", "--remote", "D0", "--timeout", "0.2", "--retries", "3", "--json"});
     std::vector<std::vector<std::uint8_t>> seen;
     for (int i = 0; i < 4; ++i)
         if (auto f = silent.receive(); !f.empty()) seen.push_back(f);

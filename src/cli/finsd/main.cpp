@@ -10,11 +10,13 @@
 //
 // Exit codes: 0 clean shutdown (SIGINT/SIGTERM: the state file is closed cleanly, with
 // checksums), 2 usage or configuration error, 3 start-up failure (cannot bind, state
-// file refused, in use or without room on disk, control socket).
+// file refused, in use or without room on disk, control socket), 4 the state file shrank
+// while finsd ran (truncated from outside: plc/storage_guard.hpp).
 #include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <memory>
 #include <optional>
@@ -27,9 +29,11 @@
 #include <CLI/CLI.hpp>
 #include <asio/io_context.hpp>
 #include <asio/signal_set.hpp>
+#include <asio/steady_timer.hpp>
 
 #include "cli/finsd/config.hpp"
 #include "cli/finsd/config_plant.hpp"
+#include "cli/finsd/control_setup.hpp"
 #include "cli/finsd/ctl.hpp"
 #include "cli/finsd/serial_gateway_setup.hpp"
 #include "cli/finsd/serial_ports.hpp"
@@ -37,6 +41,7 @@
 #include "plc/profile.hpp"
 #include "plc/storage.hpp"
 #include "plc/storage_format.hpp"
+#include "plc/storage_guard.hpp"
 #include "server/control/control.hpp"
 #include "server/instructions/instruction_schedule.hpp"
 #include "server/serial/serial_ports.hpp"
@@ -87,10 +92,12 @@ int configure(int argc, char** argv, Settings& settings) {
     CLI::App app{"finsd: a virtual Omron CPU Unit speaking FINS/UDP and FINS/TCP"};
     app.set_version_flag("--version", std::string("finsd ") + FINSKIT_VERSION);
     app.footer(
-        "finsd ctl --socket PATH VERB ...: change a running finsd through its control channel\n"
-        "(--control PATH); `finsd ctl --help` lists the verbs.\n"
+        "finsd ctl [--socket PATH] VERB ...: change a running finsd through its control channel\n"
+        "(--control PATH, else $FINSD_SOCKET, else $XDG_RUNTIME_DIR/finsd.sock or, for root,\n"
+        "/run/finsd/finsd.sock); `finsd ctl --help` lists the verbs.\n"
         "Logs go to stderr; stdout carries only \"listening <port>\" once serving.\n"
-        "Exit codes: 0 clean shutdown, 2 usage or configuration error, 3 start-up failure.");
+        "Exit codes: 0 clean shutdown, 2 usage or configuration error, 3 start-up failure,\n"
+        "4 the state file shrank (was truncated) while finsd ran.");
     std::string config;
     Overrides o;
     std::string profile, mode, data_dir, control, log_level, bind, protection;
@@ -107,7 +114,10 @@ int configure(int argc, char** argv, Settings& settings) {
     auto* o_data = app.add_option(
         "--data-dir", data_dir,
         "Keep retained memory in DIR/finsd.state (DIR and its parents are created if missing)");
-    auto* o_control = app.add_option("--control", control, "Control channel socket path");
+    auto* o_control = app.add_option(
+        "--control", control,
+        "Control channel socket path (default $FINSD_SOCKET, $XDG_RUNTIME_DIR/finsd.sock or "
+        "/run/finsd/finsd.sock)");
     auto* o_bind =
         app.add_option("--bind", bind, "Address to listen on (IPv4 or IPv6; default 127.0.0.1)");
     auto* o_port =
@@ -333,15 +343,15 @@ int serve(const Settings& s) {
     fins::server::SerialPorts gateway_ports;
     fins::cli::finsd::open_gateway_ports(io, s.serial, gateway_ports);
     (*server)->attach_serial_ports(&gateway_ports);
-    std::unique_ptr<fins::server::ControlServer> control;
-    if (s.control_socket) {
-        auto started = fins::server::ControlServer::start(io, plc, *s.control_socket,
-                                                          &(*server)->instructions(), &schedule);
-        if (!started)
-            return fail(3, "control channel " + s.control_socket->string() + ": " +
-                               started.error().message());
-        control = std::move(*started);
-    }
+    // --control, FINSD_SOCKET or the default path (control_setup.hpp).
+    fins::server::ControlTarget target;
+    target.plc = &plc;
+    target.addresses = {{(*server)->address().network, (*server)->address().node}};
+    target.instructions = &(*server)->instructions();
+    target.schedule = &schedule;
+    auto control_start = fins::cli::start_control(io, {std::move(target)}, s.control_socket);
+    if (control_start.exit_code >= 0) return fail(control_start.exit_code, control_start.error);
+    auto& control = control_start.server;
     fins::cli::finsd::SerialPorts serial;
     if (auto r = start_serial_ports(io, (*server)->dispatcher(), s.serial, serial); !r)
         return fail(2, r.error());
@@ -357,8 +367,7 @@ int serve(const Settings& s) {
     std::printf("listening %u\n", port);
     std::fflush(stdout);
 
-    signals.async_wait([&](std::error_code, int signal) {
-        spdlog::info("finsd: signal {}, shutting down", signal);
+    const auto shut_down = [&] {
         schedule.stop();
         (*server)->stop();
         gateway_ports.close_all();
@@ -366,8 +375,29 @@ int serve(const Settings& s) {
         serial.stop();
         plc.storage().flush();
         io.stop();
+    };
+    signals.async_wait([&](std::error_code, int signal) {
+        spdlog::info("finsd: signal {}, shutting down", signal);
+        shut_down();
     });
+    // A state file truncated from outside is caught by the SIGBUS guard at the next
+    // access; this look once a second also catches it while nothing touches the file.
+    asio::steady_timer file_check{io};
+    std::function<void()> check_file = [&] {
+        file_check.expires_after(std::chrono::seconds(1));
+        file_check.async_wait([&](std::error_code ec) {
+            if (ec) return;
+            if (!plc.storage().intact()) return shut_down();
+            check_file();
+        });
+    };
+    if (s.data_dir) check_file();
     io.run();
+    if (!plc.storage().intact()) {
+        std::fputs(fins::plc::state_file_lost_message(plc.storage().path().string()).c_str(),
+                   stderr);
+        return fins::plc::state_file_lost_exit_code;
+    }
     plc.storage().close();  // sections on disk, then their checksums and "stopped cleanly"
     return 0;
 }

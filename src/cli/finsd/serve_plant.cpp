@@ -14,6 +14,7 @@
 #include <asio/signal_set.hpp>
 
 #include "cli/finsd/config_plant.hpp"
+#include "cli/finsd/control_setup.hpp"
 #include "cli/finsd/serial_gateway_setup.hpp"
 #include "cli/finsd/serial_ports.hpp"
 #include "plc/injections.hpp"
@@ -176,19 +177,26 @@ int serve_plant(const Settings& s) {
             extras.stop();
             return rc;
         }
-    // The control channel (`finsd ctl`) drives the first [[plc]] of the plant.
-    std::unique_ptr<server::ControlServer> control;
-    if (s.control_socket) {
-        auto started = server::ControlServer::start(io, (*plant)->plc(0), *s.control_socket);
-        if (!started) {
-            extras.stop();
-            return fail(3, "control channel " + s.control_socket->string() + ": " +
-                               started.error().message());
-        }
-        control = std::move(*started);
-        spdlog::info("finsd: control channel {} drives plc \"{}\"", s.control_socket->string(),
-                     s.plant.cpus[0].name);
+    // The control channel (`finsd ctl --plc NAME|NET.NODE`) drives every [[plc]]; the
+    // first without --plc (control_setup.hpp).
+    std::vector<server::ControlTarget> targets((*plant)->cpu_count());
+    for (std::size_t i = 0; i < targets.size(); ++i) {
+        targets[i].plc = &(*plant)->plc(i);
+        targets[i].name = s.plant.cpus[i].name;
+        // send / recv / sendcmd leave through the CPU Unit's first unit.
+        targets[i].instructions = &(*plant)->server(i, 0).instructions();
     }
+    for (std::size_t i = 0; i < (*plant)->router().port_count(); ++i) {
+        const auto& p = (*plant)->router().port(i);
+        targets[p.cpu].addresses.emplace_back(p.address.network, p.address.node);
+    }
+    auto control_start = start_control(io, std::move(targets), s.control_socket);
+    if (control_start.exit_code >= 0) {
+        extras.stop();
+        std::fprintf(stderr, "finsd: %s\n", control_start.error.c_str());
+        return control_start.exit_code;
+    }
+    auto& control = control_start.server;
     asio::signal_set signals{io, SIGINT, SIGTERM};
     auto& router = (*plant)->router();
     for (std::size_t i = 0; i < config.cpus.size(); ++i)

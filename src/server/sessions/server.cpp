@@ -91,8 +91,9 @@ struct Server::Impl {
         if (pending < limits.max_pending) return;
         for (const auto& weak : sessions)
             if (auto s = weak.lock(); s && s->pending()) {
-                spdlog::info("fins/tcp: {} connections without a handshake, closing the oldest",
-                             pending);
+                log_summarised(nodes.log().evictions, spdlog::level::info,
+                               "fins/tcp: {} connections without a handshake, closing the oldest",
+                               pending);
                 s->close();
                 return;
             }

@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "fins/error.hpp"
+#include "server/sessions/tcp_session_log.hpp"
 
 namespace fins::server {
 
@@ -32,6 +33,8 @@ class TcpNodeTable {
     void reserve_for_clients(std::size_t clients) noexcept { reserved_ = clients; }
     [[nodiscard]] std::size_t reserved() const noexcept { return reserved_; }
     [[nodiscard]] bool full() const noexcept { return count_ + reserved_ >= max_connections_; }
+    // The server's FINS/TCP log lines, bounded per interval (tcp_session_log.hpp).
+    TcpSessionLog& log() noexcept { return log_; }
 
   private:
     std::array<TcpSession*, 256> owners_{};
@@ -39,6 +42,7 @@ class TcpNodeTable {
     std::size_t max_connections_;
     std::size_t count_ = 0;
     std::size_t reserved_ = 0;
+    TcpSessionLog log_;
 };
 
 }  // namespace fins::server

@@ -32,6 +32,7 @@
 
 #include "fins/frame.hpp"
 #include "server/dispatch/dispatcher.hpp"
+#include "server/sessions/log_summary.hpp"
 
 namespace fins::server {
 
@@ -96,8 +97,7 @@ class UdpSession : public std::enable_shared_from_this<UdpSession>, private Repl
     Counters counters_;
     std::size_t current_ = 0;  // the datagram being dispatched (defer() answers it)
     ResponseHook response_hook_;
-    std::uint64_t dropped_unlogged_ = 0;
-    std::chrono::steady_clock::time_point last_drop_log_{};
+    LogSummary drops_logged_;  // one warning per interval (log_summary.hpp)
 };
 
 }  // namespace fins::server
