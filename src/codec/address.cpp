@@ -54,9 +54,16 @@ struct Prefix {
     Area area;
 };
 // Longer prefixes first: "CIO" before "C", "DR" before "D". "E" is handled apart.
+// DM, HR, WR, AR, TIM and CNT are the names CX-Programmer and the older manuals use for
+// D, H, W, A, T and C: accepted as aliases (none is a prefix of another area's name
+// followed by a digit), always printed the short way. Nothing else is: LR (CIO 1000-1199
+// on CS/CJ) or SR name no single area of 5-2-2.
 constexpr Prefix prefixes[] = {
-    {"CIO", Area::cio},          {"IR", Area::index_register},
-    {"DR", Area::data_register}, {"TK", Area::task_flag},
+    {"CIO", Area::cio},          {"TIM", Area::timer},
+    {"CNT", Area::counter},      {"IR", Area::index_register},
+    {"DR", Area::data_register}, {"DM", Area::dm},
+    {"HR", Area::holding},       {"WR", Area::work},
+    {"AR", Area::auxiliary},     {"TK", Area::task_flag},
     {"W", Area::work},           {"H", Area::holding},
     {"A", Area::auxiliary},      {"T", Area::timer},
     {"C", Area::counter},        {"D", Area::dm},
