@@ -64,10 +64,6 @@ std::string hex4(std::uint16_t v) {
     return fmt::format("{:04X}", v);
 }
 
-std::string node_text(const NodeAddress& a) {
-    return fmt::format("{}.{}.{}", a.network, a.node, a.unit);
-}
-
 std::string time_text(const LogTime& t) {
     return fmt::format("{}-{:02}-{:02} {:02}:{:02}:{:02}", full_year(t.year), t.month, t.day,
                        t.hour, t.minute, t.second);
