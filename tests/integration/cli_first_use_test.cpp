@@ -175,6 +175,9 @@ TEST(CliFirstUse, DestNetNodeIsUnitZeroAndProbeAsksTheDest) {
     EXPECT_EQ(elsewhere.exit_code, 4) << elsewhere.out;
     EXPECT_TRUE(has(elsewhere.err, "(0x0201)")) << elsewhere.err;
     EXPECT_EQ(fins(d, {"--dest", "0", "read", "D0"}).exit_code, 2);
+    auto bad_source = fins(d, {"--source", "0.300", "probe"});
+    EXPECT_EQ(bad_source.exit_code, 2) << bad_source.out;
+    EXPECT_EQ(bad_source.err, "fins: --source '0.300' is not NET.NODE[.UNIT] (e.g. 0.20)\n");
     EXPECT_EQ(fins(d, {"--dest", "0.10.0.0", "read", "D0"}).exit_code, 2);
 }
 

@@ -166,6 +166,9 @@ std::optional<std::string> explain_missing_verb(CLI::App& app);
 // FINS_HOST and FINS_PORT as the defaults of --host and --port (a flag on the command
 // line overrides its variable). A bad value: the usage message to print (exit 2).
 std::optional<std::string> apply_environment(GlobalOptions& g, int argc, char** argv);
+// The usage message for a --dest or --source that is not NET.NODE[.UNIT]; nothing when
+// both are fine (or not given).
+std::optional<std::string> check_node_options(const GlobalOptions& g);
 // Registers the global options on `app` and describes them in every verb's --help.
 void add_global_options(CLI::App& app, GlobalOptions& g);
 void describe_global_options(CLI::App& app);

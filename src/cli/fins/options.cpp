@@ -55,6 +55,15 @@ std::optional<NodeAddress> parse_node_address(const std::string& s) {
                        static_cast<std::uint8_t>(parts[2])};
 }
 
+std::optional<std::string> check_node_options(const GlobalOptions& g) {
+    if (!g.dest.empty() && !parse_node_address(g.dest))
+        return fmt::format("--dest '{}' is not NET.NODE[.UNIT] (e.g. 0.10, 0.10.0, 0.10.E1)",
+                           g.dest);
+    if (!g.source.empty() && !parse_node_address(g.source))
+        return fmt::format("--source '{}' is not NET.NODE[.UNIT] (e.g. 0.20)", g.source);
+    return std::nullopt;
+}
+
 std::string endpoint(const GlobalOptions& g) {
     if (!g.serial.empty())
         return fmt::format("{} unit {}", g.serial.substr(0, g.serial.find(',')), g.unit);
@@ -84,24 +93,12 @@ std::unique_ptr<Client> open_client(const GlobalOptions& g, Output& out, int& ex
     }
     o.timeout = std::chrono::milliseconds(static_cast<long>(g.timeout_seconds * 1000.0 + 0.5));
     o.retries = g.retries;
-    if (!g.dest.empty()) {
-        auto d = parse_node_address(g.dest);
-        if (!d) {
-            exit_code = out.usage(fmt::format(
-                "--dest '{}' is not NET.NODE[.UNIT] (e.g. 0.10, 0.10.0, 0.10.E1)", g.dest));
-            return nullptr;
-        }
-        o.destination = *d;
+    if (const auto bad = check_node_options(g)) {
+        exit_code = out.usage(*bad);
+        return nullptr;
     }
-    if (!g.source.empty()) {
-        auto s = parse_node_address(g.source);
-        if (!s) {
-            exit_code = out.usage(
-                fmt::format("--source '{}' is not NET.NODE[.UNIT] (e.g. 0.20)", g.source));
-            return nullptr;
-        }
-        o.source = *s;
-    }
+    if (!g.dest.empty()) o.destination = *parse_node_address(g.dest);
+    if (!g.source.empty()) o.source = *parse_node_address(g.source);
     auto client = Client::connect(o);
     if (!client) {
         // Only TCP connects; over UDP (and Host Link) nothing was sent yet.

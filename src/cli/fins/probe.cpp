@@ -178,6 +178,7 @@ Result<FoundNode> discover_node(const GlobalOptions& g) {
 
 int run_probe(const GlobalOptions& g, Output& out) {
     const std::string context = fmt::format("probe {} over {}", endpoint(g), link_name(g));
+    if (const auto bad = check_node_options(g)) return out.usage(*bad);
     int rc = exit_ok;
     const bool dest_given = !g.dest.empty();
     auto found = dest_given ? ask_dest(g, out, rc) : discover_node(g);
