@@ -5,6 +5,7 @@
 
 #include "codec/test_support.hpp"
 #include "fins/address.hpp"
+#include "fins/address_names.hpp"
 
 namespace fins {
 namespace {
@@ -139,6 +140,7 @@ TEST(Address, CxProgrammerNamesOf5_2_2AreasAreAliases) {
         EXPECT_EQ(*a, f.address);
         EXPECT_EQ(format_address(*a), f.canonical);
     }
+    EXPECT_EQ(area_names(), "CIO IR DR TK W H A T C D E (also TIM CNT DM HR WR AR)");
     // The short names still win where they are a prefix: DR is a data register, not D.
     EXPECT_EQ(parse_address("DR3")->area, Area::data_register);
     EXPECT_EQ(parse_address("CIO5")->area, Area::cio);

@@ -134,7 +134,9 @@ TEST(CliFirstUse, CxProgrammerAreaNamesAreTheAreasOf5_2_2) {
     }
     auto lr = fins(d, {"read", "LR5"});
     EXPECT_EQ(lr.exit_code, 2);
-    EXPECT_TRUE(has(lr.err, "unknown memory area")) << lr.err;
+    EXPECT_EQ(lr.err,
+              "fins: bad address 'LR5': unknown memory area; the areas are CIO IR DR TK W H A T "
+              "C D E (also TIM CNT DM HR WR AR)\n");
 }
 
 // W342 5-1-2 "Write-protected from network": the PLC checks the command's source node.

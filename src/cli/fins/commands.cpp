@@ -10,18 +10,26 @@
 #include <fmt/core.h>
 
 #include "fins/address.hpp"
+#include "fins/address_names.hpp"
 #include "fins/client.hpp"
 #include "fins/commands/memory_area.hpp"
 #include "fins/memory_area.hpp"
 
 namespace fins::cli {
 
+std::string bad_address(const std::string& text, std::error_code ec) {
+    if (ec == make_error_code(AddressError::unknown_area))
+        return fmt::format("bad address '{}': unknown memory area; the areas are {}", text,
+                           area_names());
+    return fmt::format("bad address '{}': {}", text, ec.message());
+}
+
 namespace {
 
 std::optional<Address> address_or_usage(const std::string& text, Output& out, int& exit_code) {
     auto a = parse_address(text);
     if (!a) {
-        exit_code = out.usage(fmt::format("bad address '{}': {}", text, a.error().message()));
+        exit_code = out.usage(bad_address(text, a.error()));
         return std::nullopt;
     }
     return *a;

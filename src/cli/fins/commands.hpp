@@ -80,6 +80,8 @@ std::string plural(std::size_t n, std::string_view one, std::string_view many);
 // NET.NODE.UNIT as --dest takes it: network and node decimal, the unit decimal below 10
 // and hex from 10 on (E1, FE; 0x10 when the hex has no letter).
 std::string node_text(const NodeAddress& a);
+// "bad address 'XX5': why"; an unknown area lists the areas there are.
+std::string bad_address(const std::string& text, std::error_code ec);
 // "host:port" ("[::1]:9600" for IPv6).
 std::string endpoint(const GlobalOptions& g);
 
