@@ -30,7 +30,15 @@ int main(int argc, char** argv) {
     // Global options may also follow the verb: `fins read D100 --json`.
     app.fallthrough(true);
     app.set_version_flag("--version", std::string("fins ") + FINSKIT_VERSION);
+    // Errors found before --json is parsed still honour it.
+    const auto json_asked = [argc, argv] {
+        bool json = false;
+        for (int i = 1; i < argc; ++i)
+            json = json || std::string_view(argv[i]) == "--json";
+        return json;
+    };
     GlobalOptions g;
+    if (const auto bad = apply_environment(g, argc, argv)) return Output{json_asked()}.usage(*bad);
     add_global_options(app, g);
 
     std::string as = "uint16";
@@ -100,10 +108,8 @@ int main(int argc, char** argv) {
         // --help and --version print and exit 0; every other parse error is a usage
         // error like any other, with the prefix and, under --json, as JSON.
         if (e.get_exit_code() == 0) return app.exit(e);
-        bool json = false;
-        for (int i = 1; i < argc; ++i)
-            json = json || std::string_view(argv[i]) == "--json";
-        Output out{json};
+        Output out{json_asked()};
+        if (const auto verb = explain_missing_verb(app)) return out.usage(*verb);
         return out.usage(fmt::format("{} (see fins --help)", e.what()));
     }
     if (group_rc >= 0) return group_rc;
