@@ -294,6 +294,57 @@ TEST(FinsdPlantConfig, StorageSerialRemoteAndScheduleErrorsNamePlcN) {
               "[[plc.ethernet]] unit 1");
 }
 
+// [plc.files] is the single node's [files] for one CPU Unit: the same keys, read by the
+// same loader, checked against that CPU Unit's model; errors name plc[N].files.
+TEST(FinsdPlantConfig, EachCpuUnitTakesAFilesTableOfItsOwn) {
+    const auto s = load(R"(
+[[plc]]
+name = "a"
+profile = "cp1h"
+  [plc.files]
+  cassette = false
+[[plc]]
+name = "b"
+  [plc.files]
+  card_kbytes = 2048
+  em_file_bank = 20
+[[plc]]
+name = "c"
+  [plc.files]
+  card = false
+)");
+    ASSERT_TRUE(s) << s.error();
+    ASSERT_EQ(s->plant.cpus.size(), 3u);
+    const auto& a = s->plant.cpus[0].files;
+    EXPECT_EQ(a.cassette, false);
+    EXPECT_FALSE(a.card_kbytes || a.em_file_bank);  // the CP1H's
+    const auto& b = s->plant.cpus[1].files;
+    EXPECT_EQ(b.card_kbytes, 2048u);
+    EXPECT_EQ(b.em_file_bank, 20);
+    EXPECT_FALSE(b.cassette);
+    EXPECT_EQ(s->plant.cpus[2].files.card_kbytes, 0u);               // no card
+    EXPECT_FALSE(s->card_kbytes || s->em_file_bank || s->cassette);  // not the single node's
+}
+
+TEST(FinsdPlantConfig, FilesErrorsNamePlcN) {
+    const std::string b = "[[plc]]\nname = \"a\"\n[[plc]]\nname = \"b\"\n";
+    const auto range = load(b + "[plc.files]\nem_file_bank = 25\n");
+    ASSERT_FALSE(range);
+    EXPECT_EQ(range.error(), "plant.toml:6:1: plc[1].files.em_file_bank: 25 is not 0-24");
+    const auto unknown = load(b + "[plc.files]\nslots = 2\n");
+    ASSERT_FALSE(unknown);
+    EXPECT_EQ(unknown.error(), "plant.toml:6:1: plc[1].files.slots: unknown key");
+    // The model's devices: the CJ2H has no cassette slot, the CJ1M no EM bank.
+    const auto cassette = load(b + "[plc.files]\ncassette = true\n");
+    ASSERT_FALSE(cassette);
+    EXPECT_EQ(cassette.error(),
+              "plant.toml:5:1: plc[1].files.cassette: the cj2h has no Memory Cassette slot (22 "
+              "20 is a CP1H command)");
+    const auto bank = load(b + "profile = \"cj1m\"\n[plc.files]\nem_file_bank = 0\n");
+    ASSERT_FALSE(bank);
+    EXPECT_EQ(bank.error(), "plant.toml:6:1: plc[1].files.em_file_bank: the cj1m has no EM bank 0");
+}
+
 // One translation of an Ethernet unit's settings into server options, for the single node
 // (its [network] keys) and each unit of a plant.
 TEST(FinsdPlantConfig, SingleNodeAndPlantUnitsShareOneServerOptionsTranslation) {

@@ -10,6 +10,7 @@
 #include "cli/finsd/config_schedule.hpp"
 #include "cli/finsd/config_serial.hpp"
 #include "cli/finsd/config_values.hpp"
+#include "plc/profile.hpp"
 #include "server/routing/node_address_table.hpp"
 
 namespace fins::cli::finsd {
@@ -81,7 +82,7 @@ class PlantLoader {
 
     Expected<void> load_cpu(const toml::table& t, const std::string& path, PlantCpuConfig& cpu,
                             Settings::PlantCpuSettings& extra) {
-        std::optional<toml::source_region> storage_at;
+        std::optional<toml::source_region> storage_at, files_at;
         for (auto&& [k, v] : t) {
             const std::string key(k.str());
             const std::string p = path + "." + key;
@@ -152,6 +153,12 @@ class PlantLoader {
                 if (auto rr = load_cpu_section(k, v, source_, p, scratch); !rr) return rr;
                 cpu.durability = scratch.durability;
                 storage_at = v.source();
+            } else if (key == "files") {
+                // As the top-level [files]: this CPU Unit's card, EM file bank, cassette.
+                Settings scratch;
+                if (auto rr = load_cpu_section(k, v, source_, p, scratch); !rr) return rr;
+                cpu.files = static_cast<const server::FileMemoryOptions&>(scratch);
+                files_at = v.source();
             } else if (key == "serial") {
                 // As the top-level [serial]: Host Link slave and Serial Gateway ports.
                 if (auto rr = load_serial_table(v, source_, extra.serial); !rr)
@@ -179,6 +186,12 @@ class PlantLoader {
         if (cpu.durability == plc::Durability::power && !cpu.data_dir)
             return fail(*storage_at, path + ".storage.durability",
                         "\"power\" needs data_dir (without one nothing is kept)");
+        // The model's devices, as validate() checks [files] (an unknown profile is
+        // validate_plant's to name).
+        if (files_at && plc::find_profile(cpu.profile) != nullptr)
+            if (auto r = check_file_memory(cpu.files, cpu.profile, path + ".files"); !r)
+                return tl::unexpected(fmt::format("{}:{}:{}: {}", source_, files_at->begin.line,
+                                                  files_at->begin.column, r.error()));
         return check_serial(path, cpu, extra);
     }
 

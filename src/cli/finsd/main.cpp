@@ -297,31 +297,8 @@ int serve(const Settings& s) {
     plc.change_mode(s.mode, std::chrono::system_clock::now());
     fins::cli::finsd::apply_cpu_options(s, plc);
     // File memory (22 xx): <data_dir>/card and <data_dir>/em; else a temp dir removed at exit.
-    if (s.card_kbytes) {
-        if (*s.card_kbytes == 0)
-            plc.files().remove_card();
-        else
-            plc.files().insert_card(*s.card_kbytes);
-    }
-    if (s.em_file_bank) plc.files().set_em_file_bank(*s.em_file_bank);
-    if (s.cassette) plc.files().mount_cassette(*s.cassette);
-    if (s.data_dir) {
-        const auto r = plc.files().attach(*s.data_dir);
-        // A device directory that is a symlink is followed (plc/file_memory.hpp): say so.
-        for (const auto& link : plc.files().device_links()) {
-            const auto path = (*s.data_dir / link.device).string();
-            if (link.error)
-                return fail(3, "file memory: " + path + " is a symlink to " + link.target.string() +
-                                   ", not a usable directory: " + link.error.message());
-            // A warning: files then live outside the data directory, which backups of
-            // that directory miss; the operator should see it at any log level but error.
-            spdlog::warn(
-                "finsd: file memory: {} is a symlink to {}: followed (nothing below it is)", path,
-                link.target.string());
-        }
-        if (!r)
-            return fail(3, "file memory in " + s.data_dir->string() + ": " + r.error().message());
-    }
+    if (const auto refused = fins::server::set_up_file_memory(plc, s, s.data_dir, ""))
+        return fail(3, refused->message);
 
     // The same translation as each unit of a plant gets (server/routing/plant.hpp).
     auto options = fins::server::options_for(fins::cli::finsd::single_unit(s),

@@ -61,6 +61,8 @@ void warn_single_node_keys(const Settings& s) {
              s.um_read_protection || s.dip_write_protection || !s.um_password.empty(),
          "[protection] (a [[plc]] takes its own)");
     note(s.durability != single.durability, "[storage] durability (a [[plc]] takes its own)");
+    note(s.card_kbytes || s.em_file_bank || s.cassette,
+         "[files] (a [[plc]] takes its own [plc.files])");
     note(!s.serial.empty(), "[serial] and --serial (a [[plc]] takes its own [plc.serial])");
     note(!s.remotes.empty(), "[[remote]] (a [[plc]] takes its own [[plc.remote]])");
     note(!s.schedule.empty(), "[[schedule]] (a [[plc]] takes its own [[plc.schedule]])");

@@ -41,6 +41,39 @@ ServerOptions options_for(const PlantPortConfig& unit, const TcpLimits& limits) 
     return options;
 }
 
+std::optional<FileMemoryRefusal> set_up_file_memory(
+    plc::Plc& plc, const FileMemoryOptions& options,
+    const std::optional<std::filesystem::path>& data_dir, std::string_view who) {
+    auto& files = plc.files();
+    if (options.card_kbytes) {
+        if (*options.card_kbytes == 0)
+            files.remove_card();
+        else
+            files.insert_card(*options.card_kbytes);
+    }
+    if (options.em_file_bank) files.set_em_file_bank(*options.em_file_bank);
+    if (options.cassette) files.mount_cassette(*options.cassette);
+    if (!data_dir) return std::nullopt;
+    const auto r = files.attach(*data_dir);
+    // A device directory that is a symlink is followed (plc/file_memory.hpp): say so.
+    for (const auto& link : files.device_links()) {
+        const auto path = (*data_dir / link.device).string();
+        if (link.error)
+            return FileMemoryRefusal{
+                link.error, fmt::format("{}file memory: {} is a symlink to {}, not a usable "
+                                        "directory: {}",
+                                        who, path, link.target.string(), link.error.message())};
+        // A warning: files then live outside the data directory, which backups of that
+        // directory miss; the operator should see it at any log level but error.
+        spdlog::warn("finsd: {}file memory: {} is a symlink to {}: followed (nothing below it is)",
+                     who, path, link.target.string());
+    }
+    if (!r)
+        return FileMemoryRefusal{r.error(), fmt::format("{}file memory in {}: {}", who,
+                                                        data_dir->string(), r.error().message())};
+    return std::nullopt;
+}
+
 std::size_t unit_toward(const PlantCpuConfig& cpu, std::uint8_t network) noexcept {
     const auto on = [&](std::uint8_t n) -> std::optional<std::size_t> {
         for (std::size_t i = 0; i < cpu.ports.size(); ++i)
@@ -173,6 +206,11 @@ Result<std::unique_ptr<Plant>> Plant::start(asio::io_context& io, const PlantCon
         auto plc = open_cpu(c, profile, config.reset_state);
         if (!plc) return Unexpected(plc.error());
         (*plc)->change_mode(c.mode, std::chrono::system_clock::now());
+        if (const auto refused = set_up_file_memory(**plc, c.files, c.data_dir,
+                                                    fmt::format("plc \"{}\": ", c.name))) {
+            spdlog::error("finsd: {}", refused->message);
+            return Unexpected(refused->error);
+        }
 
         plc::RoutingTables tables;
         tables.gateway_count = c.gateway_count;
