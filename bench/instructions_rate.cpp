@@ -12,9 +12,12 @@
 #include <chrono>
 #include <cstdio>
 #include <functional>
+#include <map>
 #include <memory>
+#include <string>
 #include <thread>
 
+#include <fmt/format.h>
 #include <CLI/CLI.hpp>
 #include <asio/executor_work_guard.hpp>
 #include <asio/io_context.hpp>
@@ -36,13 +39,16 @@ struct Runner {
     std::uint64_t done = 0;
     std::uint64_t errors = 0;
     unsigned running = 0;
-    std::function<void()> finished;  // the last instruction ended after `end`
+    std::function<void()> finished;            // the last instruction ended after `end`
+    std::map<std::string, std::uint64_t> why;  // errors by error ID, end code and detail
 
     void launch() {
         ++running;
         engine.start(request, [this](const server::InstructionResult& r) {
             --running;
             ++(r.done() ? done : errors);
+            if (!r.done())
+                ++why[fmt::format("{:04X} {:04X} {}", r.error_id, r.error_id_ex, r.detail)];
             if (Clock::now() < end)
                 launch();
             else if (running == 0)
@@ -116,6 +122,28 @@ int main(int argc, char** argv) {
                      static_cast<std::uint8_t>(words & 0xFF)};
     r.options.timeout = 10;
     r.options.retries = 0;
+    // Warm-up, untimed: one instruction at a time until one completes (up to 5 s), so a
+    // FINS/TCP remote's connection is up before the clock starts (until then each one
+    // ends at once with 0800/0101, not established).
+    std::uint64_t warm_up_errors = 0;
+    std::function<void()> warm_up;
+    const auto warm_up_end = Clock::now() + std::chrono::seconds(5);
+    warm_up = [&] {
+        (*node1)->instructions().start(r, [&](const server::InstructionResult& result) {
+            if (result.done() || Clock::now() >= warm_up_end) {
+                io1.stop();
+                return;
+            }
+            ++warm_up_errors;
+            warm_up();
+        });
+    };
+    asio::post(io1, warm_up);
+    io1.run();
+    io1.restart();
+    if (warm_up_errors > 0)
+        std::printf("warm-up: %llu instructions ended before the remote answered\n",
+                    static_cast<unsigned long long>(warm_up_errors));
     const auto start = Clock::now();
     Runner runner{
         (*node1)->instructions(),
@@ -140,5 +168,7 @@ int main(int argc, char** argv) {
         kind.c_str(), transport.c_str(), words, in_flight,
         static_cast<double>(runner.done) / elapsed, static_cast<unsigned long long>(runner.done),
         static_cast<unsigned long long>(runner.errors), elapsed);
+    for (const auto& [what, n] : runner.why)
+        std::printf("  error %s: %llu\n", what.c_str(), static_cast<unsigned long long>(n));
     return runner.errors == 0 ? 0 : 1;
 }
