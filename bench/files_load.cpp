@@ -9,7 +9,8 @@
 // With --loss or --reorder, put_file runs instead through a loopback LossyUdpProxy
 // (tests/client/lossy_proxy.hpp) that drops (--loss) and holds back (--reorder, up to
 // 60 ms, so later datagrams overtake) that fraction of the datagrams each way, with
-// --retries; the file is then read back over a direct client and compared.
+// --retries (--proxy: through it without faults); the file is then read back over a
+// direct client and compared.
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
@@ -134,6 +135,7 @@ struct Lossy {
     double reorder = 0;
     unsigned retries = 8;
     unsigned timeout_ms = 100;
+    bool proxy = false;  // through the proxy even without faults (the 0 % reference)
 };
 
 // put_file of `data` through the proxy, then get_file over `direct`: 0 when every round's
@@ -169,15 +171,17 @@ int lossy_rounds(std::uint16_t server_port, fins::Client& direct,
             fmt::print(
                 "{{\"round\":{},\"loss\":{},\"reorder\":{},\"put_s\":{:.3f},"
                 "\"put_mbps\":{:.2f},\"ok\":{},\"identical\":{},\"dropped\":{},"
-                "\"delayed\":{},\"retransmitted\":{}}}\n",
+                "\"delayed\":{},\"forwarded\":{},\"sent\":{},\"retransmitted\":{}}}\n",
                 round, l.loss, l.reorder, put_s, mb / put_s, put.has_value(), identical, c.dropped,
-                c.delayed, st.retransmitted);
+                c.delayed, c.forwarded, st.sent, st.retransmitted);
         else
             fmt::print(
                 "round {}: put {:.3f} s ({:.1f} MB/s) through {:.0f} % loss, {:.0f} % "
-                "held back: {}, file {}; proxy dropped {}, held back {}; client re-sent {}\n",
+                "held back: {}, file {}; proxy dropped {}, held back {}, passed {}; client sent "
+                "{}, re-sent {}\n",
                 round, put_s, mb / put_s, l.loss * 100, l.reorder * 100, put ? "ok" : "FAILED",
-                identical ? "identical" : "DIFFERENT", c.dropped, c.delayed, st.retransmitted);
+                identical ? "identical" : "DIFFERENT", c.dropped, c.delayed, c.forwarded, st.sent,
+                st.retransmitted);
     }
     return status;
 }
@@ -200,6 +204,7 @@ int main(int argc, char** argv) {
     app.add_option("--reorder", lossy.reorder,
                    "Put through a proxy holding back this fraction (up to 60 ms)")
         ->check(CLI::Range(0.0, 0.5));
+    app.add_flag("--proxy", lossy.proxy, "Put through the proxy also without --loss/--reorder");
     app.add_option("--retries", lossy.retries, "Client retries with --loss/--reorder")
         ->capture_default_str()
         ->check(CLI::Range(0, 15));
@@ -241,7 +246,7 @@ int main(int argc, char** argv) {
 
     const auto put_frames = encode_frames(data, name, true);
     const auto get_frames = encode_frames(data, name, false);
-    if (lossy.loss > 0 || lossy.reorder > 0) {
+    if (lossy.proxy || lossy.loss > 0 || lossy.reorder > 0) {
         const int status =
             lossy_rounds((*server)->udp_port(), **client, data, name, window, rounds, lossy, json);
         (*server)->stop();
