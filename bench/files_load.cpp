@@ -5,6 +5,12 @@
 //
 // finsd runs in this process on its own thread with a data directory under $TMPDIR;
 // the echo server runs on another thread. Timing lives here, never in tests.
+//
+// With --loss or --reorder, put_file runs instead through a loopback LossyUdpProxy
+// (tests/client/lossy_proxy.hpp) that drops (--loss) and holds back (--reorder, up to
+// 60 ms, so later datagrams overtake) that fraction of the datagrams each way, with
+// --retries (--proxy: through it without faults); the file is then read back over a
+// direct client and compared.
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
@@ -30,6 +36,7 @@
 #include "plc/plc.hpp"
 #include "server/sessions/server.hpp"
 
+#include "client/lossy_proxy.hpp"
 #include "echo_server.hpp"
 
 namespace {
@@ -123,6 +130,62 @@ std::vector<std::vector<std::uint8_t>> encode_frames(std::span<const std::uint8_
     return frames;
 }
 
+struct Lossy {
+    double loss = 0;
+    double reorder = 0;
+    unsigned retries = 8;
+    unsigned timeout_ms = 100;
+    bool proxy = false;  // through the proxy even without faults (the 0 % reference)
+};
+
+// put_file of `data` through the proxy, then get_file over `direct`: 0 when every round's
+// file is identical.
+int lossy_rounds(std::uint16_t server_port, fins::Client& direct,
+                 const std::vector<std::uint8_t>& data, const fins::FileName& name,
+                 std::size_t window, unsigned rounds, const Lossy& l, bool json) {
+    int status = 0;
+    for (unsigned round = 0; round < rounds; ++round) {
+        fins::test::Faults faults;
+        faults.drop = l.loss;
+        faults.duplicate = 0;
+        faults.delay = l.reorder;
+        faults.seed = round + 1;
+        fins::test::LossyUdpProxy proxy(server_port, faults);
+        fins::ClientOptions o;
+        o.port = proxy.port();
+        o.retries = l.retries;
+        o.timeout = std::chrono::milliseconds(l.timeout_ms);
+        auto client = fins::Client::connect(o);
+        if (!client) return 1;
+        const auto t0 = Clock::now();
+        auto put =
+            fins::put_file(**client, fins::disk_memory_card, "", name, data, true, {}, window);
+        const double put_s = std::chrono::duration<double>(Clock::now() - t0).count();
+        auto got = fins::get_file(direct, fins::disk_memory_card, "", name, {}, window);
+        const bool identical = put && got && *got == data;
+        if (!identical) status = 1;
+        const auto c = proxy.counts();
+        const auto st = (*client)->stats();
+        const double mb = static_cast<double>(data.size()) / 1e6;
+        if (json)
+            fmt::print(
+                "{{\"round\":{},\"loss\":{},\"reorder\":{},\"put_s\":{:.3f},"
+                "\"put_mbps\":{:.2f},\"ok\":{},\"identical\":{},\"dropped\":{},"
+                "\"delayed\":{},\"forwarded\":{},\"sent\":{},\"retransmitted\":{}}}\n",
+                round, l.loss, l.reorder, put_s, mb / put_s, put.has_value(), identical, c.dropped,
+                c.delayed, c.forwarded, st.sent, st.retransmitted);
+        else
+            fmt::print(
+                "round {}: put {:.3f} s ({:.1f} MB/s) through {:.0f} % loss, {:.0f} % "
+                "held back: {}, file {}; proxy dropped {}, held back {}, passed {}; client sent "
+                "{}, re-sent {}\n",
+                round, put_s, mb / put_s, l.loss * 100, l.reorder * 100, put ? "ok" : "FAILED",
+                identical ? "identical" : "DIFFERENT", c.dropped, c.delayed, c.forwarded, st.sent,
+                st.retransmitted);
+    }
+    return status;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -135,6 +198,19 @@ int main(int argc, char** argv) {
     app.add_option("--window", window, "Chunks in flight")->capture_default_str();
     app.add_option("--rounds", rounds, "Put/get rounds")->capture_default_str();
     app.add_flag("--json", json, "Print JSON lines");
+    Lossy lossy;
+    app.add_option("--loss", lossy.loss, "Put through a proxy dropping this fraction each way")
+        ->check(CLI::Range(0.0, 0.5));
+    app.add_option("--reorder", lossy.reorder,
+                   "Put through a proxy holding back this fraction (up to 60 ms)")
+        ->check(CLI::Range(0.0, 0.5));
+    app.add_flag("--proxy", lossy.proxy, "Put through the proxy also without --loss/--reorder");
+    app.add_option("--retries", lossy.retries, "Client retries with --loss/--reorder")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 15));
+    app.add_option("--timeout-ms", lossy.timeout_ms, "Client timeout with --loss/--reorder")
+        ->capture_default_str()
+        ->check(CLI::Range(10, 2000));
     CLI11_PARSE(app, argc, argv);
     spdlog::set_level(spdlog::level::warn);
 
@@ -170,6 +246,16 @@ int main(int argc, char** argv) {
 
     const auto put_frames = encode_frames(data, name, true);
     const auto get_frames = encode_frames(data, name, false);
+    if (lossy.proxy || lossy.loss > 0 || lossy.reorder > 0) {
+        const int status =
+            lossy_rounds((*server)->udp_port(), **client, data, name, window, rounds, lossy, json);
+        (*server)->stop();
+        io.stop();
+        server_thread.join();
+        std::error_code ec;
+        std::filesystem::remove_all(root, ec);
+        return status;
+    }
     for (unsigned round = 0; round < rounds; ++round) {
         auto t0 = Clock::now();
         auto put =
