@@ -45,10 +45,10 @@ struct Address {
 
 // How to access an address on the wire.
 enum class Access : std::uint8_t {
-    natural,       // the bit code if a bit is named, else the word code
-    word,          // word code (bit must be absent)
-    bit,           // bit code; for T/C the completion flag, for TK the task flag
-    forced,        // with forced status: 70-72 / F0-F2 / 49
+    natural,  // the bit code if a bit is named, else the word code
+    word,     // word code (bit must be absent)
+    bit,      // bit code; for T/C the completion flag, for TK the task flag
+    forced,   // with forced status: 70-72 / F0-F2 / 49
 };
 
 Result<Address> parse_address(std::string_view text);

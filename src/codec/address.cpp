@@ -220,7 +220,8 @@ std::string area_names() {
     std::string aliases;
     for (const auto& p : prefixes) {
         std::string& list = p.alias ? aliases : names;
-        list += (list.empty() ? "" : " ") + std::string(p.text);
+        if (!list.empty()) list += ' ';
+        list += p.text;
         if (!p.alias && p.area == Area::dm) list += " E";  // EM, parsed apart from the table
     }
     return names + " (also " + aliases + ")";
