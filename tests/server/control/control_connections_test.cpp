@@ -27,7 +27,9 @@ using Json = nlohmann::json;
 // Frames go nowhere: every instruction waits for its timeout.
 class SilentTransport : public server::InstructionTransport {
   public:
-    Sent send_frame(const NodeAddress&, Bytes) override { return Sent::ok; }
+    Sent send_frame(const NodeAddress&, Bytes, server::InstructionRoute&) override {
+        return Sent::ok;
+    }
 };
 
 class ControlConnections : public ::testing::Test {
