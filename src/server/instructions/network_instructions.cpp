@@ -203,6 +203,7 @@ void NetworkInstructions::arm(std::size_t index) {
 void NetworkInstructions::on_timeout(std::size_t index, std::uint64_t generation) {
     Port& p = *ports_[index];
     if (!p.busy || p.generation != generation) return;
+    transport_.unanswered(p.route);
     if (p.transmissions <= p.request.options.retries) {
         ++counters_.retransmissions;
         return transmit(index);

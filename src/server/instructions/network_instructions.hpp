@@ -100,6 +100,9 @@ class InstructionTransport {
     // Sends `frame` to `destination`; on ok, `route` says which way it went.
     virtual Sent send_frame(const NodeAddress& destination, Bytes frame,
                             InstructionRoute& route) = 0;
+    // No answer came in time to a frame that went by `route` (each transmission that
+    // timed out, retries included). A FINS/TCP client connection counts them.
+    virtual void unanswered(const InstructionRoute& route) { (void)route; }
 };
 
 class NetworkInstructions {
