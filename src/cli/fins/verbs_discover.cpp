@@ -201,7 +201,7 @@ class Sweep {
             });
             if (it == in_flight_.end()) continue;
             Target& t = targets_[*it];
-            t.found = FoundNode{r->header.source, {}};
+            t.found = FoundNode{r->header.source, {}, {}};
             t.found->address.unit = 0;
             if (r->code.ok())
                 if (auto data = CpuUnitDataRead{CpuUnitDataSection::model_and_area}.decode_response(
