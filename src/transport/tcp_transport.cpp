@@ -1,7 +1,10 @@
 #include "transport/tcp_transport.hpp"
 
+#include <netinet/in.h>
+#include <netinet/tcp.h>
 #include <sys/socket.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <string>
@@ -56,7 +59,9 @@ void TcpTransport::async_open(OpenHandler done) {
 
 void TcpTransport::on_connected() {
     std::error_code ec;
+    fd_ = socket_.native_handle();
     socket_.set_option(tcp::no_delay(true), ec);
+    if (!ec) set_keepalive(ec);
     if (!ec) socket_.non_blocking(true, ec);
     if (ec) return finish_open(Unexpected(ec));
     ByteWriter w(hello_);
@@ -210,7 +215,8 @@ void TcpTransport::send(Bytes frame) {
     ByteWriter w(header);
     write_tcp_header(w, TcpCommand::frame, frame.size());
     if (corked_) {
-        cork_.insert(cork_.end(), header.begin(), header.begin() + static_cast<std::ptrdiff_t>(w.size()));
+        cork_.insert(cork_.end(), header.begin(),
+                     header.begin() + static_cast<std::ptrdiff_t>(w.size()));
         cork_.insert(cork_.end(), frame.begin(), frame.end());
         return;
     }
@@ -258,12 +264,34 @@ void TcpTransport::fail(std::error_code reason) {
     if (on_close_) on_close_(reason);
 }
 
+void TcpTransport::set_keepalive(std::error_code& ec) {
+    const auto& k = options_.keepalive;
+    if (k.idle.count() <= 0) return;
+    const auto fd = fd_;
+    const auto seconds = [](std::chrono::seconds s) { return static_cast<int>(s.count()); };
+    const int on = 1;
+    const int idle = seconds(k.idle);
+    const int interval = std::max(seconds(k.interval), 1);
+    const int count = std::max(k.count, 1);
+    const auto user_timeout = static_cast<unsigned>((idle + interval * count) * 1000);
+    const auto set = [&](int level, int name, const auto& value) {
+        if (!ec && ::setsockopt(fd, level, name, &value, sizeof value) != 0)
+            ec = std::error_code(errno, std::system_category());
+    };
+    set(SOL_SOCKET, SO_KEEPALIVE, on);
+    set(IPPROTO_TCP, TCP_KEEPIDLE, idle);
+    set(IPPROTO_TCP, TCP_KEEPINTVL, interval);
+    set(IPPROTO_TCP, TCP_KEEPCNT, count);
+    set(IPPROTO_TCP, TCP_USER_TIMEOUT, user_timeout);
+}
+
 void TcpTransport::close() {
     ++generation_;
     std::error_code ignored;
     resolver_.cancel();
     open_timer_.cancel();
     socket_.close(ignored);
+    fd_ = -1;
     queue_.clear();
     writing_ = false;
     front_written_ = 0;

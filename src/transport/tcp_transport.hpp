@@ -6,7 +6,8 @@
 // the server node (LinkInfo). A command 1 with a non-zero error code, or a command 3,
 // fails the open with that TcpError (e.g. 0x21 node_already_connected); anything else
 // fails it with ClientError::handshake_failed. The whole open is bounded by
-// TransportOptions::open_timeout.
+// TransportOptions::open_timeout. TransportOptions::keepalive, when set, goes on the
+// socket once connected.
 //
 // Open: every packet is parsed with parse_tcp_frame(), which copes with packets split
 // across reads or glued together. Command 2 delivers its FINS frame; command 6
@@ -48,9 +49,13 @@ class TcpTransport final : public Transport {
     // Reads that returned bytes since construction (handshake included); lets tests see
     // how the bytes of a packet actually arrived.
     [[nodiscard]] std::uint64_t reads() const noexcept { return reads_; }
+    // The socket, for inspecting its options (tests); -1 while closed.
+    [[nodiscard]] int native_handle() const noexcept { return fd_; }
 
   private:
     void on_connected();
+    // TransportOptions::keepalive on the connected socket.
+    void set_keepalive(std::error_code& ec);
     void read_handshake();
     void finish_open(Result<LinkInfo> result);
     void read_frames();
@@ -66,6 +71,7 @@ class TcpTransport final : public Transport {
     TransportOptions options_;
     asio::ip::tcp::resolver resolver_;
     asio::ip::tcp::socket socket_;
+    int fd_ = -1;  // socket_'s, once connected
     asio::steady_timer open_timer_;
     State state_ = State::closed;
     std::uint64_t generation_ = 0;  // bumped on close: handlers of older sockets ignore

@@ -49,6 +49,17 @@ struct TransportOptions {
     // TCP: the client node sent in the node-address request; 0 = ask the server to
     // allocate one (frames 3.2 command 0).
     std::uint8_t requested_node = 0;
+    // TCP: keep-alive, so that a peer gone without a FIN or RST (power off, cable
+    // pulled) ends the connection. idle > 0 turns it on: SO_KEEPALIVE with TCP_KEEPIDLE
+    // = idle, TCP_KEEPINTVL = interval, TCP_KEEPCNT = count, and TCP_USER_TIMEOUT = idle
+    // + interval x count (keep-alive probes only an idle connection; the user timeout
+    // also ends one whose sent bytes stay unacknowledged). idle 0: the kernel's defaults.
+    struct KeepAlive {
+        std::chrono::seconds idle{0};
+        std::chrono::seconds interval{0};
+        int count = 0;
+    };
+    KeepAlive keepalive;
 };
 
 class Transport {

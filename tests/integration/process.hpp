@@ -1,11 +1,13 @@
 // Child processes for CLI tests: run a program to completion capturing stdout, stderr
 // and the exit code, or keep one running (finsd) and read its first line. Every wait is
-// bounded; a child still running at the end is killed.
+// bounded; a child still running at the end is killed, and so is one whose test binary
+// died first (PR_SET_PDEATHSIG): an orphan finsd would hold its port into the next run.
 #pragma once
 
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -27,8 +29,12 @@ class Child {
         int out[2];
         int err[2];
         if (::pipe(out) != 0 || ::pipe(err) != 0) return;
+        const pid_t parent = ::getpid();
         pid_ = ::fork();
         if (pid_ == 0) {
+            // prctl(2): the signal comes when the thread that forked ends; a parent that
+            // died before the prctl has already reparented us, so check getppid() after.
+            if (::prctl(PR_SET_PDEATHSIG, SIGKILL) != 0 || ::getppid() != parent) ::_exit(127);
             ::dup2(out[1], 1);
             ::dup2(err[1], 2);
             ::close(out[0]);

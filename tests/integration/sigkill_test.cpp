@@ -4,10 +4,15 @@
 // file was not stopped cleanly). CIO, W, timers and the cleared Auxiliary Area words
 // start at zero again.
 #include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <chrono>
+#include <fstream>
 #include <functional>
 #include <iostream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <fmt/format.h>
@@ -209,6 +214,51 @@ TEST(Sigkill, KillWithWritesInFlightLosesNoAcknowledgedWrite) {
     std::cout << "[ sigkill ] in flight: acknowledged " << acknowledged << " writes, lost " << lost
               << "\n";
     EXPECT_EQ(lost, 0u);
+}
+
+}  // namespace
+}  // namespace fins::test
+
+namespace fins::test {
+namespace {
+
+// True while `pid` runs (a zombie, or no process at all, is not running).
+bool running(pid_t pid) {
+    std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+    std::string line;
+    if (!std::getline(stat, line)) return false;
+    const auto paren = line.rfind(')');
+    return paren != std::string::npos && paren + 2 < line.size() && line[paren + 2] != 'Z';
+}
+
+// A test binary that dies abruptly (no destructor runs) takes its Child processes with
+// it: an orphaned finsd once held a port and broke the next run (process.hpp).
+TEST(Sigkill, ChildOfATestBinaryThatDiesIsKilledToo) {
+    int fds[2];
+    ASSERT_EQ(::pipe(fds), 0);
+    const pid_t binary = ::fork();
+    ASSERT_GE(binary, 0);
+    if (binary == 0) {
+        ::close(fds[0]);
+        auto* child = new Child({"/bin/sleep", "30"});  // never destroyed: we die first
+        const pid_t pid = child->pid();
+        if (::write(fds[1], &pid, sizeof pid) != sizeof pid) ::_exit(1);
+        ::_exit(0);
+    }
+    ::close(fds[1]);
+    pid_t grandchild = -1;
+    const auto got = ::read(fds[0], &grandchild, sizeof grandchild);
+    ::close(fds[0]);
+    ::waitpid(binary, nullptr, 0);
+    ASSERT_EQ(got, static_cast<ssize_t>(sizeof grandchild));
+    ASSERT_GT(grandchild, 0);
+    bool gone = false;
+    for (int i = 0; i < 500 && !gone; ++i) {  // at most 5 s
+        gone = !running(grandchild);
+        if (!gone) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    if (!gone) ::kill(grandchild, SIGKILL);  // the test failed: do not leave it behind
+    EXPECT_TRUE(gone) << "the Child outlived its test binary";
 }
 
 }  // namespace

@@ -73,4 +73,9 @@ InstructionTransport::Sent UdpInstructionTransport::send_frame(const NodeAddress
                                                                                 : Sent::failed;
 }
 
+void UdpInstructionTransport::unanswered(const InstructionRoute& route) {
+    for (TcpClient* client : clients_)
+        if (static_cast<const void*>(client) == route.connection) client->note_unanswered();
+}
+
 }  // namespace fins::server

@@ -55,6 +55,8 @@ class UdpInstructionTransport final : public InstructionTransport {
     UdpInstructionTransport(std::shared_ptr<UdpSession> udp, asio::ip::address local,
                             NodeAddress self, std::vector<RemoteNode> remotes);
     Sent send_frame(const NodeAddress& destination, Bytes frame, InstructionRoute& route) override;
+    // Tells the FINS/TCP client connection the frame went on, if any (tcp_client.hpp).
+    void unanswered(const InstructionRoute& route) override;
     // Puts `frame` on the FINS/TCP connection of client node `node` and returns that
     // connection; null when no connection holds that node (or its queue is full). Set
     // by the server.

@@ -20,6 +20,7 @@ transport::TransportOptions transport_options(const RemoteNode& remote,
     o.port = remote.port;
     o.open_timeout = timing.open_timeout;
     o.requested_node = remote.client_node;
+    o.keepalive = timing.keepalive;
     return o;
 }
 
@@ -97,18 +98,35 @@ void TcpClient::on_open(Result<transport::LinkInfo> link) {
     established_ = true;
     client_node_ = link->local_node;
     failures_in_row_ = 0;
+    unanswered_in_row_ = 0;
     ++counters_.connects;
     spdlog::info("fins/tcp client: connected to node {} at {}:{} as node {}", remote_.node,
                  remote_.host, remote_.port, client_node_);
 }
 
 void TcpClient::on_close(std::error_code reason) {
+    spdlog::warn("fins/tcp client: connection to node {} at {}:{} lost: {}; reconnecting",
+                 remote_.node, remote_.host, remote_.port, reason.message());
+    drop();
+}
+
+void TcpClient::drop() {
     established_ = false;
     client_node_ = 0;
     ++counters_.drops;
-    spdlog::warn("fins/tcp client: connection to node {} at {}:{} lost: {}; reconnecting",
-                 remote_.node, remote_.host, remote_.port, reason.message());
     retry_later(std::chrono::milliseconds(timing_.retry_min));
+}
+
+void TcpClient::note_unanswered() {
+    if (!established_ || timing_.max_unanswered == 0) return;
+    if (++unanswered_in_row_ < timing_.max_unanswered) return;
+    spdlog::warn(
+        "fins/tcp client: node {} at {}:{} left {} frames in a row unanswered; "
+        "reconnecting",
+        remote_.node, remote_.host, remote_.port, unanswered_in_row_);
+    ++counters_.silent;
+    transport_.close();  // calls no handler
+    drop();
 }
 
 std::chrono::milliseconds tcp_client_retry_delay(unsigned failures,
@@ -147,6 +165,7 @@ bool TcpClient::send_frame(Bytes frame) {
 }
 
 void TcpClient::on_frame(Bytes frame) {
+    unanswered_in_row_ = 0;  // the server is alive
     if (frame.size() < header_size) {
         ++counters_.unmatched;
         return;

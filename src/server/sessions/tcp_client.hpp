@@ -20,6 +20,13 @@
 // several finsd restarting together do not reconnect in step); the first retry after an
 // established connection drops waits `retry_min`. W421 7-4: a client unit "keeps
 // retrying the connect every few seconds".
+// A server gone without closing (power off, cable pulled; what an NX does is not in
+// W596 or W421, chosen here): TCP keep-alive on the connection (TcpClientTiming::
+// keepalive) ends it within idle + interval x count, 30 s by default, and a server that
+// holds the connection but answers nothing is dropped after `max_unanswered`
+// consecutive instruction frames on it got no answer in time (the instruction
+// transport reports each, note_unanswered(); any frame received resets the count).
+// Either way the connection is reopened as after any drop.
 // Frames this node sends carry the client node as SA1 (W421 7-4: "substituting the
 // value allocated in SA1"). Answers (ICF bit 6) from the remote node go to the
 // response hook. FRAME SEND is full duplex (W421 7-4): a command the server sends to
@@ -49,6 +56,11 @@ struct TcpClientTiming {
     std::chrono::milliseconds open_timeout{10'000};
     std::chrono::milliseconds retry_min{100};
     std::chrono::milliseconds retry_max{10'000};
+    // Keep-alive on the socket: a dead server is noticed within 10 + 5 x 4 = 30 s.
+    transport::TransportOptions::KeepAlive keepalive{std::chrono::seconds(10),
+                                                     std::chrono::seconds(5), 4};
+    // Consecutive unanswered instruction frames that close the connection; 0: never.
+    unsigned max_unanswered = 3;
 };
 
 // The back-off before the next attempt after `failures` failed opens in a row:
@@ -64,6 +76,7 @@ class TcpClient {
         std::uint64_t drops = 0;      // established connections that ended
         std::uint64_t unmatched = 0;  // frames received that nobody took
         std::uint64_t served = 0;     // commands from the server answered
+        std::uint64_t silent = 0;     // connections closed for max_unanswered timeouts
     };
     // Gets each answer received while established; true when it was taken.
     using ResponseHook = std::function<bool(Bytes frame, const TcpClient& connection)>;
@@ -91,6 +104,11 @@ class TcpClient {
     [[nodiscard]] bool reaches(const NodeAddress& destination) const noexcept;
     // Sends a frame of this node's with SA1 = client_node(). False while not established.
     bool send_frame(Bytes frame);
+    // A frame sent on the connection got no answer in time: the max_unanswered-th in a
+    // row closes the connection and opens it again.
+    void note_unanswered();
+    // The connection's socket (tests inspect its options); -1 while down.
+    [[nodiscard]] int native_handle() const noexcept { return transport_.native_handle(); }
 
   private:
     void open();
@@ -98,6 +116,7 @@ class TcpClient {
     void on_frame(Bytes frame);
     void serve(Bytes command);
     void on_close(std::error_code reason);
+    void drop();
     void retry_later(std::chrono::milliseconds delay);
     [[nodiscard]] std::chrono::milliseconds next_delay() noexcept;
 
@@ -112,6 +131,7 @@ class TcpClient {
     bool established_ = false;
     std::uint8_t client_node_ = 0;
     unsigned failures_in_row_ = 0;
+    unsigned unanswered_in_row_ = 0;
     std::minstd_rand random_;
     Counters counters_;
     std::array<std::uint8_t, max_frame_size> out_{};
