@@ -3,9 +3,12 @@
 // is bounded (process.hpp).
 #pragma once
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -50,6 +53,29 @@ class ScratchDir {
 
 // finsd with `args` after "--port 0 --log-level warn". started() is false when it exited
 // before listening; result() then holds its exit code and stderr.
+// Held by a test whose finsd binds fixed addresses and ports (plant configurations name
+// port 9611 on loopback addresses of their own): ctest -j runs each test in its own
+// process, and two tests of one file would otherwise bind the same address at once.
+// Such tests run one at a time, across processes (an flock, released when the test ends
+// or its process dies).
+class FixedPorts {
+  public:
+    FixedPorts()
+        : fd_(::open("/tmp/finskit-tests-fixed-ports.lock", O_CREAT | O_RDWR | O_CLOEXEC, 0666)) {
+        if (fd_ >= 0)
+            while (::flock(fd_, LOCK_EX) != 0 && errno == EINTR) {
+            }
+    }
+    ~FixedPorts() {
+        if (fd_ >= 0) ::close(fd_);
+    }
+    FixedPorts(const FixedPorts&) = delete;
+    FixedPorts& operator=(const FixedPorts&) = delete;
+
+  private:
+    int fd_;
+};
+
 class Finsd {
   public:
     explicit Finsd(std::vector<std::string> args) {

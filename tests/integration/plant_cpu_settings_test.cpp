@@ -60,6 +60,7 @@ std::vector<std::uint16_t> words_at(const std::string& host, const std::string& 
 }
 
 TEST(PlantCpuSettings, EachCpuUnitStartsWithItsOwnMemoryTable) {
+    const FixedPorts fixed_ports;  // 127.0.x.y:9611 (finsd_run.hpp)
     ScratchDir dir("plant-memory");
     Finsd d(
         {"--config",
@@ -72,6 +73,7 @@ TEST(PlantCpuSettings, EachCpuUnitStartsWithItsOwnMemoryTable) {
 }
 
 TEST(PlantCpuSettings, EntryTheCpuUnitCannotHoldIsRefusedWithItsName) {
+    const FixedPorts fixed_ports;  // 127.0.x.y:9611 (finsd_run.hpp)
     ScratchDir dir("plant-memory");
     // The CJ1M has no EM area: the entry is refused for line-b, naming it and the model.
     const auto file = dir.write("plant.toml", plant("memory = { \"E0_0\" = 1 }"));
@@ -82,6 +84,7 @@ TEST(PlantCpuSettings, EntryTheCpuUnitCannotHoldIsRefusedWithItsName) {
 }
 
 TEST(PlantCpuSettings, EachCpuUnitHasItsOwnProtectionAndInjections) {
+    const FixedPorts fixed_ports;  // 127.0.x.y:9611 (finsd_run.hpp)
     ScratchDir dir("plant-settings");
     // line-a: network write protection for every node; line-b: a battery error.
     const auto config = plant("  [plc.inject]\n  battery_error = true\n",
@@ -110,6 +113,7 @@ TEST(PlantCpuSettings, EachCpuUnitHasItsOwnProtectionAndInjections) {
 // [[plc.ethernet]] unit that sets none of its own (default 9600); a unit's `port` wins.
 // finsd_run.hpp passes --port 0: line-a listens on a free port, line-b on its 9611.
 TEST(PlantCpuSettings, PortFlagIsThePortOfUnitsWithoutOneOfTheirOwn) {
+    const FixedPorts fixed_ports;  // 127.0.x.y:9611 (finsd_run.hpp)
     ScratchDir dir("plant-port");
     auto config = plant("");
     const std::string fixed = "  bind = \"127.0.61.1\"\n  port = 9611\n";
@@ -130,6 +134,7 @@ TEST(PlantCpuSettings, PortFlagIsThePortOfUnitsWithoutOneOfTheirOwn) {
 // [plc.storage] durability: "power" fdatasyncs that CPU Unit's state file before each
 // write's answer ([storage] durability of a single node); the other CPU Unit never syncs.
 TEST(PlantCpuSettings, EachCpuUnitHasItsOwnDurability) {
+    const FixedPorts fixed_ports;  // 127.0.x.y:9611 (finsd_run.hpp)
     ScratchDir dir("plant-durability");
     server::PlantConfig config;
     for (const char* name : {"a", "b"}) {
@@ -154,6 +159,7 @@ TEST(PlantCpuSettings, EachCpuUnitHasItsOwnDurability) {
 // The single node's [storage], [serial], [[remote]] and [[schedule]] describe no CPU Unit
 // of a plant: finsd says they are ignored and where a plant takes them.
 TEST(PlantCpuSettings, SingleNodeTablesInAPlantAreNamedAsIgnored) {
+    const FixedPorts fixed_ports;  // 127.0.x.y:9611 (finsd_run.hpp)
     ScratchDir dir("plant-ignored");
     const std::string single = R"(
 [[remote]]

@@ -62,6 +62,7 @@ name = "temp"
 // <data_dir>/card and is read back, byte for byte, after the plant stops and starts again.
 // The CPU Unit without data_dir keeps its files in a temporary root for the run only.
 TEST(PlantFiles, W342_5_3_33_FileOnAPlantCpuUnitsCardSurvivesARestart) {
+    const FixedPorts fixed_ports;  // 127.0.x.y:9611 (finsd_run.hpp)
     ScratchDir dir("plant-files");
     const fs::path data = dir.path() / "kept";
     const auto config =
@@ -100,6 +101,7 @@ TEST(PlantFiles, W342_5_3_33_FileOnAPlantCpuUnitsCardSurvivesARestart) {
 // A device directory of a plant CPU Unit that is a symlink to no directory refuses the
 // start (exit 3) naming the CPU Unit and the path, as a single node's does.
 TEST(PlantFiles, SymlinkedCardToNoDirectoryRefusesTheStartNamingTheCpuUnit) {
+    const FixedPorts fixed_ports;  // 127.0.x.y:9611 (finsd_run.hpp)
     ScratchDir dir("plant-files");
     const fs::path data = dir.path() / "kept";
     fs::create_directories(data);
@@ -119,6 +121,7 @@ TEST(PlantFiles, SymlinkedCardToNoDirectoryRefusesTheStartNamingTheCpuUnit) {
 // taken out; "temp", a CJ2H, has no card but EM file memory: each answers 2301 (file
 // device missing) for its own missing device only (22 20 in PROGRAM mode, where it runs).
 TEST(PlantFiles, W342_5_3_43_EachCpuUnitHasItsOwnCassetteAndCard) {
+    const FixedPorts fixed_ports;  // 127.0.x.y:9611 (finsd_run.hpp)
     ScratchDir dir("plant-files");
     Finsd d(
         {"--config",
@@ -140,6 +143,7 @@ TEST(PlantFiles, W342_5_3_43_EachCpuUnitHasItsOwnCassetteAndCard) {
 // The single node's [files] describes no CPU Unit of a plant: finsd says it is ignored
 // and that a [[plc]] takes its own [plc.files]; the CPU Units keep their profile's card.
 TEST(PlantFiles, SingleNodeFilesTableInAPlantIsNamedAsIgnored) {
+    const FixedPorts fixed_ports;  // 127.0.x.y:9611 (finsd_run.hpp)
     ScratchDir dir("plant-files");
     Finsd d({"--config", dir.write("plant.toml", "[files]\ncard = false\n" + plant("", ""))});
     ASSERT_TRUE(d.started()) << d.result().err;

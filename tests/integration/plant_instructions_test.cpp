@@ -62,6 +62,7 @@ std::vector<std::uint16_t> words_at(std::uint8_t node, const std::string& addres
 }
 
 TEST(PlantInstructions, W596_3_EachCpuUnitRunsItsOwnSchedule) {
+    const FixedPorts fixed_ports;  // 127.0.x.y:9611 (finsd_run.hpp)
     ScratchDir dir("plant-schedule");
     // line-a sends its D100-D101 to line-b's D200 (automatic generation: node 2 is
     // 127.0.71.2 at line-a's own port); line-b has no schedule.
@@ -118,6 +119,7 @@ class RemoteNode {
 };
 
 TEST(PlantInstructions, W596_2_3_RemoteNodeAddressesArePerCpuUnit) {
+    const FixedPorts fixed_ports;  // 127.0.x.y:9611 (finsd_run.hpp)
     ScratchDir dir("plant-remote");
     RemoteNode node9;
     // Both CPU Units send 05 01 to node 1.9; only line-a knows where node 9 is (the test's

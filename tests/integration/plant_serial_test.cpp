@@ -50,6 +50,7 @@ std::unique_ptr<Client> client_to(const std::string& host, NodeAddress destinati
 }
 
 TEST(PlantSerial, W342_3_5_HostLinkPortAnswersForItsOwnCpuUnit) {
+    const FixedPorts fixed_ports;  // 127.0.x.y:9611 (finsd_run.hpp)
     PtyPair pty;
     ASSERT_TRUE(pty.ok());
     ScratchDir dir("plant-hostlink");
@@ -70,6 +71,7 @@ TEST(PlantSerial, W342_3_5_HostLinkPortAnswersForItsOwnCpuUnit) {
 // W342 5-3-46 (28 03) on a gateway port whose device cannot be opened: 0205, as for a
 // single node; the unit is listed by 05 02 of its CPU Unit only.
 TEST(PlantSerial, W342_5_3_46_GatewayPortIsOnItsOwnCpuUnit) {
+    const FixedPorts fixed_ports;  // 127.0.x.y:9611 (finsd_run.hpp)
     ScratchDir dir("plant-gateway");
     const auto serial = "  [plc.serial]\n  \"scu2.1\" = \"/nonexistent/tty,timeout=0.5\"\n";
     Finsd d({"--config", dir.write("plant.toml", plant(serial))});
