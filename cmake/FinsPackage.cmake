@@ -55,15 +55,20 @@ write_basic_package_version_file(${PROJECT_BINARY_DIR}/finsConfigVersion.cmake
 install(FILES ${PROJECT_BINARY_DIR}/finsConfig.cmake ${PROJECT_BINARY_DIR}/finsConfigVersion.cmake
   DESTINATION ${FINS_CMAKE_DIR} COMPONENT dev)
 
-# pkg-config: `pkg-config --cflags --libs fins` (add --static for libfins.a).
+# pkg-config: `pkg-config --cflags --libs fins` links libfins.so; `... fins-static`
+# links libfins.a (`--static` cannot: -lfins takes the .so whenever both are there).
 file(RELATIVE_PATH FINS_PC_TO_PREFIX /prefix/${CMAKE_INSTALL_LIBDIR}/pkgconfig /prefix)
-configure_file(${PROJECT_SOURCE_DIR}/cmake/fins.pc.in ${PROJECT_BINARY_DIR}/fins.pc @ONLY)
-install(FILES ${PROJECT_BINARY_DIR}/fins.pc
-  DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig COMPONENT dev)
+foreach(pc fins fins-static)
+  configure_file(${PROJECT_SOURCE_DIR}/cmake/${pc}.pc.in ${PROJECT_BINARY_DIR}/${pc}.pc @ONLY)
+  install(FILES ${PROJECT_BINARY_DIR}/${pc}.pc
+    DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig COMPONENT dev)
+endforeach()
 
 install(TARGETS finsd fins RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
-install(FILES ${PROJECT_SOURCE_DIR}/README.md ${PROJECT_SOURCE_DIR}/docs/architecture.md
-  ${PROJECT_SOURCE_DIR}/docs/benchmarks.md DESTINATION ${CMAKE_INSTALL_DOCDIR} COMPONENT runtime)
+# README.md and its pages under docs/ keep their relative links.
+install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR} COMPONENT runtime)
+file(GLOB fins_doc_pages CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/docs/*.md)
+install(FILES ${fins_doc_pages} DESTINATION ${CMAKE_INSTALL_DOCDIR}/docs COMPONENT runtime)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/examples/ DESTINATION ${CMAKE_INSTALL_DOCDIR}/examples
   COMPONENT dev FILES_MATCHING PATTERN "*.cpp" PATTERN "*.toml" PATTERN "CMakeLists.txt")
 
@@ -104,4 +109,5 @@ if(FINS_PYTHON)
   add_subdirectory(${PROJECT_SOURCE_DIR}/python ${PROJECT_BINARY_DIR}/python)
 endif()
 
+include(${CMAKE_CURRENT_LIST_DIR}/FinsDebian.cmake)
 include(${CMAKE_CURRENT_LIST_DIR}/FinsCPack.cmake)

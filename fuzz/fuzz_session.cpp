@@ -9,6 +9,12 @@
 // between chunks, so the server sees them as separate reads). A record cut short by the
 // end of the input keeps what is there.
 //
+// The server has every route a frame can take: it is unit 0 (1.1) of CPU Unit A in a
+// plant whose routing tables put network 2 on unit 1 (2.1) and network 3 behind 2.5
+// (CPU Unit B, no tables of its own); and it serves a Serial Gateway port (unit 80) and
+// a port whose Host Link slaves are network 5 (unit 81), on a device that does not
+// exist (a request there is answered 0205, through the session's reply path).
+//
 // Checked beyond "no crash": every datagram finsd sends is a response frame of at most
 // 2,012 bytes; everything it sends on TCP is a sequence of well-formed FINS/TCP packets
 // whose frames are response frames; the session ends (a sentinel datagram is answered
@@ -29,6 +35,10 @@
 #include "fins/frame.hpp"
 #include "fins/tcp.hpp"
 #include "plc/plc.hpp"
+#include "plc/routing_tables.hpp"
+#include "server/dispatch/dispatcher.hpp"
+#include "server/routing/router.hpp"
+#include "server/serial/serial_ports.hpp"
 #include "server/sessions/server.hpp"
 
 namespace {
@@ -57,18 +67,57 @@ int client_socket(int type, std::uint16_t port) {
 struct Session {
     asio::io_context io{1};
     plc::Plc plc;
+    plc::Plc remote;  // CPU Unit B
+    server::Router router;
+    server::Dispatcher a2{plc, {2, 1, 0}};
+    server::Dispatcher b2{remote, {2, 5, 0}};
+    server::SerialPorts ports;
     std::unique_ptr<server::Server> server;
     int udp = -1;
     std::uint8_t sentinel_sid = 0;
 
     Session() {
         spdlog::set_level(spdlog::level::off);
+        const auto cpu_a = router.add_cpu(plc, false);
+        const auto cpu_b = router.add_cpu(remote, false);
+        const auto a1_port = router.add_port(cpu_a, 0, {1, 1, 0});
+        for (const auto& [port, dispatcher] :
+             {std::pair{router.add_port(cpu_a, 1, {2, 1, 0}), &a2},
+              std::pair{router.add_port(cpu_b, 0, {2, 5, 0}), &b2}}) {
+            dispatcher->attach(router, port);
+            router.set_dispatcher(port, *dispatcher);
+        }
+        plc::RoutingTables tables;
+        tables.local[0] = {1, 0};
+        tables.local[1] = {2, 1};
+        tables.local_count = 2;
+        tables.relay[0] = {3, 2, 5};
+        tables.relay_count = 1;
+        plc::encode_routing_tables(tables, plc.parameters().words(plc::routing_table_area));
+
         server::ServerOptions options;
         options.bind_address = "127.0.0.1";
         options.port = 0;
+        options.network = 1;
+        options.node = 1;
+        options.router = &router;
+        options.router_port = a1_port;
         auto started = server::Server::start(io, plc, options);
         check(started.has_value());
         server = std::move(*started);
+        router.set_dispatcher(a1_port, server->dispatcher());
+
+        server::GatewayPortConfig gateway;
+        gateway.name = "scu0.1";
+        gateway.unit_address = 0x80;
+        gateway.line.device = "/nonexistent/fuzz-gateway";
+        ports.add(std::make_shared<server::SerialGatewayPort>(io, gateway));
+        server::GatewayPortConfig host_link = gateway;
+        host_link.name = "scu0.2";
+        host_link.unit_address = 0x81;
+        host_link.network = 5;
+        ports.add(std::make_shared<server::SerialGatewayPort>(io, host_link));
+        server->attach_serial_ports(&ports);
         udp = client_socket(SOCK_DGRAM, server->udp_port());
     }
 };

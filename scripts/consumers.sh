@@ -25,8 +25,14 @@ for kind in shared static; do
     -DCMAKE_PREFIX_PATH="$prefix" -DFINS_EXAMPLES_STATIC=$static >/dev/null
   ninja -C "$work/cmake-$kind" -j "$jobs" >/dev/null
 done
-# The shared build really uses the installed libfins.so with its SONAME.
+# The shared build really uses the installed libfins.so with its SONAME, the static one
+# does not load it at all.
 ldd "$work/cmake-shared/example_read_write" | grep "libfins.so.* => $prefix" >/dev/null
+passed=$((passed + 1))
+no_libfins_so() {
+  if ldd "$1" | grep libfins.so; then echo "FAILED: $1 links libfins.so" >&2; exit 1; fi
+}
+no_libfins_so "$work/cmake-static/example_read_write"
 passed=$((passed + 1))
 
 echo "== consumer: pkg-config fins"
@@ -37,9 +43,11 @@ for ex in "${examples[@]}"; do
   g++ $(pkg-config --cflags fins) "$root/examples/$ex.cpp" -o "$work/pc/$ex" \
     $(pkg-config --libs fins) -Wl,-rpath,"$(pkg-config --variable=libdir fins)"
 done
-# libfins.a: --static adds what the archive needs (fmt, threads).
-g++ $(pkg-config --cflags fins) "$root/examples/read_write.cpp" -o "$work/pc/read_write_static" \
-  $(pkg-config --libs --static fins | sed 's/-lfins\b/-l:libfins.a/')
+# libfins.a as README says: fins-static names the archive and what it needs (fmt, threads).
+# shellcheck disable=SC2046
+g++ $(pkg-config --cflags fins-static) "$root/examples/read_write.cpp" \
+  -o "$work/pc/read_write_static" $(pkg-config --libs fins-static)
+no_libfins_so "$work/pc/read_write_static"
 passed=$((passed + 1))
 
 echo "== consumers against the installed finsd"

@@ -14,7 +14,7 @@ jobs=${FINS_JOBS:-$(nproc)}
 # No tests, benchmarks or in-tree examples: the ASan tree builds those, consumers.sh the
 # examples against the install.
 args=(-DCMAKE_BUILD_TYPE=Release -DCMAKE_INSTALL_PREFIX=/usr -DFINS_TESTS=OFF -DFINS_BENCH=OFF
-  -DFINS_EXAMPLES=OFF)
+  -DFINS_EXAMPLES=OFF -DFINS_MAN=ON)
 # The .deb's Python module is for Debian's own interpreter, whatever else is on PATH.
 if [[ -x /usr/bin/python3 ]]; then args+=(-DPython3_EXECUTABLE=/usr/bin/python3); fi
 if command -v ccache >/dev/null; then args+=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi

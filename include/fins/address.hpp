@@ -1,7 +1,7 @@
 // PLC address strings as engineers write them, and their FINS memory addresses.
 //
 //   D100  D100.15  CIO10.13  10.13  W5  H10.1  A448  T10  C10
-//   E3_100  E0_0.5  E100 (current EM bank)  IR0  DR3  TK2
+//   E3_100  E0_0.5  E100 (current EM bank)  IR0  DR3  TK2  DM100 = D100 (address_names.hpp)
 //
 // parse_address() accepts these forms (area letters case-insensitive, "CIO" optional
 // for a bare number); format_address() prints the canonical form back, so

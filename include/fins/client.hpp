@@ -287,8 +287,12 @@ Result<std::vector<std::uint8_t>> get_file(Client& client, std::uint16_t disk,
                                            const FileProgress& progress = {},
                                            std::size_t window = 8);
 // Writes a whole file: the first 22 03 creates it (0001 with `replace`, else 0000: 2107
-// when it exists), the rest extend it with 0003 at their positions, `window` in flight.
-// If a chunk fails the file holds the chunks before it.
+// when it exists), the rest write 0003 at their explicit positions, `window` in flight,
+// and a final 22 02 checks the file's size. With ClientOptions::retries it completes
+// through lost, duplicated and reordered datagrams: a chunk that overtook a lost one
+// (refused 1103) is sent again after it, a repeated chunk rewrites the same bytes, and a
+// file found shorter than acknowledged is resumed from its size. The file on the PLC is
+// always a prefix of `data`; when the call fails, its size says how much arrived.
 Result<void> put_file(Client& client, std::uint16_t disk, const std::string& directory,
                       const FileName& file, std::span<const std::uint8_t> data, bool replace,
                       const FileProgress& progress = {}, std::size_t window = 8);

@@ -1,5 +1,6 @@
 // PLC address strings <-> Address <-> FINS memory addresses (W342 5-2-2).
 #include "fins/address.hpp"
+#include "fins/address_names.hpp"
 
 #include <algorithm>
 
@@ -52,14 +53,30 @@ std::optional<std::uint32_t> take_decimal(std::string_view& text) noexcept {
 struct Prefix {
     std::string_view text;
     Area area;
+    bool alias = false;  // another name of an area listed under its short name
 };
 // Longer prefixes first: "CIO" before "C", "DR" before "D". "E" is handled apart.
+// DM, HR, WR, AR, TIM and CNT are the names CX-Programmer and the older manuals use for
+// D, H, W, A, T and C: accepted as aliases (none is a prefix of another area's name
+// followed by a digit), always printed the short way. Nothing else is: LR (CIO 1000-1199
+// on CS/CJ) or SR name no single area of 5-2-2.
 constexpr Prefix prefixes[] = {
-    {"CIO", Area::cio},          {"IR", Area::index_register},
-    {"DR", Area::data_register}, {"TK", Area::task_flag},
-    {"W", Area::work},           {"H", Area::holding},
-    {"A", Area::auxiliary},      {"T", Area::timer},
-    {"C", Area::counter},        {"D", Area::dm},
+    {"CIO", Area::cio},
+    {"TIM", Area::timer, true},
+    {"CNT", Area::counter, true},
+    {"IR", Area::index_register},
+    {"DR", Area::data_register},
+    {"DM", Area::dm, true},
+    {"HR", Area::holding, true},
+    {"WR", Area::work, true},
+    {"AR", Area::auxiliary, true},
+    {"TK", Area::task_flag},
+    {"W", Area::work},
+    {"H", Area::holding},
+    {"A", Area::auxiliary},
+    {"T", Area::timer},
+    {"C", Area::counter},
+    {"D", Area::dm},
 };
 
 constexpr std::uint8_t max_bank = 0x18;
@@ -196,6 +213,17 @@ Result<Address> parse_address(std::string_view text) {
     }
     if (!rest.empty()) return fail(AddressError::trailing_characters);
     return a;
+}
+
+std::string area_names() {
+    std::string names;
+    std::string aliases;
+    for (const auto& p : prefixes) {
+        std::string& list = p.alias ? aliases : names;
+        list += (list.empty() ? "" : " ") + std::string(p.text);
+        if (!p.alias && p.area == Area::dm) list += " E";  // EM, parsed apart from the table
+    }
+    return names + " (also " + aliases + ")";
 }
 
 std::string format_address(const Address& a) {

@@ -52,6 +52,14 @@ FileEntry dot_entry(std::string_view dots, const struct stat& st) {
 
 constexpr const char* volume_file = ".volume";
 
+// The volume label's date lives in the mtime of an empty hidden file, made with the
+// device directory (22 04 dates it again).
+void ensure_volume(int device) noexcept {
+    if (host::kind_of(device, volume_file) != Kind::missing) return;
+    const Fd v(::openat(device, volume_file, O_WRONLY | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0644));
+    host::set_mtime(device, volume_file, Clock::host_local(std::chrono::system_clock::now()));
+}
+
 }  // namespace
 
 // ---- devices ----
@@ -86,15 +94,45 @@ Result<void> FileMemory::attach(const std::filesystem::path& root) {
     std::filesystem::create_directories(root, ec);
     const int fd = ::open(root.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     if (fd < 0) return Unexpected(std::error_code(errno, std::generic_category()));
+    // Device directories that are symlinks: opened now, following that one link.
+    constexpr std::array<const char*, 3> devices = {"card", "em", "cassette"};
+    std::array<Fd, 3> linked;
+    std::vector<DeviceLink> links;
+    std::error_code refused;
+    for (std::size_t i = 0; i < devices.size(); ++i) {
+        struct stat st {};
+        if (::fstatat(fd, devices[i], &st, AT_SYMLINK_NOFOLLOW) != 0 || !S_ISLNK(st.st_mode))
+            continue;
+        DeviceLink link{devices[i], std::filesystem::read_symlink(root / devices[i], ec), {}};
+        linked[i] = Fd(::openat(fd, devices[i], O_RDONLY | O_DIRECTORY | O_CLOEXEC));
+        if (!linked[i].valid()) {
+            link.error = std::error_code(errno, std::generic_category());
+            if (!refused) refused = link.error;
+        }
+        links.push_back(std::move(link));
+    }
+    device_links_ = std::move(links);
+    if (refused) {
+        ::close(fd);
+        return Unexpected(refused);
+    }
     close_devices();
     if (root_fd_ >= 0) ::close(root_fd_);
     if (own_root_) std::filesystem::remove_all(root_, ec);
     root_fd_ = fd;
     root_ = root;
     own_root_ = false;
-    for (const char* device : {"card", "em", "cassette"}) {
-        const Fd dir = host::open_directory(root_fd_, device);
-        if (dir.valid()) host::clear(dir.get(), true);
+    device_fds_[0] = linked[0].release();
+    device_fds_[1] = linked[1].release();
+    cassette_fd_ = linked[2].release();
+    for (std::size_t i = 0; i < devices.size(); ++i) {
+        const int kept = i == 2 ? cassette_fd_ : device_fds_[i];
+        if (kept >= 0) {
+            host::clear(kept, true);
+            if (i < 2) ensure_volume(kept);
+        } else if (const Fd dir = host::open_directory(root_fd_, devices[i]); dir.valid()) {
+            host::clear(dir.get(), true);
+        }
     }
     return {};
 }
@@ -137,11 +175,7 @@ Result<FileMemory::Device> FileMemory::open_device(std::uint16_t disk) {
         fd = host::open_directory(root_fd_, dir).release();
         if (fd < 0) return fail(EndCode::memory_error);
         used_[d.index].reset();
-        if (host::kind_of(fd, volume_file) == Kind::missing) {
-            const Fd v(
-                ::openat(fd, volume_file, O_WRONLY | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0644));
-            host::set_mtime(fd, volume_file, Clock::host_local(std::chrono::system_clock::now()));
-        }
+        ensure_volume(fd);
     }
     d.fd = fd;
     return d;
@@ -176,8 +210,20 @@ Result<FileNameReadResponse> FileMemory::list(const FileNameRead& c) {
     const Fd dir = host::open_path(device->fd, *path);
     if (!dir.valid()) return fail(EndCode::read_file_missing);
 
+    struct stat volume {};
+    const bool dated = ::fstatat(device->fd, volume_file, &volume, AT_SYMLINK_NOFOLLOW) == 0;
     std::vector<FileEntry> all;
-    if (!path->empty()) {
+    if (path->empty()) {
+        // 5-3-32 "Total Number of Files": "Volume labels ... are all counted as files. (The
+        // root directory can contain a volume label, but not a current directory or parent
+        // directory mark.)" On FAT the label is an entry of the root directory, first here:
+        // attribute 08 (volume label), size 0, the date of the label (the last format).
+        FileEntry label;
+        label.name = *FileName::from(device->label);
+        label.date = dated ? date_of(volume.st_mtime) : 0;
+        label.attribute = attribute_volume;
+        all.push_back(label);
+    } else {
         struct stat st {};
         ::fstat(dir.get(), &st);
         all.push_back(dot_entry(".", st));
@@ -189,9 +235,7 @@ Result<FileNameReadResponse> FileMemory::list(const FileNameRead& c) {
 
     FileNameReadResponse r;
     r.disk.volume_label = *FileName::from(device->label);
-    struct stat volume {};
-    if (::fstatat(device->fd, volume_file, &volume, AT_SYMLINK_NOFOLLOW) == 0)
-        r.disk.date = date_of(volume.st_mtime);
+    if (dated) r.disk.date = date_of(volume.st_mtime);
     const auto used = bytes_in_use(*device);
     r.disk.total_capacity =
         static_cast<std::uint32_t>(std::min<std::uint64_t>(device->capacity, 0xFFFFFFFF));

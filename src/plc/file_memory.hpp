@@ -27,7 +27,9 @@
 // 2301 device missing (card not inserted, EM not configured as file memory); 2006 file
 // or directory missing on a read, 2106 on a write; 2107 name exists; 2108 directory not
 // empty; 2103 directory depth limit; 1103 position past the file's end; 1104 capacity
-// or 32-bit size exceeded; 250F a host I/O error.
+// or 32-bit size exceeded; 250F a host I/O error
+// (a full host disk too), after which the file is exactly as the last acknowledged write
+// left it: an extending write the host refuses part way is cut back (ftruncate).
 #pragma once
 
 #include <cstdint>
@@ -35,6 +37,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <system_error>
 #include <vector>
 
 #include "fins/commands/file_memory.hpp"
@@ -46,9 +49,8 @@ namespace fins::plc {
 
 // EM file memory: one bank of 32,768 words = 64 KiB of file space.
 inline constexpr std::uint32_t em_bank_bytes = 32768 * 2;
-// 5-3-39 .. 5-3-41 data files (.IOM, .STD, .OBJ) start with a 48-byte header
-// (CJ2SW p.269/272); finskit writes zeros there and skips it on load.
-inline constexpr std::size_t data_file_header_size = 48;
+// The data files' header (fins/commands/file_memory.hpp).
+using fins::data_file_header_size;
 // Directories below the root: 5 levels counting the root (CJ2SW p.271).
 inline constexpr std::size_t max_file_directories = 4;
 
@@ -62,7 +64,21 @@ class FileMemory {
     // Keeps the devices under `root` (created if missing) and removes temp files a
     // killed finsd left behind. Without attach(), the first file access creates a
     // private temporary root that the destructor removes.
+    // A device directory (<root>/card, em, cassette) that is a symlink was put there by
+    // whoever owns the data directory (no FINS command creates one), e.g. to keep the card
+    // on another disk: it is followed here, once, and the directory it names is that
+    // device until the next attach(); below it nothing is followed. One that does not name
+    // a directory fails attach() (ENOTDIR, or the error opening it).
     Result<void> attach(const std::filesystem::path& root);
+    struct DeviceLink {
+        std::string device;            // "card", "em", "cassette"
+        std::filesystem::path target;  // what the symlink says
+        std::error_code error;         // why it was refused, if it was
+    };
+    // The device symlinks the last attach() found (for finsd's log).
+    [[nodiscard]] const std::vector<DeviceLink>& device_links() const noexcept {
+        return device_links_;
+    }
     [[nodiscard]] std::filesystem::path root() const { return root_; }
 
     // The memory card: inserted with a capacity, or not (2301).
@@ -184,6 +200,7 @@ class FileMemory {
     bool cassette_mounted_ = false;
     int cassette_fd_ = -1;
     std::vector<OpenFile> open_files_;
+    std::vector<DeviceLink> device_links_;
     std::uint64_t use_counter_ = 0;
 };
 

@@ -200,14 +200,15 @@ bool replace(int dir, const std::string& name, Bytes content, std::int64_t mtime
     return true;
 }
 
-bool write_at(int dir, const std::string& name, std::uint64_t offset, Bytes data,
-              std::int64_t mtime) noexcept {
-    const Fd fd(::openat(dir, name.c_str(), O_WRONLY | O_NOFOLLOW | O_CLOEXEC));
-    return fd.valid() && write_fd(fd.get(), offset, data, mtime);
-}
-
-bool write_undated(int fd, std::uint64_t offset, Bytes data) noexcept {
-    return write_fully(fd, data, static_cast<off_t>(offset));
+bool extend_undated(int fd, std::uint64_t old_size, Bytes data) noexcept {
+    if (write_fully(fd, data, static_cast<off_t>(old_size))) return true;
+    // The bytes that fitted before the host refused the rest would make the file larger
+    // than any acknowledged write: a client resuming at 22 02's size would skip data.
+    const int saved = errno;
+    while (::ftruncate(fd, static_cast<off_t>(old_size)) != 0 && errno == EINTR) {
+    }
+    errno = saved;
+    return false;
 }
 
 bool set_mtime_fd(int fd, std::int64_t mtime) noexcept {
@@ -215,9 +216,10 @@ bool set_mtime_fd(int fd, std::int64_t mtime) noexcept {
     return ::futimens(fd, times) == 0;
 }
 
-bool write_fd(int fd, std::uint64_t offset, Bytes data, std::int64_t mtime) noexcept {
-    const timespec times[2] = {at(mtime), at(mtime)};
-    return write_fully(fd, data, static_cast<off_t>(offset)) && ::futimens(fd, times) == 0;
+bool extend_at(int dir, const std::string& name, std::uint64_t old_size, Bytes data,
+               std::int64_t mtime) noexcept {
+    const Fd fd(::openat(dir, name.c_str(), O_WRONLY | O_NOFOLLOW | O_CLOEXEC));
+    return fd.valid() && extend_undated(fd.get(), old_size, data) && set_mtime_fd(fd.get(), mtime);
 }
 
 }  // namespace fins::plc::host

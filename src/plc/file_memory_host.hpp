@@ -69,13 +69,16 @@ std::optional<std::vector<std::uint8_t>> read_all(int dir, const std::string& na
 // to `name` (replacing) and fsyncs `dir`. False on any host error (the temp is removed).
 bool replace(int dir, const std::string& name, Bytes content, std::int64_t mtime,
              unsigned& counter) noexcept;
-// pwrite of `data` at `offset` into the existing regular file `name`, then dates it.
-bool write_at(int dir, const std::string& name, std::uint64_t offset, Bytes data,
-              std::int64_t mtime) noexcept;
-// The same on an open descriptor of a regular file.
-bool write_fd(int fd, std::uint64_t offset, Bytes data, std::int64_t mtime) noexcept;
-// pwrite of `data` at `offset`, all of it or false; the caller dates the file later.
-bool write_undated(int fd, std::uint64_t offset, Bytes data) noexcept;
+// Extending writes (22 03 0002, or 0003 at the file's end): `data` written at
+// `old_size`, the file's size now, all of it or nothing. A write the host refuses part
+// way (ENOSPC, EFBIG, EIO) is cut back to `old_size` with ftruncate, so the file stays
+// exactly as the last acknowledged write left it (5-3-34: a refused write changes
+// nothing). False on any host error.
+// The regular file `name` in `dir` (opened without following a symlink), then dated.
+bool extend_at(int dir, const std::string& name, std::uint64_t old_size, Bytes data,
+               std::int64_t mtime) noexcept;
+// An open descriptor of a regular file; the caller dates the file later.
+bool extend_undated(int fd, std::uint64_t old_size, Bytes data) noexcept;
 // Sets the modification time of an open file.
 bool set_mtime_fd(int fd, std::int64_t mtime) noexcept;
 // Sets the modification time of `name` (not following symlinks).

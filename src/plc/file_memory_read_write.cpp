@@ -148,11 +148,13 @@ EndCode FileMemory::write(const SingleFileWrite& c, CivilSeconds now) {
             if (cached != nullptr) static_cast<void>(walked.release());
         }
         if (cached != nullptr) {
-            ok = host::write_undated(cached->fd, offset, c.data);
-            cached->last_write = now;
-            cached->undated = true;
+            ok = host::extend_undated(cached->fd, offset, c.data);
+            if (ok) {
+                cached->last_write = now;
+                cached->undated = true;
+            }
         } else {
-            ok = host::write_at(dir_fd, *name, offset, c.data, now);
+            ok = host::extend_at(dir_fd, *name, offset, c.data, now);
         }
     } else {
         // A new inode replaces the file: the kept descriptor would write to the old one.

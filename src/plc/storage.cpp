@@ -15,6 +15,7 @@
 
 #include "plc/crc32c.hpp"
 #include "plc/storage_format.hpp"
+#include "plc/storage_guard.hpp"
 
 namespace fins::plc {
 
@@ -79,6 +80,10 @@ struct Storage::Impl {
     bool upgraded = false;  // converted from a version 1 file
     std::error_code problem;
     std::filesystem::path path;
+    // From seal() on: the file's size and its mappings under the SIGBUS guard.
+    std::uint64_t sealed_size = 0;
+    std::vector<std::pair<void*, std::size_t>> guarded;
+    std::unique_ptr<StateFileGuard> guard;
 
     std::span<std::byte> on_heap(std::size_t bytes) {
         // Large sections (EM banks, DM) come from anonymous memory the kernel backs
@@ -133,6 +138,7 @@ struct Storage::Impl {
     Result<void> verify_sections(std::uint64_t size);
 
     ~Impl() {
+        guard.reset();  // before the mappings go
         for (auto [p, n] : maps)
             ::munmap(p, n);
         for (auto [p, n] : anonymous)
@@ -365,6 +371,10 @@ Result<void> Storage::seal() {
         step("directory synced");
     }
     s.sealed = true;
+    s.sealed_size = s.header->descriptor.file_size;
+    s.guarded = s.maps;
+    s.guarded.emplace_back(s.header, page);
+    s.guard = std::make_unique<StateFileGuard>(s.guarded, s.path.string());
     return {};
 }
 
@@ -380,6 +390,13 @@ std::filesystem::path Storage::path() const {
     return impl_->path;
 }
 
+bool Storage::intact() const noexcept {
+    const Impl& s = *impl_;
+    if (!s.sealed || s.fd < 0) return true;
+    struct stat st {};
+    return ::fstat(s.fd, &st) == 0 && static_cast<std::uint64_t>(st.st_size) >= s.sealed_size;
+}
+
 void Storage::flush() noexcept {
     for (auto [p, n] : impl_->maps)
         ::msync(p, n, MS_SYNC);
@@ -390,6 +407,9 @@ void Storage::close() noexcept {
     Impl& s = *impl_;
     if (!s.sealed || s.closed) return;
     s.closed = true;
+    // A file that shrank under us is left as it is: sealing it would touch pages that
+    // are gone (SIGBUS) and could mark lost data "clean".
+    if (!intact()) return;
     // Sections first: checksums never describe data that is not on disk. When a sync
     // fails the file stays "running" and is checked as after a SIGKILL.
     if (::fdatasync(s.fd) != 0) return;

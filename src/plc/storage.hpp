@@ -101,6 +101,9 @@ class Storage {
     // its checksum; false after a SIGKILL or power loss (only the header and section
     // table were checked) and for a new file.
     [[nodiscard]] bool checksums_verified() const noexcept;
+    // False when the sealed state file is now shorter than it was (truncated from
+    // outside, storage_guard.hpp): close() then leaves it alone. True without a file.
+    [[nodiscard]] bool intact() const noexcept;
     // The state file, empty without a data directory.
     [[nodiscard]] std::filesystem::path path() const;
     // Asks the kernel to write retained sections to disk now (msync). Not needed for

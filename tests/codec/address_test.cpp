@@ -5,6 +5,7 @@
 
 #include "codec/test_support.hpp"
 #include "fins/address.hpp"
+#include "fins/address_names.hpp"
 
 namespace fins {
 namespace {
@@ -71,7 +72,9 @@ TEST(Address, BadStrings) {
         {" D100", AddressError::unknown_area},         // no leading spaces
         {"D100 ", AddressError::trailing_characters},  // no trailing spaces
         {"X100", AddressError::unknown_area},
-        {"DM100", AddressError::bad_number},
+        {"LR5", AddressError::unknown_area},  // LR is CIO 1000-1199: no single area
+        {"DMX", AddressError::bad_number},
+        {"TIM5.1", AddressError::bit_not_allowed},
         {"D", AddressError::bad_number},
         {"D-1", AddressError::bad_number},
         {"D+1", AddressError::bad_number},
@@ -114,6 +117,34 @@ TEST(Address, BadStrings) {
         ASSERT_FALSE(a) << "'" << c.text << "' parsed";
         EXPECT_EQ(a.error(), make_error_code(c.error)) << "'" << c.text << "'";
     }
+}
+
+// W342 5-2-2 names the areas D, H, W, A, T, C; CX-Programmer and the older manuals call
+// them DM, HR, WR, AR, TIM, CNT. Users type those: they are the same addresses, and are
+// printed back the short way.
+TEST(Address, CxProgrammerNamesOf5_2_2AreasAreAliases) {
+    const Form aliases[] = {
+        {"DM100", "D100", {Area::dm, 0, 100, std::nullopt}},
+        {"dm100.3", "D100.3", {Area::dm, 0, 100, 3}},
+        {"HR0", "H0", {Area::holding, 0, 0, std::nullopt}},
+        {"WR0", "W0", {Area::work, 0, 0, std::nullopt}},
+        {"AR448", "A448", {Area::auxiliary, 0, 448, std::nullopt}},
+        {"TIM5", "T5", {Area::timer, 0, 5, std::nullopt}},
+        {"CNT5", "C5", {Area::counter, 0, 5, std::nullopt}},
+        {"cnt4095", "C4095", {Area::counter, 0, 4095, std::nullopt}},
+    };
+    for (const auto& f : aliases) {
+        SCOPED_TRACE(std::string(f.text));
+        auto a = parse_address(f.text);
+        ASSERT_TRUE(a) << a.error().message();
+        EXPECT_EQ(*a, f.address);
+        EXPECT_EQ(format_address(*a), f.canonical);
+    }
+    EXPECT_EQ(area_names(), "CIO IR DR TK W H A T C D E (also TIM CNT DM HR WR AR)");
+    // The short names still win where they are a prefix: DR is a data register, not D.
+    EXPECT_EQ(parse_address("DR3")->area, Area::data_register);
+    EXPECT_EQ(parse_address("CIO5")->area, Area::cio);
+    EXPECT_EQ(parse_address("TK2")->area, Area::task_flag);
 }
 
 TEST(Address, GoldenExamplesFromTheManual) {

@@ -233,7 +233,9 @@ TEST_F(CliDiagnostic, CtlVerbsAndExitCodes) {
     EXPECT_EQ(ctl({"fal", "0"}).exit_code, 2);
     EXPECT_EQ(ctl({"mode", "debug"}).exit_code, 2);
     EXPECT_EQ(ctl({"bogus"}).exit_code, 2);
-    EXPECT_EQ(run({finsd_bin, "ctl", "status"}).exit_code, 2);  // --socket missing
+    // No --socket: $FINSD_SOCKET (else the default path finsd uses too; issue 18).
+    EXPECT_EQ(
+        run({"/usr/bin/env", "FINSD_SOCKET=" + socket_, finsd_bin, "ctl", "status"}).exit_code, 0);
     auto gone = run({finsd_bin, "ctl", "--socket", socket_ + ".missing", "status"});
     EXPECT_EQ(gone.exit_code, 3);
     EXPECT_NE(gone.err.find("cannot connect"), std::string::npos) << gone.err;

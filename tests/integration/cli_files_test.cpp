@@ -117,6 +117,81 @@ std::string version(std::size_t i) {
     s[1] = static_cast<char>(i & 0xFF);
     return s;
 }
+// 5-3-39: `files save` in the README table's order ("D100 10" then the file) and in the
+// synopsis's (the file, then COUNT); wrong lists get a usage message, not the argument
+// parser's; a compare that finds a difference (2007) says where, both values, how many.
+TEST(CliFiles, W342_5_3_39_SaveInEitherOrderAndCompareSaysWhere) {
+    ScratchDir dir("cli-files-compare");
+    Finsd d({"--data-dir", (dir.path() / "data").string()});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    ASSERT_EQ(
+        fins(d, {"write", "D100", "0", "1", "2", "3", "4", "5", "6", "7", "8", "9"}).exit_code, 0);
+    auto r = fins(d, {"files", "save", "D100", "10", "/D100.IOM"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(r.out, "files save: 10 words\n");
+    r = fins(d, {"files", "save", "D100", "/D101.IOM", "10"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    // Usage errors name the forms; nothing of the argument parser's wording.
+    for (const std::vector<std::string>& bad :
+         {std::vector<std::string>{"files", "save", "D100"},
+          {"files", "save", "D100", "ten", "/X.IOM"},
+          {"files", "save", "D100", "/X.IOM", "10", "extra"},
+          {"files", "compare", "/D100.IOM", "D100", "many"}}) {
+        r = fins(d, bad);
+        EXPECT_EQ(r.exit_code, 2) << bad[2];
+        EXPECT_NE(r.err.find("usage: files "), std::string::npos) << r.err;
+        EXPECT_EQ(r.err.find("could not be converted"), std::string::npos) << r.err;
+    }
+    EXPECT_EQ(fins(d, {"files", "compare", "/D100.IOM", "D100", "10"}).exit_code, 0);
+    ASSERT_EQ(fins(d, {"write", "D103", "99"}).exit_code, 0);
+    ASSERT_EQ(fins(d, {"write", "D107", "0x77"}).exit_code, 0);
+    r = fins(d, {"files", "compare", "/D100.IOM", "D100", "10"});
+    EXPECT_EQ(r.exit_code, 4);
+    EXPECT_NE(r.err.find("2007"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("2 of 10 words differ; the first is D103: file 0003, PLC 0063"),
+              std::string::npos)
+        << r.err;
+    r = fins(d, {"--json", "files", "compare", "/D100.IOM", "D100", "12"});
+    EXPECT_EQ(r.exit_code, 4);
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["error"]["end_code"], "2007");
+    EXPECT_NE(j["error"]["context"].get<std::string>().find("the file holds 10 words, not 12"),
+              std::string::npos)
+        << r.out;
+    // Parameter areas say the word of the area.
+    ASSERT_EQ(fins(d, {"files", "save", "plc-setup", "/P.STD"}).exit_code, 0);
+    ASSERT_EQ(fins(d, {"files", "compare", "/P.STD", "plc-setup"}).exit_code, 0);
+    ASSERT_EQ(fins(d, {"files", "compare", "/D100.IOM", "plc-setup"}).exit_code, 4);
+}
+// DATA_DIR/card as a symlink (the card on another disk): finsd says at start that it
+// follows it and files land behind it; a link that names no directory stops finsd at
+// start (exit 3), naming it. Names from the network still never escape (plc tests).
+TEST(CliFiles, FrameSerialFiles_4_1_SymlinkedCardIsFollowedAndLogged) {
+    namespace fs = std::filesystem;
+    ScratchDir dir("cli-files-link");
+    fs::create_directories(dir.path() / "disk/sd");
+    fs::create_directories(dir.path() / "data");
+    fs::create_directory_symlink(dir.path() / "disk/sd", dir.path() / "data/card");
+    {
+        Finsd d({"--data-dir", (dir.path() / "data").string()});
+        ASSERT_TRUE(d.started()) << d.result().err;
+        const auto local = dir.write("a.txt", "hello");
+        ASSERT_EQ(fins(d, {"files", "put", local, "/A.TXT"}).exit_code, 0);
+        EXPECT_EQ(slurp(dir.path() / "disk/sd/A.TXT"), "hello");
+        const auto stopped = d.stop();
+        EXPECT_NE(stopped.err.find("card is a symlink to " + (dir.path() / "disk/sd").string() +
+                                   ": followed"),
+                  std::string::npos)
+            << stopped.err;
+    }
+    fs::remove(dir.path() / "data/card");
+    fs::create_directory_symlink(dir.path() / "disk/none", dir.path() / "data/card");
+    Finsd broken({"--data-dir", (dir.path() / "data").string()});
+    EXPECT_FALSE(broken.started());
+    EXPECT_EQ(broken.result().exit_code, 3);
+    EXPECT_NE(broken.result().err.find("card is a symlink to"), std::string::npos)
+        << broken.result().err;
+}
 
 // W342 5-3-34 + the durability rule: 22 03 (0001) replacing a file while finsd
 // is SIGKILLed leaves one whole version, never a mix, and never one older than the

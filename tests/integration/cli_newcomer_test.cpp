@@ -177,8 +177,12 @@ TEST(CliConventions, FinsdStdoutCarriesOnlyListeningAndCtlTakesOptionsAfterTheVe
     EXPECT_EQ(after.exit_code, 0) << after.err;
     auto before = run({finsd_path, "ctl", "--socket", socket, "status"});
     EXPECT_EQ(before.exit_code, 0) << before.err;
-    auto missing = run({finsd_path, "ctl", "status"});
-    EXPECT_EQ(missing.exit_code, 2);
+    // No --socket: $FINSD_SOCKET (or the default path), the same rule finsd follows.
+    auto from_env = run({"/usr/bin/env", "FINSD_SOCKET=" + socket, finsd_path, "ctl", "status"});
+    EXPECT_EQ(from_env.exit_code, 0) << from_env.err;
+    auto missing =
+        run({"/usr/bin/env", "FINSD_SOCKET=" + socket + ".none", finsd_path, "ctl", "status"});
+    EXPECT_EQ(missing.exit_code, 3);
     EXPECT_EQ(missing.err.rfind("finsd ctl: ", 0), 0u) << missing.err;
 
     d.terminate();

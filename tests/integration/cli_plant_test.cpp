@@ -30,6 +30,21 @@ TEST(CliPlant, RelayedReadAndWriteThroughTwoRouters) {
     EXPECT_EQ(r.out, "D10  7\nD11  8\n");
 }
 
+// Issue 18 item 12: probe asks the --dest it is given (through the routers, like any
+// request), not node 00 of the host it talks to.
+TEST(CliPlant, ProbeAsksTheRoutedDest) {
+    PlantThread plant;
+    auto local = fins_cli(plant, {"--json", "probe"});
+    auto far = fins_cli(plant, {"--json", "--dest", "3.5.0", "probe"});
+    EXPECT_EQ(far.exit_code, 0) << far.err;
+    EXPECT_NE(far.out.find(R"("node":"3.5.0")"), std::string::npos) << far.out;
+    EXPECT_NE(far.out, local.out);
+    auto nowhere = fins_cli(plant, {"--dest", "9.5.0", "probe"});
+    EXPECT_EQ(nowhere.exit_code, 4) << nowhere.out;
+    EXPECT_NE(nowhere.err.find("relay error: the router at network 1 node 1"), std::string::npos)
+        << nowhere.err;
+}
+
 TEST(CliPlant, W342_5_1_3_RelayErrorNamesTheRouterInTextAndJson) {
     PlantThread plant;
     auto text = fins_cli(plant, {"--dest", "9.5.0", "read", "D10"});

@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -52,9 +53,11 @@ class Peer {
         }
         return {};
     }
-    // Answers `command` with `end_code` and `data`, as a CPU Unit does (frames 1.5).
+    // Answers `command` with `end_code` and `data`, as a CPU Unit does (frames 1.5), to
+    // the sender of the last datagram or to `to`.
     void answer(const std::vector<std::uint8_t>& command, std::uint16_t end_code,
-                const std::vector<std::uint8_t>& data = {}) {
+                const std::vector<std::uint8_t>& data = {},
+                std::optional<asio::ip::udp::endpoint> to = std::nullopt) {
         std::vector<std::uint8_t> r{0xC0,
                                     0x00,
                                     command[2],
@@ -70,7 +73,7 @@ class Peer {
                                     static_cast<std::uint8_t>(end_code >> 8),
                                     static_cast<std::uint8_t>(end_code)};
         r.insert(r.end(), data.begin(), data.end());
-        socket_.send_to(asio::buffer(r), from_);
+        socket_.send_to(asio::buffer(r), to.value_or(from_));
     }
     [[nodiscard]] const asio::ip::udp::endpoint& from() const { return from_; }
 
@@ -200,11 +203,29 @@ TEST_F(NetworkInstructions, W596_3_HostProgramSeesEveryHeaderByteAndItsAnswerCom
     EXPECT_EQ(j["result"]["response"], "05010000434A");
 }
 
+// Issue 18 item 6: another process on the host of node 7 answers first, from another
+// port; finsd takes only the answer from node 7's address and port.
+TEST_F(NetworkInstructions, Issue18_AForgedAnswerFromAnotherPortIsIgnored) {
+    start_node1("");
+    Peer host("127.0.0.7", node1_->port());
+    Peer forger("127.0.0.7", 0);
+    Child cmd({finsd_path, "ctl", "--socket", socket_path(), "sendcmd", "--dest", "0.7.0",
+               "--command", "0501", "--json"});
+    const auto frame = host.receive();
+    ASSERT_EQ(frame.size(), 12u);
+    forger.answer(frame, 0x0000, {0x66, 0x66}, host.from());
+    host.answer(frame, 0x0000, {0x43, 0x4A});
+    const auto r = cmd.wait();
+    EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+    const auto j = Json::parse(r.out, nullptr, false);
+    EXPECT_EQ(j["result"]["response"], "05010000434A");
+}
+
 TEST_F(NetworkInstructions, W596_3_NoAnswerRetriesThenExits5) {
     start_node1("");
     Peer silent("127.0.0.7", node1_->port());
     Child cmd({finsd_path, "ctl", "--socket", socket_path(), "send", "--dest", "0.7.0", "--local",
-               "D0", "--remote", "D0", "--timeout", "2", "--retries", "3", "--json"});
+               "D0", "--remote", "D0", "--timeout", "0.2", "--retries", "3", "--json"});
     std::vector<std::vector<std::uint8_t>> seen;
     for (int i = 0; i < 4; ++i)
         if (auto f = silent.receive(); !f.empty()) seen.push_back(f);

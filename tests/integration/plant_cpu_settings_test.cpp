@@ -8,6 +8,7 @@
 
 #include "fins/address.hpp"
 #include "finsd_run.hpp"
+#include "plant_fixture.hpp"
 
 namespace fins::test {
 namespace {
@@ -103,6 +104,75 @@ TEST(PlantCpuSettings, EachCpuUnitHasItsOwnProtectionAndInjections) {
     const auto read = a->send_raw(CommandCode{0x01, 0x01}, read_d0);
     ASSERT_TRUE(read) << read.error().message();
     EXPECT_FALSE(read->code.non_fatal_cpu_error());
+}
+
+// Newcomer 12: in a plant, --port (and [network] port) is the port of every
+// [[plc.ethernet]] unit that sets none of its own (default 9600); a unit's `port` wins.
+// finsd_run.hpp passes --port 0: line-a listens on a free port, line-b on its 9611.
+TEST(PlantCpuSettings, PortFlagIsThePortOfUnitsWithoutOneOfTheirOwn) {
+    ScratchDir dir("plant-port");
+    auto config = plant("");
+    const std::string fixed = "  bind = \"127.0.61.1\"\n  port = 9611\n";
+    config.replace(config.find(fixed), fixed.size(), "  bind = \"127.0.61.1\"\n");
+    Finsd d({"--config", dir.write("plant.toml", config)});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    EXPECT_NE(d.port(), 9600);  // "listening": the first unit's port
+    ClientOptions o;
+    o.host = "127.0.61.1";
+    o.port = d.port();
+    o.timeout = std::chrono::milliseconds(3000);
+    auto a = Client::connect(o);
+    ASSERT_TRUE(a) << a.error().message();
+    EXPECT_EQ(words_of(**a, "D100", 2), (std::vector<std::uint16_t>{11, 12}));
+    EXPECT_EQ(words_at("127.0.62.1", "D100", 2), (std::vector<std::uint16_t>{0, 0}));
+}
+
+// [plc.storage] durability: "power" fdatasyncs that CPU Unit's state file before each
+// write's answer ([storage] durability of a single node); the other CPU Unit never syncs.
+TEST(PlantCpuSettings, EachCpuUnitHasItsOwnDurability) {
+    ScratchDir dir("plant-durability");
+    server::PlantConfig config;
+    for (const char* name : {"a", "b"}) {
+        server::PlantCpuConfig cpu;
+        cpu.name = name;
+        cpu.data_dir = dir.path() / name;
+        cpu.ports = {plant_port(0, 1, name[0] == 'a' ? "127.0.67.1" : "127.0.67.2")};
+        config.cpus.push_back(cpu);
+    }
+    config.cpus[0].durability = plc::Durability::power;
+    PlantThread plant(config);
+    for (const auto& [cpu, host] : {std::pair{0, "127.0.67.1"}, std::pair{1, "127.0.67.2"}}) {
+        auto c = plant.client(host, plant.port(static_cast<std::size_t>(cpu)),
+                              {1, static_cast<std::uint8_t>(cpu + 1), 0});
+        ASSERT_NE(c, nullptr);
+        ASSERT_TRUE(c->write_words(*parse_address("D0"), std::vector<std::uint16_t>{1}));
+    }
+    EXPECT_EQ(plant.plant().plc(0).storage().syncs(), 1u);
+    EXPECT_EQ(plant.plant().plc(1).storage().syncs(), 0u);
+}
+
+// The single node's [storage], [serial], [[remote]] and [[schedule]] describe no CPU Unit
+// of a plant: finsd says they are ignored and where a plant takes them.
+TEST(PlantCpuSettings, SingleNodeTablesInAPlantAreNamedAsIgnored) {
+    ScratchDir dir("plant-ignored");
+    const std::string single = R"(
+[[remote]]
+node = 9
+address = "127.0.0.9"
+[[schedule]]
+every = "1s"
+instruction = "sendcmd"
+dest = "0.9.0"
+command = "0501"
+)";
+    Finsd d({"--config", dir.write("plant.toml", single + plant(""))});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    const auto err = d.stop().err;
+    EXPECT_NE(err.find("[[remote]] (a [[plc]] takes its own [[plc.remote]])"), std::string::npos)
+        << err;
+    EXPECT_NE(err.find("[[schedule]] (a [[plc]] takes its own [[plc.schedule]])"),
+              std::string::npos)
+        << err;
 }
 
 }  // namespace

@@ -101,6 +101,8 @@ class PlantThread {
         EXPECT_TRUE(c.has_value()) << (c ? "" : c.error().message());
         return c ? std::move(*c) : nullptr;
     }
+    // The plant itself: read it only while its thread is idle (after an answer came).
+    server::Plant& plant() noexcept { return *plant_; }
     // A client on network 1 at router-a's port.
     std::unique_ptr<Client> from_network_1(NodeAddress destination, bool tcp = false) {
         return client("127.0.1.1", port(0), destination, tcp);

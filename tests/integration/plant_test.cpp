@@ -243,5 +243,34 @@ TEST(Plant, W342_5_1_3_ARelayLoopEndsWith0504EvenFromAGctAbove07) {
     EXPECT_EQ(*r.relay, (RelayErrorSource{2, 2}));
 }
 
+// fins-frames.md 1.3: DA1 FF is a broadcast, sent without an answer (W343 08 03). To
+// another network it is relayed as a broadcast there (README "Routing"): line-3 on
+// network 3 runs it; no answer comes back through the routers. Before: 8201 from
+// router-b, which looked for a node FF.
+TEST(Plant, Frames_1_3_BroadcastToAnotherNetworkRunsThereAndIsNotAnswered) {
+    PlantThread plant;
+    ClientOptions o;
+    o.timeout = std::chrono::milliseconds(300);
+    auto c = plant.client("127.0.1.1", plant.port(0), {3, broadcast_node, 0}, false, o);
+    auto direct = plant.client("127.0.3.5", plant.port(2), line_3);
+    ASSERT_TRUE(c && direct);
+    // 01 02 D200 = 1234, no answer asked.
+    ASSERT_TRUE(c->send_no_response(
+        {0x01, 0x02}, std::vector<std::uint8_t>{0x82, 0x00, 0xC8, 0x00, 0x00, 0x01, 0x12, 0x34}));
+    std::uint16_t seen = 0;
+    for (int i = 0; i < 100 && seen != 0x1234; ++i) {
+        const auto r = direct->read_words(dm(200), 1);
+        if (r && !r->empty()) seen = r->front();
+    }
+    EXPECT_EQ(seen, 0x1234);
+    // An answer asked for: the command runs there, and none comes back.
+    const auto r = c->send_raw(
+        {0x01, 0x02}, std::vector<std::uint8_t>{0x82, 0x00, 0xC9, 0x00, 0x00, 0x01, 0x56, 0x78});
+    EXPECT_FALSE(r.has_value()) << "answered " << std::hex << r->code.raw();
+    const auto after = direct->read_words(dm(201), 1);
+    ASSERT_TRUE(after);
+    EXPECT_EQ(*after, std::vector<std::uint16_t>{0x5678});
+}
+
 }  // namespace
 }  // namespace fins::test

@@ -14,6 +14,7 @@
 
 #include "cli/finsd/config.hpp"
 #include "finsd_run.hpp"
+#include "plc/storage_guard.hpp"
 
 namespace fins::test {
 namespace {
@@ -135,6 +136,48 @@ TEST(FinsdStateFile, ByteChangedWhileStoppedIsRefused) {
     Finsd refused({"--data-dir", data});
     EXPECT_EQ(refused.result().exit_code, 3);
     EXPECT_TRUE(has(refused.result().err, "fails its checksum")) << refused.result().err;
+}
+
+// Issue 18 item 5: `: > finsd.state` while finsd runs. The next access to a retained
+// section ends finsd with exit 4 and one line naming the file (storage_guard.hpp),
+// never a silent SIGBUS (exit 135); the emptied file is left as it is, and refused at
+// the next start.
+TEST(FinsdStateFile, TruncatedWhileRunningExits4WithALineNeverASigbus) {
+    ScratchDir dir("statetrunc");
+    const std::string data = (dir.path() / "data").string();
+    const fs::path file = dir.path() / "data" / "finsd.state";
+    Finsd d({"--data-dir", data});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    write_d0(d, 0x1234);
+    std::ofstream(file, std::ios::binary | std::ios::trunc).close();  // : > finsd.state
+    {
+        auto c = d.client(true);
+        ASSERT_NE(c, nullptr);
+        // D0 lives in the emptied file: no answer comes (finsd exits on this read).
+        EXPECT_FALSE(c->read_words(addr("D0"), 1).has_value());
+    }
+    const auto ended = d.stop(0);  // signal 0: only waits
+    EXPECT_EQ(ended.exit_code, plc::state_file_lost_exit_code) << ended.err;
+    EXPECT_TRUE(has(ended.err, plc::state_file_lost_message(file.string()))) << ended.err;
+    EXPECT_EQ(fs::file_size(file), 0u);
+    Finsd refused({"--data-dir", data});
+    EXPECT_EQ(refused.result().exit_code, 3);
+    EXPECT_TRUE(has(refused.result().err, "empty (0 bytes)")) << refused.result().err;
+}
+
+// Truncated but never touched before SIGTERM: no seal is written over the lost data,
+// and the exit says why (the same code and line).
+TEST(FinsdStateFile, TruncatedThenStoppedExits4AndWritesNothing) {
+    ScratchDir dir("statetrunc");
+    const std::string data = (dir.path() / "data").string();
+    const fs::path file = dir.path() / "data" / "finsd.state";
+    Finsd d({"--data-dir", data});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    std::ofstream(file, std::ios::binary | std::ios::trunc).close();
+    const auto ended = d.stop(SIGTERM);
+    EXPECT_EQ(ended.exit_code, plc::state_file_lost_exit_code) << ended.err;
+    EXPECT_TRUE(has(ended.err, plc::state_file_lost_message(file.string()))) << ended.err;
+    EXPECT_EQ(fs::file_size(file), 0u);
 }
 
 TEST(FinsdStateFile, StorageKeysAndFlags) {

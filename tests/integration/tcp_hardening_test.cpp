@@ -11,9 +11,12 @@
 #include <cerrno>
 #include <functional>
 #include <memory>
+#include <sstream>
 #include <thread>
 
 #include <gtest/gtest.h>
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
 #include <asio/io_context.hpp>
 #include <asio/post.hpp>
 
@@ -269,6 +272,41 @@ TEST(TcpLimits, CapOnUnfinishedHandshakesClosesTheOldest) {
     EXPECT_TRUE(oldest.closed_by_peer());
     EXPECT_EQ(be32(second.handshake(), 12), 0u);
     EXPECT_EQ(be32(third.handshake(), 12), 0u);
+}
+
+// Issue 18 item 7: every handshake and every refusal logged an info line (5 MB in 10 s
+// of churn), and a refusal showed the node as 0x000000ff. Now each kind of line comes at
+// most once per interval (log_summary.hpp) and the refused node is decimal, with why.
+TEST(TcpLogVolume, ChurnOfConnectionsLogsAFewLinesNotOnePerConnection) {
+    std::ostringstream captured;
+    const auto previous = spdlog::default_logger();
+    const auto previous_level = spdlog::get_level();
+    spdlog::set_default_logger(std::make_shared<spdlog::logger>(
+        "capture", std::make_shared<spdlog::sinks::ostream_sink_mt>(captured)));
+    spdlog::set_level(spdlog::level::info);
+    {
+        InProcessFinsd finsd(calm());
+        for (int i = 0; i < 200; ++i) {
+            auto c = finsd.connect();
+            c.handshake(0);
+        }
+        for (int i = 0; i < 50; ++i) {
+            auto c = finsd.connect();
+            c.send(tcp_packet(TcpCommand::node_address_request, {0x00, 0x00, 0x00, 0xFF}));
+            c.receive_packet();
+        }
+    }
+    spdlog::set_default_logger(previous);
+    spdlog::set_level(previous_level);
+    const std::string log = captured.str();
+    std::size_t lines = 0;
+    for (const char ch : log)
+        lines += ch == '\n' ? 1U : 0U;
+    EXPECT_LE(lines, 6u) << log;
+    EXPECT_NE(log.find("refused client node 255: the client FINS node address is out of range"),
+              std::string::npos)
+        << log;
+    EXPECT_EQ(log.find("0x000000ff"), std::string::npos) << log;
 }
 
 }  // namespace

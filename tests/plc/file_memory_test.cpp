@@ -114,11 +114,11 @@ TEST_F(FileMemoryTest, W342_5_3_34_DatedWithTheCpuClock) {
     ASSERT_EQ(put("A.TXT", "x"), EndCode::normal_completion);
     const auto list = files.list({disk_memory_card, 0, 20, ""});
     ASSERT_TRUE(list);
-    ASSERT_EQ(list->files.size(), 1U);
+    ASSERT_EQ(list->files.size(), 2U);  // the volume label, then the file
     // 1,700,000,000 = 2023-11-14 22:13:20
-    EXPECT_EQ(list->files[0].date, pack_file_date(2023, 11, 14, 22, 13, 20));
-    EXPECT_EQ(list->files[0].size, 1U);
-    EXPECT_EQ(list->files[0].attribute, attribute_archive);
+    EXPECT_EQ(list->files[1].date, pack_file_date(2023, 11, 14, 22, 13, 20));
+    EXPECT_EQ(list->files[1].size, 1U);
+    EXPECT_EQ(list->files[1].attribute, attribute_archive);
 }
 
 TEST_F(FileMemoryTest, HostileNamesNeverLeaveTheDevice) {
@@ -144,7 +144,8 @@ TEST_F(FileMemoryTest, HostileNamesNeverLeaveTheDevice) {
     EXPECT_EQ(put("X.TXT", "x", "\\" + std::string(65, 'A')), EndCode::parameter_error);
     const auto list = files.list({disk_memory_card, 0, 20, ""});
     ASSERT_TRUE(list);
-    EXPECT_TRUE(list->files.empty());  // the symlinks are invisible
+    ASSERT_EQ(list->files.size(), 1U);  // the symlinks are invisible: the volume label only
+    EXPECT_EQ(list->files[0].attribute, attribute_volume);
     EXPECT_EQ(slurp(box.dir / "secret/KEY.TXT"), "secret");
     EXPECT_EQ(box.outside(), before);
     EXPECT_EQ(fs::directory_iterator(box.dir / "secret")->path().filename(), "KEY.TXT");
@@ -184,12 +185,12 @@ TEST_F(FileMemoryTest, W342_5_3_32_ListingAcrossRequests) {
         ASSERT_EQ(put("F" + std::to_string(i), "x"), EndCode::normal_completion);
     const auto first = files.list({disk_memory_card, 0, 20, ""});
     ASSERT_TRUE(first);
-    EXPECT_EQ(first->disk.total_files, 25);
+    EXPECT_EQ(first->disk.total_files, 26);  // with the volume label (5-3-32)
     EXPECT_EQ(first->files.size(), 20U);
     EXPECT_FALSE(first->last);
     const auto rest = files.list({disk_memory_card, 20, 20, ""});
     ASSERT_TRUE(rest);
-    EXPECT_EQ(rest->files.size(), 5U);
+    EXPECT_EQ(rest->files.size(), 6U);
     EXPECT_TRUE(rest->last);
     EXPECT_EQ(files.list({disk_memory_card, 0, 21, ""}).error(), EndCode::parameter_error);
     // A sub-directory lists "." and ".." first.
@@ -200,6 +201,48 @@ TEST_F(FileMemoryTest, W342_5_3_32_ListingAcrossRequests) {
     ASSERT_EQ(sub->files.size(), 2U);
     EXPECT_EQ(sub->files[0].name.text(), ".");
     EXPECT_EQ(sub->files[1].attribute, attribute_directory);
+}
+
+TEST_F(FileMemoryTest, W342_5_3_32_RootCountsTheVolumeLabelAsAFile) {
+    ASSERT_EQ(files.format(disk_memory_card, 0, 1'700'000'000), EndCode::normal_completion);
+    ASSERT_EQ(put("A.TXT", "abc"), EndCode::normal_completion);
+    ASSERT_EQ(files.directory({disk_memory_card, 0, name("SUB"), ""}, 0),
+              EndCode::normal_completion);
+    const auto root = files.list({disk_memory_card, 0, 20, ""});
+    ASSERT_TRUE(root);
+    // "Volume labels ... are all counted as files. (The root directory can contain a
+    // volume label, but not a current directory or parent directory mark.)"
+    EXPECT_EQ(root->disk.total_files, 3);
+    ASSERT_EQ(root->files.size(), 3U);
+    const FileEntry& label = root->files[0];
+    EXPECT_EQ(label.name, root->disk.volume_label);
+    EXPECT_EQ(label.name.text(), "MEMCARD");
+    EXPECT_EQ(label.attribute, attribute_volume);
+    EXPECT_EQ(label.size, 0U);
+    EXPECT_EQ(label.date, root->disk.date);
+    EXPECT_EQ(label.date, pack_file_date(2023, 11, 14, 22, 13, 20));
+    EXPECT_EQ(root->files[1].name.text(), "A.TXT");
+    EXPECT_EQ(root->files[2].name.text(), "SUB");
+    EXPECT_TRUE(root->last);
+    // Positions count the label: the file is entry 1.
+    const auto second = files.list({disk_memory_card, 1, 1, ""});
+    ASSERT_TRUE(second);
+    ASSERT_EQ(second->files.size(), 1U);
+    EXPECT_EQ(second->files[0].name.text(), "A.TXT");
+    // A sub-directory has no label: ".", "..", then its entries.
+    const auto sub = files.list({disk_memory_card, 0, 20, "\\SUB"});
+    ASSERT_TRUE(sub);
+    EXPECT_EQ(sub->disk.total_files, 2);
+    for (const auto& e : sub->files)
+        EXPECT_EQ(e.attribute & attribute_volume, 0);
+    // EM file memory's root has its own label.
+    files.set_em_file_bank(0x10);
+    const auto em = files.list({disk_em_file, 0, 20, ""});
+    ASSERT_TRUE(em);
+    EXPECT_EQ(em->disk.total_files, 1);
+    ASSERT_EQ(em->files.size(), 1U);
+    EXPECT_EQ(em->files[0].name.text(), "EMFILE");
+    EXPECT_EQ(em->files[0].attribute, attribute_volume);
 }
 
 TEST_F(FileMemoryTest, W342_5_3_42_DirectoryRules) {
@@ -236,10 +279,62 @@ TEST_F(FileMemoryTest, W342_5_3_35_DevicesMissingAndFormat) {
     EXPECT_EQ(files.format(disk_memory_card, 0, 1'700'000'000), EndCode::normal_completion);
     const auto after = files.list({disk_memory_card, 0, 20, ""});
     ASSERT_TRUE(after);
-    EXPECT_TRUE(after->files.empty());
+    ASSERT_EQ(after->files.size(), 1U);  // the volume label, dated by the format
+    EXPECT_EQ(after->files[0].date, pack_file_date(2023, 11, 14, 22, 13, 20));
     EXPECT_EQ(after->disk.date, pack_file_date(2023, 11, 14, 22, 13, 20));
     files.remove_card();
     EXPECT_EQ(put("A.TXT", "x"), EndCode::file_device_missing);
+}
+
+// frames-serial-files 4 "a hostile path never escapes" is about names from the network;
+// <root>/card itself comes from whoever owns the data directory: a symlink there (the card
+// on another disk) is followed at attach() and reported; a broken one fails attach().
+TEST(FileMemoryDeviceLinks, FrameSerialFiles_4_1_CardSymlinkIsFollowedAndReported) {
+    Sandbox box;
+    Profile profile = cj2h();
+    fs::create_directories(box.dir / "disk/cardstore");
+    { std::ofstream(box.dir / "disk/cardstore/.tmp-9-9") << "half"; }
+    fs::create_directory_symlink(box.dir / "disk/cardstore", box.dir / "root/card");
+    FileMemory files(profile);
+    ASSERT_TRUE(files.attach(box.dir / "root"));
+    ASSERT_EQ(files.device_links().size(), 1U);
+    EXPECT_EQ(files.device_links()[0].device, "card");
+    EXPECT_EQ(files.device_links()[0].target, box.dir / "disk/cardstore");
+    EXPECT_FALSE(files.device_links()[0].error);
+    EXPECT_FALSE(fs::exists(box.dir / "disk/cardstore/.tmp-9-9"));  // cleaned like any card
+    const auto data = bytes("on the other disk");
+    EXPECT_EQ(files.write({disk_memory_card, 0, name("A.TXT"), 0, data, ""}, 0),
+              EndCode::normal_completion);
+    EXPECT_EQ(slurp(box.dir / "disk/cardstore/A.TXT"), "on the other disk");
+    const auto list = files.list({disk_memory_card, 0, 20, ""});
+    ASSERT_TRUE(list);
+    EXPECT_EQ(list->disk.total_files, 2);  // the volume label and A.TXT
+    // Below the followed directory, symlinks are still neither followed nor listed.
+    fs::create_directory(box.dir / "secret");
+    fs::create_directory_symlink(box.dir / "secret", box.dir / "disk/cardstore/LINK");
+    EXPECT_EQ(files.write({disk_memory_card, 0, name("X.TXT"), 0, data, "\\LINK"}, 0),
+              EndCode::write_file_missing);
+    EXPECT_TRUE(fs::is_empty(box.dir / "secret"));
+
+    // Dangling, or naming a file: refused at attach, the link named.
+    fs::remove(box.dir / "root/card");
+    fs::create_directory_symlink(box.dir / "disk/none", box.dir / "root/card");
+    FileMemory dangling(profile);
+    EXPECT_FALSE(dangling.attach(box.dir / "root"));
+    ASSERT_EQ(dangling.device_links().size(), 1U);
+    EXPECT_TRUE(dangling.device_links()[0].error);
+    fs::remove(box.dir / "root/card");
+    { std::ofstream(box.dir / "disk/file") << "x"; }
+    fs::create_symlink(box.dir / "disk/file", box.dir / "root/card");
+    FileMemory to_file(profile);
+    const auto r = to_file.attach(box.dir / "root");
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error(), std::errc::not_a_directory);
+    // Without links there is nothing to report.
+    fs::remove(box.dir / "root/card");
+    FileMemory plain(profile);
+    ASSERT_TRUE(plain.attach(box.dir / "root"));
+    EXPECT_TRUE(plain.device_links().empty());
 }
 
 }  // namespace

@@ -22,6 +22,7 @@
 
 #include "plc/crc32c.hpp"
 #include "plc/storage.hpp"
+#include "plc/storage_guard.hpp"
 
 namespace fins::plc::test {
 namespace {
@@ -172,6 +173,29 @@ TEST_F(StateFile, EmptyFileIsRefusedAndKept) {
     EXPECT_TRUE(Storage::is_refusal(r.error()));
     EXPECT_TRUE(fs::exists(state()));
     EXPECT_EQ(fs::file_size(state()), 0u);
+}
+
+// Issue 18 item 5: the file emptied under a sealed Storage. The next access to a
+// retained section ends the process with exit 4 and the line naming the file
+// (storage_guard.hpp), never a SIGBUS; intact() sees it; a SIGBUS elsewhere is not taken.
+TEST_F(StateFile, TruncatedUnderASealedStorageExits4WithTheLineNotASigbus) {
+    auto s = Storage::open(dir_, "p1");
+    ASSERT_TRUE(s) << message(s);
+    auto a = (*s)->array<std::uint16_t>("a", 100, R);
+    ASSERT_TRUE((*s)->seal());
+    EXPECT_TRUE((*s)->intact());
+    fs::resize_file(state(), 0);
+    EXPECT_FALSE((*s)->intact());
+    const std::string line = state_file_lost_message(state().string());
+    std::string pattern;
+    for (const char c : line)  // the whole line, literally (POSIX regex)
+        if (c != '\n') pattern += std::string(std::strchr("().*+?^$[]{}|\\", c) ? "\\" : "") + c;
+    EXPECT_EXIT(
+        {
+            volatile std::uint16_t* word = &a[99];
+            *word = 1;
+        },
+        ::testing::ExitedWithCode(state_file_lost_exit_code), pattern);
 }
 
 TEST_F(StateFile, SetAsideRenamesNeverDeletesAndRespectsTheLock) {

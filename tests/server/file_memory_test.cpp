@@ -50,15 +50,19 @@ TEST(FileMemoryHandlers, W342_5_3_32_DiskDataAndEntries) {
     const auto r = run(h, FileNameRead{disk_memory_card, 0, 20, ""});
     ASSERT_EQ(r.end_code(), 0x0000);
     const auto d = r.data();
-    ASSERT_EQ(d.size(), 28U + 2 * 22);
+    // 5-3-32: the root's volume label is counted and listed as a file (attribute 08).
+    ASSERT_EQ(d.size(), 28U + 3 * 22);
     EXPECT_EQ(to_hex(Bytes(d).first(12)), to_hex(file("MEMCARD").bytes));
     EXPECT_EQ(to_hex(Bytes(d).subspan(16, 4)), "01 E0 00 00");  // 30,720 KB
     EXPECT_EQ(to_hex(Bytes(d).subspan(20, 4)), "01 DF FF FB");  // minus 5 bytes
-    EXPECT_EQ(to_hex(Bytes(d).subspan(24, 4)), "00 02 80 02");  // 2 files, 2 + last
-    EXPECT_EQ(to_hex(Bytes(d).subspan(28, 12)), to_hex(file("A.IOM").bytes));
-    EXPECT_EQ(to_hex(Bytes(d).subspan(44, 6)), "00 00 00 05 00 20");  // size, archive
-    EXPECT_EQ(to_hex(Bytes(d).subspan(50, 12)), to_hex(file("LOGS").bytes));
-    EXPECT_EQ(to_hex(Bytes(d).subspan(70, 2)), "00 10");  // sub-directory
+    EXPECT_EQ(to_hex(Bytes(d).subspan(24, 4)), "00 03 80 03");  // 3 files, 3 + last
+    EXPECT_EQ(to_hex(Bytes(d).subspan(28, 12)), to_hex(file("MEMCARD").bytes));
+    EXPECT_EQ(to_hex(Bytes(d).subspan(40, 4)), to_hex(Bytes(d).subspan(12, 4)));  // its date
+    EXPECT_EQ(to_hex(Bytes(d).subspan(44, 6)), "00 00 00 00 00 08");  // size 0, volume label
+    EXPECT_EQ(to_hex(Bytes(d).subspan(50, 12)), to_hex(file("A.IOM").bytes));
+    EXPECT_EQ(to_hex(Bytes(d).subspan(66, 6)), "00 00 00 05 00 20");  // size, archive
+    EXPECT_EQ(to_hex(Bytes(d).subspan(72, 12)), to_hex(file("LOGS").bytes));
+    EXPECT_EQ(to_hex(Bytes(d).subspan(92, 2)), "00 10");  // sub-directory
     // Disk data only.
     const auto disk = run(h, FileNameRead{disk_memory_card, 0, 0, ""});
     ASSERT_EQ(disk.end_code(), 0x0000);

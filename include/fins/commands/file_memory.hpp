@@ -38,6 +38,9 @@ inline constexpr std::uint16_t max_file_read_bytes = 1988;
 // Bytes of disk data before the entries of a 22 01 response; bytes per entry.
 inline constexpr std::size_t disk_data_size = 26;
 inline constexpr std::size_t file_entry_size = 22;
+// 5-3-39 .. 5-3-41 data files (.IOM, .STD, .OBJ) start with a 48-byte header
+// (CJ2SW p.269/272); finskit writes zeros there and skips it on load.
+inline constexpr std::size_t data_file_header_size = 48;
 
 // The 12-byte name of 5-1 "Volume Labels and File Names": 8 name characters, ".",
 // 3 extension characters, left-aligned, padded with 20 hex; no extension: "." and the

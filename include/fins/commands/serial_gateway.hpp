@@ -29,6 +29,15 @@
 
 namespace fins {
 
+// W342 5-3-46 .. 5-3-48 tables: the unit address (DA2) of a serial port. Serial
+// Communications Unit N (0-F): port 1 = 80 + 4N, port 2 = 81 + 4N; the Board: E4, E5.
+constexpr std::uint8_t scu_port_unit_address(unsigned unit_number, unsigned port) noexcept {
+    return static_cast<std::uint8_t>(0x80U + 4U * unit_number + (port - 1U));
+}
+constexpr std::uint8_t board_port_unit_address(unsigned port) noexcept {
+    return static_cast<std::uint8_t>(0xE4U + (port - 1U));
+}
+
 // 28 03/04/05 responses: the slave's answer as the FINS response carries it.
 struct SerialGatewayResponse {
     std::vector<std::uint8_t> data;  // empty after a broadcast

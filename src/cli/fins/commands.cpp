@@ -1,5 +1,6 @@
 #include "cli/fins/commands.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <chrono>
 #include <cstdio>
@@ -9,18 +10,26 @@
 #include <fmt/core.h>
 
 #include "fins/address.hpp"
+#include "fins/address_names.hpp"
 #include "fins/client.hpp"
 #include "fins/commands/memory_area.hpp"
 #include "fins/memory_area.hpp"
 
 namespace fins::cli {
 
+std::string bad_address(const std::string& text, std::error_code ec) {
+    if (ec == make_error_code(AddressError::unknown_area))
+        return fmt::format("bad address '{}': unknown memory area; the areas are {}", text,
+                           area_names());
+    return fmt::format("bad address '{}': {}", text, ec.message());
+}
+
 namespace {
 
 std::optional<Address> address_or_usage(const std::string& text, Output& out, int& exit_code) {
     auto a = parse_address(text);
     if (!a) {
-        exit_code = out.usage(fmt::format("bad address '{}': {}", text, a.error().message()));
+        exit_code = out.usage(bad_address(text, a.error()));
         return std::nullopt;
     }
     return *a;
@@ -314,10 +323,14 @@ int run_read_multi(const GlobalOptions& g, const ReadMultiArgs& a, Output& out) 
     }
     nlohmann::json items_json = nlohmann::json::array();
     std::string text;
+    // Addresses of every length in one column: the values line up.
+    std::size_t width = 0;
+    for (const auto& address : addresses)
+        width = std::max(width, format_address(address).size());
     for (std::size_t i = 0; i < read.size() && i < addresses.size(); ++i) {
         const auto name = format_address(addresses[i]);
         items_json.push_back({{"address", name}, {"value", read[i]}});
-        text += fmt::format("{}  {}\n", name, read[i]);
+        text += fmt::format("{:<{}}  {}\n", name, width, read[i]);
     }
     out.print({{"items", items_json}}, text);
     return exit_ok;
@@ -353,8 +366,7 @@ int run_raw(const GlobalOptions& g, const RawArgs& a, Output& out) {
                        {"ok", r->code.ok()},
                        {"fatal_cpu_error", r->code.fatal_cpu_error()},
                        {"non_fatal_cpu_error", r->code.non_fatal_cpu_error()},
-                       {"source", fmt::format("{}.{}.{}", r->header.source.network,
-                                              r->header.source.node, r->header.source.unit)},
+                       {"source", node_text(r->header.source)},
                        {"sid", r->header.service_id},
                        {"data", hex_bytes(r->data)}};
     std::string text = fmt::format("end code {:04X} {}", r->code.raw(), name);
@@ -365,8 +377,7 @@ int run_raw(const GlobalOptions& g, const RawArgs& a, Output& out) {
         text +=
             fmt::format(" [relay error at network {} node {}]", r->relay->network, r->relay->node);
     }
-    text += fmt::format("\nfrom {}.{}.{} sid {:02X}\ndata ({} bytes): {}\n",
-                        r->header.source.network, r->header.source.node, r->header.source.unit,
+    text += fmt::format("\nfrom {} sid {:02X}\ndata ({} bytes): {}\n", node_text(r->header.source),
                         r->header.service_id, r->data.size(), hex_bytes(r->data));
     out.print(doc, text);
     return r->code.ok() ? exit_ok : exit_end_code;

@@ -6,6 +6,7 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 #include <CLI/App.hpp>
@@ -76,8 +77,11 @@ inline std::size_t fit(std::size_t max, std::size_t link_bytes, std::size_t fixe
 // "1 word", "3 words"; "1 entry"/"2 entries" with the plural given.
 std::string plural(std::size_t n, std::string_view one);
 std::string plural(std::size_t n, std::string_view one, std::string_view many);
-// NET.NODE.UNIT in decimal, as --dest takes it.
+// NET.NODE.UNIT as --dest takes it: network and node decimal, the unit decimal below 10
+// and hex from 10 on (E1, FE; 0x10 when the hex has no letter).
 std::string node_text(const NodeAddress& a);
+// "bad address 'XX5': why"; an unknown area lists the areas there are.
+std::string bad_address(const std::string& text, std::error_code ec);
 // "host:port" ("[::1]:9600" for IPv6).
 std::string endpoint(const GlobalOptions& g);
 
@@ -103,12 +107,20 @@ class Output {
     void note_relay(const std::optional<RelayErrorSource>& relay) { relay_ = relay; }
     // The connection settings failures are explained against (set by open_client).
     void set_target(const GlobalOptions& g) { target_ = &g; }
+    // What an end code means in this verb's own terms (the Loop Control Board's 1101 is
+    // "unregistered block", not W342's memory area): failure() says `text` instead of
+    // the W342 wording when it reports `code`.
+    void explain(EndCode code, std::string text) { explained_ = {code, std::move(text)}; }
+    // The source node the client sends as (set by open_client): a 2102 names it.
+    void set_local_node(NodeAddress node) { local_ = node; }
 
   private:
     bool json_;
     const GlobalOptions* target_ = nullptr;
     bool flags_tracked_ = false;
     std::optional<RelayErrorSource> relay_;
+    std::optional<NodeAddress> local_;
+    std::optional<std::pair<EndCode, std::string>> explained_;
     bool fatal_ = false;
     bool non_fatal_ = false;
 };
@@ -134,15 +146,31 @@ class Progress {
 // What answered a probe: its FINS address (the answer's source) and model (05 01).
 struct FoundNode {
     NodeAddress address;
+    NodeAddress local;  // the source node the request went out with
     std::string model;
 };
 // Asks the PLC at g.host:g.port who it is: over UDP one 05 01 to node 00 ("the local
 // node", which the PLC answers with its own address), over TCP the node the FINS/TCP
-// handshake reports. Nothing on failure.
-std::optional<FoundNode> discover_node(const GlobalOptions& g);
+// handshake reports. --dest is not used. On failure, why (connection refused, timeout).
+Result<FoundNode> discover_node(const GlobalOptions& g);
+// The DIP switch byte of 05 01 (pin k is bit k-1) of the PLC the options address;
+// nothing when it cannot be read.
+std::optional<std::uint8_t> read_dip_switch(const GlobalOptions& g);
 // NET.NODE.UNIT: each part decimal, or hex with 0x or with a letter A-F (E1 = 225).
+// NET.NODE is unit 0 (the CPU Unit), as the protection node lists write it.
 std::optional<NodeAddress> parse_node_address(const std::string& s);
 
+// After a failed parse: when the verb (or a group's sub-verb, `fins files ...`) is missing
+// or unknown, what to say instead of CLI11's "A subcommand is required": the nearest
+// verbs by edit distance, or the group's verbs. Nothing for every other parse error.
+std::optional<std::string> explain_missing_verb(CLI::App& app);
+
+// FINS_HOST and FINS_PORT as the defaults of --host and --port (a flag on the command
+// line overrides its variable). A bad value: the usage message to print (exit 2).
+std::optional<std::string> apply_environment(GlobalOptions& g, int argc, char** argv);
+// The usage message for a --dest or --source that is not NET.NODE[.UNIT]; nothing when
+// both are fine (or not given).
+std::optional<std::string> check_node_options(const GlobalOptions& g);
 // Registers the global options on `app` and describes them in every verb's --help.
 void add_global_options(CLI::App& app, GlobalOptions& g);
 void describe_global_options(CLI::App& app);

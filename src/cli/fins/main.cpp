@@ -15,6 +15,14 @@
 
 #include "cli/fins/commands.hpp"
 
+namespace fins::cli {
+// verbs_modbus.cpp (28 04 / 28 05), verbs_watch.cpp (01 04 polling), verbs_discover.cpp
+// (05 01 over an IPv4 range).
+void add_modbus_verbs(CLI::App& app, const GlobalOptions& g, int& exit_code);
+void add_watch_verbs(CLI::App& app, const GlobalOptions& g, int& exit_code);
+void add_discover_verbs(CLI::App& app, const GlobalOptions& g, int& exit_code);
+}  // namespace fins::cli
+
 int main(int argc, char** argv) {
     using namespace fins::cli;
     CLI::App app{"fins: talk FINS to an Omron CS/CJ/CP/NX PLC or to finsd"};
@@ -22,7 +30,15 @@ int main(int argc, char** argv) {
     // Global options may also follow the verb: `fins read D100 --json`.
     app.fallthrough(true);
     app.set_version_flag("--version", std::string("fins ") + FINSKIT_VERSION);
+    // Errors found before --json is parsed still honour it.
+    const auto json_asked = [argc, argv] {
+        bool json = false;
+        for (int i = 1; i < argc; ++i)
+            json = json || std::string_view(argv[i]) == "--json";
+        return json;
+    };
     GlobalOptions g;
+    if (const auto bad = apply_environment(g, argc, argv)) return Output{json_asked()}.usage(*bad);
     add_global_options(app, g);
 
     std::string as = "uint16";
@@ -80,6 +96,9 @@ int main(int argc, char** argv) {
     add_control_verbs(app, g, group_rc);
     add_diagnostic_verbs(app, g, group_rc);
     add_file_verbs(app, g, group_rc);
+    add_watch_verbs(app, g, group_rc);
+    add_discover_verbs(app, g, group_rc);
+    add_modbus_verbs(app, g, group_rc);
 
     describe_global_options(app);
 
@@ -89,10 +108,8 @@ int main(int argc, char** argv) {
         // --help and --version print and exit 0; every other parse error is a usage
         // error like any other, with the prefix and, under --json, as JSON.
         if (e.get_exit_code() == 0) return app.exit(e);
-        bool json = false;
-        for (int i = 1; i < argc; ++i)
-            json = json || std::string_view(argv[i]) == "--json";
-        Output out{json};
+        Output out{json_asked()};
+        if (const auto verb = explain_missing_verb(app)) return out.usage(*verb);
         return out.usage(fmt::format("{} (see fins --help)", e.what()));
     }
     if (group_rc >= 0) return group_rc;

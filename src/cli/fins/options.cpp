@@ -1,7 +1,9 @@
 // The global options of `fins` (where the PLC is, how to reach it, --json), node
 // addresses and the connection every verb opens with them.
+#include <algorithm>
 #include <charconv>
 #include <chrono>
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -38,18 +40,28 @@ std::optional<unsigned> parse_node_part(std::string_view s) {
 
 std::optional<NodeAddress> parse_node_address(const std::string& s) {
     unsigned parts[3] = {0, 0, 0};
+    const auto dots = static_cast<std::size_t>(std::count(s.begin(), s.end(), '.'));
+    if (dots != 1 && dots != 2) return std::nullopt;
     std::string_view rest = s;
-    for (std::size_t i = 0; i < 3; ++i) {
+    for (std::size_t i = 0; i <= dots; ++i) {
         const auto dot = rest.find('.');
-        if ((i < 2) != (dot != std::string_view::npos)) return std::nullopt;
         const auto v = parse_node_part(rest.substr(0, dot));
         if (!v) return std::nullopt;
         parts[i] = *v;
-        rest = i < 2 ? rest.substr(dot + 1) : std::string_view{};
+        rest = dot == std::string_view::npos ? std::string_view{} : rest.substr(dot + 1);
     }
     if (parts[0] > 127) return std::nullopt;
     return NodeAddress{static_cast<std::uint8_t>(parts[0]), static_cast<std::uint8_t>(parts[1]),
                        static_cast<std::uint8_t>(parts[2])};
+}
+
+std::optional<std::string> check_node_options(const GlobalOptions& g) {
+    if (!g.dest.empty() && !parse_node_address(g.dest))
+        return fmt::format("--dest '{}' is not NET.NODE[.UNIT] (e.g. 0.10, 0.10.0, 0.10.E1)",
+                           g.dest);
+    if (!g.source.empty() && !parse_node_address(g.source))
+        return fmt::format("--source '{}' is not NET.NODE[.UNIT] (e.g. 0.20)", g.source);
+    return std::nullopt;
 }
 
 std::string endpoint(const GlobalOptions& g) {
@@ -81,34 +93,56 @@ std::unique_ptr<Client> open_client(const GlobalOptions& g, Output& out, int& ex
     }
     o.timeout = std::chrono::milliseconds(static_cast<long>(g.timeout_seconds * 1000.0 + 0.5));
     o.retries = g.retries;
-    if (!g.dest.empty()) {
-        auto d = parse_node_address(g.dest);
-        if (!d) {
-            exit_code = out.usage(
-                fmt::format("--dest '{}' is not NET.NODE.UNIT (e.g. 0.10.0, 0.10.E1)", g.dest));
-            return nullptr;
-        }
-        o.destination = *d;
-    }
-    if (!g.source.empty()) {
-        auto s = parse_node_address(g.source);
-        if (!s) {
-            exit_code = out.usage(fmt::format("--source '{}' is not NET.NODE.UNIT", g.source));
-            return nullptr;
-        }
-        o.source = *s;
-    }
-    auto client = Client::connect(o);
-    if (!client) {
-        exit_code = out.failure(client.error(), "cannot connect");
+    if (const auto bad = check_node_options(g)) {
+        exit_code = out.usage(*bad);
         return nullptr;
     }
+    if (!g.dest.empty()) o.destination = *parse_node_address(g.dest);
+    if (!g.source.empty()) o.source = *parse_node_address(g.source);
+    auto client = Client::connect(o);
+    if (!client) {
+        // Only TCP connects; over UDP (and Host Link) nothing was sent yet.
+        exit_code = out.failure(client.error(), g.tcp ? "cannot connect"
+                                                : !g.serial.empty()
+                                                    ? "cannot open the serial line"
+                                                    : "cannot send over UDP (nothing was sent)");
+        return nullptr;
+    }
+    out.set_local_node((*client)->source());
     return std::move(*client);
 }
 
+std::optional<std::string> apply_environment(GlobalOptions& g, int argc, char** argv) {
+    // A flag on the command line wins: its variable is not even looked at.
+    auto given = [&](std::string_view flag) {
+        for (int i = 1; i < argc; ++i) {
+            const std::string_view arg = argv[i];
+            if (arg == flag || (arg.size() > flag.size() && arg.substr(0, flag.size()) == flag &&
+                                arg[flag.size()] == '='))
+                return true;
+        }
+        return false;
+    };
+    if (const char* host = std::getenv("FINS_HOST"); host != nullptr && !given("--host")) {
+        if (*host == '\0') return "FINS_HOST is set but empty (unset it or name the PLC's host)";
+        g.host = host;
+    }
+    if (const char* port = std::getenv("FINS_PORT"); port != nullptr && !given("--port")) {
+        const std::string_view text = port;
+        unsigned v = 0;
+        const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+        if (text.empty() || ec != std::errc{} || end != text.data() + text.size() || v == 0 ||
+            v > 65535)
+            return fmt::format("FINS_PORT '{}' is not a port number 1-65535", text);
+        g.port = static_cast<std::uint16_t>(v);
+    }
+    return std::nullopt;
+}
+
 void add_global_options(CLI::App& app, GlobalOptions& g) {
-    app.add_option("--host", g.host, "PLC host name or IP address")->capture_default_str();
-    app.add_option("--port", g.port, "FINS port")->capture_default_str();
+    app.add_option("--host", g.host, "PLC host name or IP address (environment: FINS_HOST)")
+        ->capture_default_str();
+    app.add_option("--port", g.port, "FINS port (environment: FINS_PORT)")->capture_default_str();
     app.add_flag("--tcp", g.tcp, "Use FINS/TCP instead of FINS/UDP");
     app.add_option("--serial", g.serial,
                    "FINS over Host Link on DEVICE[,baud=9600,parity=even,data=7,stop=2]");
@@ -122,9 +156,10 @@ void add_global_options(CLI::App& app, GlobalOptions& g) {
         ->capture_default_str()
         ->check(CLI::Range(0, 15));
     app.add_option("--dest", g.dest,
-                   "Destination NET.NODE.UNIT, unit in hex allowed (0.10.E1); default: derived "
-                   "(`fins probe` finds the PLC's node)");
-    app.add_option("--source", g.source, "Source NET.NODE.UNIT (default: derived)");
+                   "Destination NET.NODE[.UNIT], unit in hex allowed (0.10.E1; 0.10 is unit 0); "
+                   "default: derived (`fins probe` finds the PLC's node)");
+    app.add_option("--source", g.source,
+                   "Source NET.NODE[.UNIT] (default: derived; `fins probe` shows it)");
     app.add_flag("--json", g.json, "Print JSON");
 }
 

@@ -49,7 +49,12 @@ std::string plural(std::size_t n, std::string_view one) {
 }
 
 std::string node_text(const NodeAddress& a) {
-    return fmt::format("{}.{}.{}", a.network, a.node, a.unit);
+    // Units are hex in the manuals (10-1F CPU Bus Units, E1 Inner Board, FE): print them
+    // so, in a form --dest reads back (a hex number without a letter needs the 0x).
+    if (a.unit < 10) return fmt::format("{}.{}.{}", a.network, a.node, a.unit);
+    const std::string hex = fmt::format("{:X}", a.unit);
+    const bool letter = hex.find_first_of("ABCDEF") != std::string::npos;
+    return fmt::format("{}.{}.{}{}", a.network, a.node, letter ? "" : "0x", hex);
 }
 
 int Output::usage(const std::string& message) {
@@ -73,18 +78,44 @@ int Output::failure(std::error_code ec, const std::string& context) {
             relay_->network, relay_->node);
     } else if (ec == make_error_code(EndCode::destination_node_not_in_network) &&
                target_ != nullptr) {
-        if (const auto found = discover_node(*target_)) {
+        if (auto found = discover_node(*target_)) {
+            // Keep the unit the request was for (loop-read's Inner Board E1): only the
+            // node was wrong.
+            if (const auto asked = parse_node_address(target_->dest);
+                asked && !target_->dest.empty())
+                found->address.unit = asked->unit;
             hint = fmt::format("the PLC at {} is node {}: use --dest {}", endpoint(*target_),
                                found->address.node, node_text(found->address));
         }
     } else if (ec == make_error_code(EndCode::unit_missing)) {
         hint = "no such unit at that node: the CPU Unit is unit 0 (--dest NET.NODE.0)";
+    } else if (ec == make_error_code(EndCode::read_only) && target_ != nullptr) {
+        // W342 5-1-3 2101: read-only, "or protected using a switch setting": DIP switch
+        // pin 1 (UM write protection, 5-1-2), which 05 01 reports as bit 0.
+        const auto dip = read_dip_switch(*target_);
+        if (dip && (*dip & 0x01) != 0)
+            hint =
+                "the CPU Unit's DIP switch pin 1 is ON: user memory is write-protected "
+                "(W342 5-1-2); turn pin 1 OFF to write";
+        else if (dip)
+            hint = "DIP switch pin 1 is OFF: the area or file itself is read-only";
+    } else if (ec == make_error_code(EndCode::write_protected) && local_) {
+        // W342 5-1-3 2102: program protection, or the PLC Setup's write protection from
+        // the network, which lets through only the nodes it lists (by SA1).
+        hint = fmt::format(
+            "fins sent as source node {}; network write protection lets only the nodes it "
+            "lists write (--source NET.NODE sends as another node, `fins probe` shows the "
+            "node in use)",
+            node_text(*local_));
     }
+    std::string meaning = ec.message();
+    if (explained_ && kind == ErrorKind::end_code && ec == make_error_code(explained_->first))
+        meaning = fmt::format("0x{:04X}: {}", ec.value(), explained_->second);
     // A transport error names the endpoint it happened with (issue 7 item 3):
     // "127.0.0.1:9600: connection refused".
     const std::string message = kind == ErrorKind::transport && target_ != nullptr
                                     ? fmt::format("{}: {}", endpoint(*target_), ec.message())
-                                    : ec.message();
+                                    : meaning;
     if (json_) {
         nlohmann::json e{{"kind", kind_name(kind)}, {"message", message}, {"context", context}};
         if (kind == ErrorKind::end_code) {
@@ -98,8 +129,7 @@ int Output::failure(std::error_code ec, const std::string& context) {
         std::printf("%s\n", nlohmann::json{{"error", e}}.dump().c_str());
     }
     if (kind == ErrorKind::end_code)
-        std::fprintf(stderr, "fins: %s: the PLC answered %s\n", context.c_str(),
-                     ec.message().c_str());
+        std::fprintf(stderr, "fins: %s: the PLC answered %s\n", context.c_str(), meaning.c_str());
     else
         std::fprintf(stderr, "fins: %s: %s\n", context.c_str(), message.c_str());
     if (!hint.empty()) std::fprintf(stderr, "fins: %s\n", hint.c_str());

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <array>
+#include <cerrno>
 #include <chrono>
 #include <cstring>
 #include <memory>
@@ -50,31 +51,37 @@ std::uint8_t local_node(int fd) {
     return bytes[3];
 }
 
-std::optional<FoundNode> discover_udp(const GlobalOptions& g) {
+std::error_code last_error() {
+    return {errno, std::generic_category()};
+}
+
+Result<FoundNode> discover_udp(const GlobalOptions& g) {
     addrinfo hints{};
     hints.ai_family = AF_UNSPEC;
     hints.ai_socktype = SOCK_DGRAM;
     addrinfo* found = nullptr;
     const auto port = std::to_string(g.port);
     if (::getaddrinfo(g.host.c_str(), port.c_str(), &hints, &found) != 0 || found == nullptr)
-        return std::nullopt;
+        return Unexpected(std::make_error_code(std::errc::host_unreachable));
     std::unique_ptr<addrinfo, void (*)(addrinfo*)> list(found, ::freeaddrinfo);
     Fd s{::socket(found->ai_family, SOCK_DGRAM | SOCK_CLOEXEC, 0)};
-    if (s.fd < 0 || ::connect(s.fd, found->ai_addr, found->ai_addrlen) != 0) return std::nullopt;
+    if (s.fd < 0 || ::connect(s.fd, found->ai_addr, found->ai_addrlen) != 0)
+        return Unexpected(last_error());
 
     Header h;
     h.destination = NodeAddress{0, 0, 0};
     h.source = NodeAddress{0, local_node(s.fd), 0};
     if (auto src = parse_node_address(g.source); src && !g.source.empty()) h.source = *src;
+    const NodeAddress source = h.source;
     h.service_id = probe_service_id;
     std::array<std::uint8_t, 64> frame{};
     const auto size = encode_request(h, CpuUnitDataRead::code, Bytes{}, frame);
-    if (!size) return std::nullopt;
+    if (!size) return Unexpected(size.error());
 
     const auto wait = std::chrono::milliseconds(static_cast<long>(g.timeout_seconds * 1000.0));
     for (unsigned attempt = 0; attempt <= g.retries; ++attempt) {
         if (::send(s.fd, frame.data(), *size, 0) != static_cast<ssize_t>(*size))
-            return std::nullopt;
+            return Unexpected(last_error());
         const auto deadline = std::chrono::steady_clock::now() + wait;
         // Bounded: every turn either returns or moves towards the deadline.
         while (true) {
@@ -84,12 +91,15 @@ std::optional<FoundNode> discover_udp(const GlobalOptions& g) {
             if (left.count() <= 0 || ::poll(&p, 1, static_cast<int>(left.count())) <= 0) break;
             std::array<std::uint8_t, 2048> in{};
             const auto n = ::recv(s.fd, in.data(), in.size(), 0);
-            if (n <= 0) return std::nullopt;  // e.g. ICMP port unreachable
+            // ICMP port unreachable: nothing listens there, as `fins read` says too.
+            if (n <= 0)
+                return Unexpected(n < 0 ? last_error()
+                                        : make_error_code(ClientError::malformed_response));
             auto r = decode_response(Bytes(in.data(), static_cast<std::size_t>(n)));
             if (!r || r->header.service_id != probe_service_id ||
                 r->command != CpuUnitDataRead::code)
                 continue;
-            FoundNode node{r->header.source, {}};
+            FoundNode node{r->header.source, source, {}};
             node.address.unit = 0;
             if (r->code.ok())
                 if (auto data = CpuUnitDataRead{}.decode_response(r->data))
@@ -97,32 +107,52 @@ std::optional<FoundNode> discover_udp(const GlobalOptions& g) {
             return node;
         }
     }
-    return std::nullopt;
+    return Unexpected(make_error_code(ClientError::timeout));
 }
 
-std::optional<FoundNode> discover_tcp(const GlobalOptions& g) {
+Result<FoundNode> discover_tcp(const GlobalOptions& g) {
     ClientOptions o;
     o.host = g.host;
     o.port = g.port;
     o.protocol = ClientOptions::Protocol::tcp;
     o.timeout = std::chrono::milliseconds(static_cast<long>(g.timeout_seconds * 1000.0 + 0.5));
+    if (!g.source.empty())
+        if (auto src = parse_node_address(g.source)) o.source = *src;
     auto client = Client::connect(o);
-    if (!client) return std::nullopt;
-    FoundNode node{(*client)->destination(), {}};
+    if (!client) return Unexpected(client.error());
+    FoundNode node{(*client)->destination(), (*client)->source(), {}};
     if (auto data = (*client)->send(CpuUnitDataRead{CpuUnitDataSection::model_and_area}))
         node.model = data->model;
     return node;
 }
 
 // Host Link: the PLC on the line answers its CPU Unit data (there is no node to find).
-std::optional<FoundNode> discover_serial(const GlobalOptions& g) {
+Result<FoundNode> discover_serial(const GlobalOptions& g) {
     int rc = 0;
     Output quiet{false};
     auto client = open_client(g, quiet, rc);
-    if (!client) return std::nullopt;
+    if (!client) return Unexpected(make_error_code(ClientError::not_connected));
     auto data = client->send(CpuUnitDataRead{CpuUnitDataSection::model_and_area});
-    if (!data) return std::nullopt;
-    return FoundNode{client->destination(), data->model};
+    if (!data) return Unexpected(data.error());
+    return FoundNode{client->destination(), client->source(), data->model};
+}
+
+// --dest given: ask that node (through the routing tables of the nodes on the way, as any
+// request goes) and report who answered.
+Result<FoundNode> ask_dest(const GlobalOptions& g, Output& out, int& rc) {
+    auto client = open_client(g, out, rc);
+    if (!client) return Unexpected(std::error_code{});
+    const CpuUnitDataRead command{CpuUnitDataSection::model_and_area};
+    std::array<std::uint8_t, 8> parameters{};
+    ByteWriter w(parameters);
+    command.encode(w);
+    auto r = client->send_raw(CpuUnitDataRead::code, w.written());
+    if (!r) return Unexpected(r.error());
+    if (r->code.relay_error()) out.note_relay(r->relay);
+    if (!r->code.ok()) return Unexpected(make_error_code(r->code.end_code()));
+    FoundNode node{r->header.source, client->source(), {}};
+    if (auto data = command.decode_response(r->data)) node.model = data->model;
+    return node;
 }
 
 const char* link_name(const GlobalOptions& g) {
@@ -131,22 +161,33 @@ const char* link_name(const GlobalOptions& g) {
 
 }  // namespace
 
-std::optional<FoundNode> discover_node(const GlobalOptions& g) {
+std::optional<std::uint8_t> read_dip_switch(const GlobalOptions& g) {
+    int rc = 0;
+    Output quiet{false};
+    auto client = open_client(g, quiet, rc);
+    if (!client) return std::nullopt;
+    auto data = client->send(CpuUnitDataRead{CpuUnitDataSection::model_and_area});
+    if (!data) return std::nullopt;
+    return data->dip_switch;
+}
+
+Result<FoundNode> discover_node(const GlobalOptions& g) {
     if (!g.serial.empty()) return discover_serial(g);
     return g.tcp ? discover_tcp(g) : discover_udp(g);
 }
 
 int run_probe(const GlobalOptions& g, Output& out) {
-    auto found = discover_node(g);
-    if (!found)
-        return out.failure(make_error_code(ClientError::timeout),
-                           fmt::format("probe {} over {}", endpoint(g), link_name(g)));
+    const std::string context = fmt::format("probe {} over {}", endpoint(g), link_name(g));
+    if (const auto bad = check_node_options(g)) return out.usage(*bad);
+    int rc = exit_ok;
+    const bool dest_given = !g.dest.empty();
+    auto found = dest_given ? ask_dest(g, out, rc) : discover_node(g);
+    if (!found) return rc != exit_ok ? rc : out.failure(found.error(), context);
     // The node a plain `fins` would address: the client's own derivation, no request sent.
     GlobalOptions plain = g;
     plain.dest.clear();
     std::optional<NodeAddress> derived;
-    if (!g.tcp && g.serial.empty()) {
-        int rc = 0;
+    if (!g.tcp && g.serial.empty() && !dest_given) {
         Output quiet{false};
         if (auto c = open_client(plain, quiet, rc)) derived = c->destination();
     }
@@ -157,6 +198,7 @@ int run_probe(const GlobalOptions& g, Output& out) {
                                     : g.tcp           ? "tcp"
                                                       : "udp"},
                        {"node", node_text(found->address)},
+                       {"local_node", node_text(found->local)},
                        {"model", found->model},
                        {"needs_dest", needs_dest}};
     std::string text =
@@ -165,6 +207,14 @@ int run_probe(const GlobalOptions& g, Output& out) {
     if (needs_dest)
         text += fmt::format("fins addresses node {} here by default: add --dest {}\n",
                             derived->node, node_text(found->address));
+    // What a network write protection list must name to let this client write (W342
+    // 5-1-2): over UDP the local address's node (254 on loopback), over TCP the node the
+    // handshake allocated for this connection (README "Which source node fins uses").
+    if (g.serial.empty())
+        text += fmt::format("fins sends as node {}{}\n", node_text(found->local),
+                            !g.source.empty() ? " (--source)"
+                            : g.tcp           ? " (allocated by the FINS/TCP handshake)"
+                                              : " (from the local address; 254 on loopback)");
     out.print(doc, text);
     return exit_ok;
 }

@@ -104,14 +104,18 @@ int run_cpu_data(const GlobalOptions& g, Output& out, const std::string& section
         const char* card = a.memory_card_type == 0x00   ? "none"
                            : a.memory_card_type == 0x04 ? "flash"
                                                         : "other";
+        // W342 5-3-15: a CPU Unit without EM answers largest bank 0 and no non-file
+        // banks, which is not "bank 0": the text says there is none.
+        const bool has_em = r->largest_em_bank != 0 || a.em_non_file_banks != 0;
         text += row("model", r->model) + row("system version", r->system_version) +
                 row("DIP switch", fmt::format("0x{:02X}", r->dip_switch)) +
-                row("largest EM bank", std::to_string(r->largest_em_bank)) +
+                (has_em ? row("largest EM bank", fmt::format("{:X} hex", r->largest_em_bank))
+                        : row("EM", "none")) +
                 row("program area", fmt::format("{} K words", a.program_kwords)) +
                 row("I/O memory", fmt::format("{} K bytes", a.iom_kbytes)) +
                 row("DM words", std::to_string(a.dm_words)) +
                 row("timers/counters", fmt::format("{} x 1024", a.timer_counter_kwords)) +
-                row("EM (non-file)", fmt::format("{} banks", a.em_non_file_banks)) +
+                (has_em ? row("EM (non-file)", plural(a.em_non_file_banks, "bank")) : "") +
                 row("memory card", fmt::format("{} (type 0x{:02X}), {} K bytes", card,
                                                a.memory_card_type, a.memory_card_kbytes));
     }
@@ -122,13 +126,16 @@ int run_cpu_data(const GlobalOptions& g, Output& out, const std::string& section
             const auto word = r->bus_units[n];
             if ((word & cpu_bus_unit_present) == 0) continue;
             const auto id = static_cast<unsigned>(word & ~cpu_bus_unit_present);
-            units.push_back({{"unit", n}, {"id", fmt::format("0x{:04X}", id)}});
-            listed += fmt::format(" {}:0x{:04X}", n, id);
+            // ID 0: the unit is there but publishes no model ID; print only the unit.
+            nlohmann::json unit{{"unit", n}};
+            if (id != 0) unit["id"] = fmt::format("0x{:04X}", id);
+            units.push_back(unit);
+            listed += id != 0 ? fmt::format(", {} (ID 0x{:04X})", n, id) : fmt::format(", {}", n);
         }
         doc["cpu_bus_units"] = units;
         doc["sysmac_bus_masters"] = r->sysmac_bus_masters;
         doc["racks"] = r->racks;
-        text += row("CPU Bus Units", listed.empty() ? "none" : listed.substr(1)) +
+        text += row("CPU Bus Units", listed.empty() ? "none" : listed.substr(2)) +
                 row("SYSMAC BUS masters", std::to_string(r->sysmac_bus_masters)) +
                 row("racks", std::to_string(r->racks));
     }
@@ -270,12 +277,14 @@ int run_clock(const GlobalOptions& g, Output& out, const ControlArgs& a) {
                       setting->minute,
                       setting->second.value_or(0),
                       0};
-    nlohmann::json doc{{"set", clock_text(t)}};
+    // The keys of `fins clock`: what the clock now reads is "time" either way.
+    nlohmann::json doc{{"time", clock_text(t)}};
     std::string text = fmt::format("clock set to {}", clock_text(t));
     if (setting->day_of_week) {
+        const char* day = *setting->day_of_week < 7 ? day_names[*setting->day_of_week] : "?";
         doc["day_of_week"] = *setting->day_of_week;
-        text +=
-            fmt::format(" {}", *setting->day_of_week < 7 ? day_names[*setting->day_of_week] : "?");
+        doc["day"] = day;
+        text += fmt::format(" {}", day);
     }
     out.print(doc, text + "\n");
     return exit_ok;

@@ -64,10 +64,6 @@ std::string hex4(std::uint16_t v) {
     return fmt::format("{:04X}", v);
 }
 
-std::string node_text(const NodeAddress& a) {
-    return fmt::format("{}.{}.{}", a.network, a.node, a.unit);
-}
-
 std::string time_text(const LogTime& t) {
     return fmt::format("{}-{:02}-{:02} {:02}:{:02}:{:02}", full_year(t.year), t.month, t.day,
                        t.hour, t.minute, t.second);
@@ -350,8 +346,7 @@ int run_force(const GlobalOptions& g, Output& out, const DiagnosticArgs& a) {
     Json done = Json::array();
     for (const auto& text : a.addresses) {
         auto address = parse_address(text);
-        if (!address)
-            return out.usage(fmt::format("bad address '{}': {}", text, address.error().message()));
+        if (!address) return out.usage(bad_address(text, address.error()));
         auto wire = to_memory_address(*address, Access::bit);
         const auto code = wire ? wire->area_code : 0;
         if (!wire || (code != 0x30 && code != 0x31 && code != 0x32 && code != 0x09))

@@ -7,9 +7,10 @@
 //   files mv PLCFILE NEWNAME            22 08 (files and directories)
 //   files mkdir DIR / rmdir DIR         22 15
 //   files format card|em --yes          22 04
-//   files save WHAT PLCFILE [COUNT]     22 0A/0B/0C area -> file
+//   files save WHAT PLCFILE [COUNT]     22 0A/0B/0C area -> file (or WHAT COUNT PLCFILE)
 //   files load PLCFILE WHAT [COUNT]     file -> area
-//   files compare PLCFILE WHAT [COUNT]  compare (exit 4 with 2007 on a difference)
+//   files compare PLCFILE WHAT [COUNT]  compare (exit 4 with 2007 on a difference, saying
+//                                       where: verbs_files_transfer.cpp)
 //   files cassette save|load|verify|init|type   22 20 (verbs_cassette.cpp)
 // PLC paths: [card:|em:][/]DIR/.../NAME.EXT ("\" works too); card is the default.
 // WHAT: a word address (D100, E3_0, W10 ...), a parameter area (plc-setup, io-table,
@@ -29,6 +30,7 @@
 #include <fmt/core.h>
 
 #include "cli/fins/commands.hpp"
+#include "cli/fins/verbs_files_transfer.hpp"
 #include "fins/commands/file_memory.hpp"
 #include "fins/commands/parameter_area.hpp"
 
@@ -135,6 +137,8 @@ int run_ls(const GlobalOptions& g, const FileArgs& a, Output& out) {
         fmt::format("{} {}  {} of {} bytes free\n", r->disk.volume_label.text(),
                     date_text(r->disk.date), r->disk.free_capacity, r->disk.total_capacity);
     for (const auto& f : r->files) {
+        // The root's volume label entry (5-3-32, attribute 08) is the header line above.
+        if ((f.attribute & attribute_volume) != 0) continue;
         const bool dir = (f.attribute & attribute_directory) != 0;
         files.push_back({{"name", f.name.text()},
                          {"size", f.size},
@@ -270,8 +274,10 @@ int run_format(const GlobalOptions& g, const FileArgs& a, Output& out) {
 }
 
 // save / load / compare: 22 0A (address), 22 0B (parameter area), 22 0C (program).
-int transfer(const GlobalOptions& g, const FileArgs& a, Output& out, FileTransferMode mode) {
-    const auto p = parse_plc_path(a.paths[0]);
+int transfer(const GlobalOptions& g, const FileArgs& args, Output& out, FileTransferMode mode) {
+    const auto a = transfer_arguments(mode, args.paths);
+    if (!a.problem.empty()) return out.usage(a.problem);
+    const auto p = parse_plc_path(a.plc);
     const auto name = name_of(p->name);
     if (!name) return bad_name(out, p->name);
     const auto code = static_cast<std::uint16_t>(mode);
@@ -284,18 +290,28 @@ int transfer(const GlobalOptions& g, const FileArgs& a, Output& out, FileTransfe
         out.print({{"count", n}, {"unit", unit}}, fmt::format("{}: {} {}\n", verb, n, unit));
         return exit_ok;
     };
+    // A compare that found a difference (2007) says where, both values and how many.
+    auto failed = [&](std::error_code ec, const CompareTarget& target) {
+        if (mode != FileTransferMode::compare || ec != make_error_code(EndCode::data_mismatch))
+            return out.failure(ec, verb);
+        const auto where = describe_file_difference(*client, p->disk, p->directory, *name, target);
+        return out.failure(ec,
+                           where.empty() ? std::string(verb) : fmt::format("{}: {}", verb, where));
+    };
     if (a.what == "program") {
         if (!(client = open_client(g, out, rc))) return rc;
         const auto r = client->send(
             ProgramAreaFileTransfer{code, 0xFFFF, 0, 0xFFFFFFFF, p->disk, *name, p->directory});
-        return r ? done(r->length, "bytes") : out.failure(r.error(), verb);
+        return r ? done(r->length, "bytes")
+                 : failed(r.error(), {CompareTarget::Kind::program, {}, 0, nullptr});
     }
     if (const auto* area = find_parameter_area(std::string_view(a.what));
         area != nullptr && area->code != parameter_area_all) {
         if (!(client = open_client(g, out, rc))) return rc;
         const auto r = client->send(ParameterAreaFileTransfer{
             code, area->code, 0, whole_parameter_area, p->disk, *name, p->directory});
-        return r ? done(r->count, "words") : out.failure(r.error(), verb);
+        return r ? done(r->count, "words")
+                 : failed(r.error(), {CompareTarget::Kind::parameters, {}, 0, area});
     }
     const auto address = parse_address(a.what);
     const Result<MemoryAddress> mem = address ? to_memory_address(*address, Access::word)
@@ -307,7 +323,8 @@ int transfer(const GlobalOptions& g, const FileArgs& a, Output& out, FileTransfe
     if (!(client = open_client(g, out, rc))) return rc;
     const auto r = client->send(MemoryAreaFileTransfer{
         code, *mem, static_cast<std::uint16_t>(a.count), p->disk, *name, p->directory});
-    return r ? done(r->count, "words") : out.failure(r.error(), verb);
+    return r ? done(r->count, "words")
+             : failed(r.error(), {CompareTarget::Kind::words, *address, a.count, nullptr});
 }
 
 int run_save(const GlobalOptions& g, const FileArgs& a, Output& out) {
@@ -377,7 +394,7 @@ void add_file_verbs(CLI::App& app, const GlobalOptions& g, int& exit_code) {
     c->add_option("device", a->plc, "card or em")->required();
     c->add_flag("--yes", a->yes, "Confirm erasing every file");
 
-    const char* what_help =
+    const std::string what_help =
         "Word address (D100), parameter area (plc-setup, io-table, "
         "routing, cpu-bus) or program";
     using Run = int (*)(const GlobalOptions&, const FileArgs&, Output&);
@@ -391,10 +408,11 @@ void add_file_verbs(CLI::App& app, const GlobalOptions& g, int& exit_code) {
     for (const auto& t : transfers) {
         a = std::make_shared<FileArgs>();
         c = verb(*files, t.name, t.help, g, exit_code, a, t.run);
-        if (t.run == &run_save) c->add_option("what", a->what, what_help)->required();
-        c->add_option("plcfile", a->plc, path_help)->required();
-        if (t.run != &run_save) c->add_option("what", a->what, what_help)->required();
-        c->add_option("count", a->count, "Words (word addresses only)");
+        // One list, read by transfer_arguments(): its messages say what goes where.
+        c->add_option("args", a->paths,
+                      t.run == &run_save ? "WHAT PLCFILE [COUNT] or WHAT COUNT PLCFILE"
+                                         : "PLCFILE WHAT [COUNT]")
+            ->description(std::string(what_help) + "; COUNT: words (word addresses only)");
     }
     add_cassette_verbs(*files, g, exit_code);
 }

@@ -223,7 +223,16 @@ int run_loop_read(const GlobalOptions& g, const LoopArgs& a, Output& out) {
     auto client = open_client(board, out, rc);
     if (!client) return rc;
     auto r = client->send(command);
-    if (!r) return out.failure(r.error(), fmt::format("loop-read block {}", *block));
+    if (!r) {
+        // The Loop Control Board's own meanings of the codes (CS LCB manual 6-3, 02 40).
+        if (r.error() == make_error_code(EndCode::area_classification_missing))
+            out.explain(EndCode::area_classification_missing,
+                        fmt::format("block {:03} is not a registered function block", *block));
+        else if (r.error() == make_error_code(EndCode::address_range_error))
+            out.explain(EndCode::address_range_error,
+                        fmt::format("none of the ITEMs exists in block {:03}", *block));
+        return out.failure(r.error(), fmt::format("loop-read block {}", *block));
+    }
     nlohmann::json items = nlohmann::json::array();
     std::string text = fmt::format("block {:03}: {} of {} ITEMs read\n", *block, r->items.size(),
                                    command.items.size());

@@ -353,10 +353,12 @@ class Loader {
     }
 
   public:
-    // A [[plc]]'s own [protection] or [inject] table.
+    // A [[plc]]'s own [protection], [inject], [storage] or [files] table.
     Expected<void> cpu_section(const toml::key& key, const toml::node& node, const std::string& p) {
         if (key.str() == "protection") return section(key, node, p, &Loader::protection);
         if (key.str() == "inject") return section(key, node, p, &Loader::inject);
+        if (key.str() == "storage") return section(key, node, p, &Loader::storage);
+        if (key.str() == "files") return section(key, node, p, &Loader::files);
         return fail(key, p, "unknown key");
     }
 

@@ -48,7 +48,9 @@ struct CpuUnitOptions {
     plc::Injections inject;             // [inject]
 };
 
-struct Settings : CpuUnitOptions {
+// [files] (card_kbytes, em_file_bank, cassette): server::FileMemoryOptions, the same
+// table as each [[plc]]'s [plc.files].
+struct Settings : CpuUnitOptions, server::FileMemoryOptions {
     std::string profile = "cj2h";
     plc::OperatingMode mode = plc::OperatingMode::run;
     std::optional<std::filesystem::path> data_dir;
@@ -73,13 +75,6 @@ struct Settings : CpuUnitOptions {
     // [storage]
     plc::Durability durability = plc::Durability::process;
     bool reset_state = false;  // --reset-state only: a refused state file is moved aside
-    // [files]: memory card inserted at start (capacity in KB; 0 = no card) and the first
-    // EM bank of EM file memory. Unset: the profile's.
-    std::optional<std::uint32_t> card_kbytes;
-    std::optional<std::uint8_t> em_file_bank;
-    // [files] cassette: a Memory Cassette mounted at start (22 20; only profiles that
-    // have one, the CP1H). Unset: the profile's.
-    std::optional<bool> cassette;
 
     std::vector<MemoryInit> memory;        // [memory]
     std::vector<SerialPortConfig> serial;  // [serial], --serial (config_serial.hpp)
@@ -88,6 +83,11 @@ struct Settings : CpuUnitOptions {
     // (the server layer knows no config entries; serve_plant applies them).
     struct PlantCpuSettings : CpuUnitOptions {  // [plc.protection], [plc.inject]
         std::vector<MemoryInit> memory;         // [plc.memory]
+        std::vector<SerialPortConfig> serial;   // [plc.serial]
+        std::vector<ScheduleEntry> schedule;    // [[plc.schedule]]
+        // Per [[plc.ethernet]]: true when it sets `port`; the others take `port` above
+        // (--port, [network] port).
+        std::vector<bool> port_given;
     };
     std::vector<PlantCpuSettings> plant_cpu;
 
@@ -130,8 +130,13 @@ Expected<void> validate(const Settings& settings);
 // Protections and injections onto the model at start (after the mode is set).
 void apply_cpu_options(const CpuUnitOptions& options, plc::Plc& plc);
 
-// One [[plc]] table's [protection] or [inject] (`key`), parsed exactly as the single
-// node's onto `cpu`; errors name `path` (e.g. plc[1].protection.network_write).
+// [files] `options` against `profile` (a known one): a cassette only where the model has a
+// slot, an EM file bank the model has. Errors name `path` ("files", "plc[1].files").
+Expected<void> check_file_memory(const server::FileMemoryOptions& options,
+                                 const std::string& profile, std::string_view path);
+
+// One [[plc]] table's [protection], [inject], [storage] or [files] (`key`), parsed exactly as the
+// single node's onto `cpu`; errors name `path` (e.g. plc[1].protection.network_write).
 Expected<void> load_cpu_section(const toml::key& key, const toml::node& node,
                                 std::string_view source, const std::string& path, Settings& cpu);
 

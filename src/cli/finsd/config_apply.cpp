@@ -170,13 +170,19 @@ Expected<void> validate(const Settings& s) {
     if (const auto e = plc::validate(s.inject); !e.empty()) return error("inject." + e);
     if (s.durability == plc::Durability::power && !s.data_dir)
         return error("storage.durability: \"power\" needs data_dir (without one nothing is kept)");
-    if (s.cassette.value_or(false) && !plc::find_profile(s.profile)->memory_cassette)
-        return error(fmt::format(
-            "files.cassette: the {} has no Memory Cassette slot (22 20 is a CP1H command)",
-            s.profile));
-    if (s.em_file_bank && *s.em_file_bank >= plc::find_profile(s.profile)->em_banks)
-        return error(fmt::format("files.em_file_bank: the {} has no EM bank {}", s.profile,
-                                 *s.em_file_bank));
+    return check_file_memory(s, s.profile, "files");
+}
+
+Expected<void> check_file_memory(const server::FileMemoryOptions& o, const std::string& profile,
+                                 std::string_view path) {
+    const auto* model = plc::find_profile(profile);
+    if (o.cassette.value_or(false) && !model->memory_cassette)
+        return error(
+            fmt::format("{}.cassette: the {} has no Memory Cassette slot (22 20 is a CP1H command)",
+                        path, profile));
+    if (o.em_file_bank && *o.em_file_bank >= model->em_banks)
+        return error(fmt::format("{}.em_file_bank: the {} has no EM bank {}", path, profile,
+                                 *o.em_file_bank));
     return {};
 }
 

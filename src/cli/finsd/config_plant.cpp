@@ -1,9 +1,16 @@
 // The [[plc]] loader (config_plant.hpp).
 #include "cli/finsd/config_plant.hpp"
 
+#include <cctype>
+#include <chrono>
+#include <optional>
+
 #include <fmt/format.h>
 
+#include "cli/finsd/config_schedule.hpp"
+#include "cli/finsd/config_serial.hpp"
 #include "cli/finsd/config_values.hpp"
+#include "plc/profile.hpp"
 #include "server/routing/node_address_table.hpp"
 
 namespace fins::cli::finsd {
@@ -75,6 +82,7 @@ class PlantLoader {
 
     Expected<void> load_cpu(const toml::table& t, const std::string& path, PlantCpuConfig& cpu,
                             Settings::PlantCpuSettings& extra) {
+        std::optional<toml::source_region> storage_at, files_at;
         for (auto&& [k, v] : t) {
             const std::string key(k.str());
             const std::string p = path + "." + key;
@@ -116,6 +124,7 @@ class PlantLoader {
                     PlantPortConfig port;
                     if (auto rr = load_port(e, ep, port); !rr) return rr;
                     cpu.ports.push_back(std::move(port));
+                    extra.port_given.push_back(e.contains("port"));
                     return Expected<void>{};
                 });
             } else if (key == "memory") {
@@ -139,6 +148,31 @@ class PlantLoader {
                     extra.network_write_protection.nodes.empty())
                     return fail(v.source(), p,
                                 "nodes: empty, so network_write = \"listed\" protects nothing");
+            } else if (key == "storage") {
+                Settings scratch;
+                if (auto rr = load_cpu_section(k, v, source_, p, scratch); !rr) return rr;
+                cpu.durability = scratch.durability;
+                storage_at = v.source();
+            } else if (key == "files") {
+                // As the top-level [files]: this CPU Unit's card, EM file bank, cassette.
+                Settings scratch;
+                if (auto rr = load_cpu_section(k, v, source_, p, scratch); !rr) return rr;
+                cpu.files = static_cast<const server::FileMemoryOptions&>(scratch);
+                files_at = v.source();
+            } else if (key == "serial") {
+                // As the top-level [serial]: Host Link slave and Serial Gateway ports.
+                if (auto rr = load_serial_table(v, source_, extra.serial); !rr)
+                    return tl::unexpected(in_plant(rr.error(), path));
+            } else if (key == "remote" || key == "schedule") {
+                // As the top-level [[remote]] / [[schedule]], for this CPU Unit.
+                Settings scratch;
+                auto rr = key == "remote" ? load_remotes(k, v, source_, scratch)
+                                          : load_schedule(k, v, source_, scratch);
+                if (!rr) return tl::unexpected(in_plant(rr.error(), path));
+                for (auto& remote : scratch.remotes)
+                    cpu.remotes.push_back(std::move(remote));
+                for (auto& entry : scratch.schedule)
+                    extra.schedule.push_back(std::move(entry));
             } else if (key == "relay") {
                 r = tables(v, p, [&](const toml::table& e, const std::string& ep) {
                     return load_relay(e, ep, cpu);
@@ -149,6 +183,40 @@ class PlantLoader {
             if (!r) return r;
         }
         if (cpu.name.empty()) return fail(t.source(), path, "name: missing");
+        if (cpu.durability == plc::Durability::power && !cpu.data_dir)
+            return fail(*storage_at, path + ".storage.durability",
+                        "\"power\" needs data_dir (without one nothing is kept)");
+        // The model's devices, as validate() checks [files] (an unknown profile is
+        // validate_plant's to name).
+        if (files_at && plc::find_profile(cpu.profile) != nullptr)
+            if (auto r = check_file_memory(cpu.files, cpu.profile, path + ".files"); !r)
+                return tl::unexpected(fmt::format("{}:{}:{}: {}", source_, files_at->begin.line,
+                                                  files_at->begin.column, r.error()));
+        return check_serial(path, cpu, extra);
+    }
+
+    // The single node's serial checks, and what a plant adds: a gateway port's network
+    // is not one of this CPU Unit's Ethernet networks, and a Serial Communications Unit
+    // does not take the unit number of one of its Ethernet units (a real PLC refuses
+    // duplicated unit numbers).
+    static Expected<void> check_serial(const std::string& path, const PlantCpuConfig& cpu,
+                                       const Settings::PlantCpuSettings& extra) {
+        if (auto r = validate_serial(extra.serial); !r)
+            return tl::unexpected(in_plant(r.error(), path));
+        for (const auto& s : extra.serial) {
+            for (const auto& unit : cpu.ports) {
+                if (s.network && *s.network == unit.network)
+                    return tl::unexpected(
+                        fmt::format("{}: {}.serial.{}: network={} is the network of "
+                                    "[[plc.ethernet]] unit {}",
+                                    s.where, path, s.name, *s.network, unit.unit_number));
+                if (s.kind == SerialPortConfig::Kind::scu && s.unit_number == unit.unit_number)
+                    return tl::unexpected(
+                        fmt::format("{}: {}.serial.{}: unit number {} is the "
+                                    "[[plc.ethernet]] unit's",
+                                    s.where, path, s.name, s.unit_number));
+            }
+        }
         return {};
     }
 
@@ -266,6 +334,57 @@ class PlantLoader {
 };
 
 }  // namespace
+
+server::PlantPortConfig single_unit(const Settings& s) {
+    server::PlantPortConfig unit;
+    unit.bind = s.bind;
+    unit.port = s.port;
+    unit.udp = s.udp;
+    unit.tcp = s.tcp;
+    unit.node = s.node;
+    unit.network = s.network;
+    unit.max_connections = s.max_connections;
+    return unit;
+}
+
+server::TcpLimits tcp_limits(const Settings& s) {
+    server::TcpLimits limits;
+    limits.handshake_timeout = std::chrono::seconds(s.tcp_handshake_timeout);
+    limits.frame_timeout = std::chrono::seconds(s.tcp_frame_timeout);
+    limits.idle_timeout = std::chrono::seconds(s.tcp_idle_timeout);
+    limits.keepalive = std::chrono::seconds(s.tcp_keepalive);
+    limits.max_pending = s.tcp_max_pending;
+    return limits;
+}
+
+Error in_plant(const Error& error, std::string_view path) {
+    // After the position "FILE:L:C: " (FILE may hold colons; L and C are digits).
+    std::size_t at = 0;
+    for (std::size_t i = error.find(": "); i != std::string::npos; i = error.find(": ", i + 1)) {
+        std::size_t j = i, colons = 0;
+        while (j > 0 && colons < 2) {
+            std::size_t digits = 0;
+            while (j > 0 && std::isdigit(static_cast<unsigned char>(error[j - 1])) != 0) {
+                --j;
+                ++digits;
+            }
+            if (digits == 0 || j == 0 || error[j - 1] != ':') break;
+            --j;
+            ++colons;
+        }
+        if (colons == 2) {
+            at = i + 2;
+            break;
+        }
+    }
+    // A key path ("serial.cpu", "remote[0].node", "serial:") continues the plant's path;
+    // anything else ("serial port cpu") follows it.
+    const auto word_end = error.find_first_not_of(
+        "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_", at);
+    const bool key = word_end != std::string::npos && word_end > at &&
+                     (error[word_end] == '.' || error[word_end] == '[' || error[word_end] == ':');
+    return error.substr(0, at) + std::string(path) + (key ? "." : ": ") + error.substr(at);
+}
 
 Expected<void> load_plant(const toml::key& key, const toml::node& node, std::string_view source,
                           Settings& settings) {

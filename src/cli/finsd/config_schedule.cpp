@@ -95,10 +95,22 @@ tl::expected<void, std::string> load_remotes(const toml::key& key, const toml::n
         const auto& t = *(**list)[i].as_table();
         const std::string p = fmt::format("remote[{}]", i);
         server::RemoteNode r;
-        bool has_node = false, has_address = false;
+        bool has_node = false, has_address = false, has_client_node = false;
         for (auto&& [k, v] : t) {
             const std::string path = p + "." + std::string(k.str());
-            if (k == "node" || k == "network") {
+            if (k == "transport") {
+                const auto* s = v.as_string();
+                if (s == nullptr || (s->get() != "udp" && s->get() != "tcp"))
+                    return fail(source, v, path, "must be \"udp\" or \"tcp\"");
+                r.tcp = s->get() == "tcp";
+            } else if (k == "client_node") {
+                const auto* n = v.as_integer();
+                if (n == nullptr || n->get() < 0 || n->get() > 254)
+                    return fail(source, v, path,
+                                "must be an integer 0-254 (0: the server allocates one)");
+                r.client_node = static_cast<std::uint8_t>(n->get());
+                has_client_node = true;
+            } else if (k == "node" || k == "network") {
                 const auto* n = v.as_integer();
                 const std::int64_t hi = k == "node" ? 254 : 127;
                 const std::int64_t lo = k == "node" ? 1 : 0;
@@ -123,6 +135,15 @@ tl::expected<void, std::string> load_remotes(const toml::key& key, const toml::n
         }
         if (!has_node || !has_address)
             return Fail(fmt::format("{}: {}: needs node and address", at(source, t.source()), p));
+        if (has_client_node && !r.tcp)
+            return Fail(fmt::format("{}: {}: client_node needs transport = \"tcp\"",
+                                    at(source, t.source()), p));
+        const auto same_connection = [&](const server::RemoteNode& o) {
+            return o.tcp && o.network == r.network && o.node == r.node;
+        };
+        if (r.tcp && std::any_of(settings.remotes.begin(), settings.remotes.end(), same_connection))
+            return Fail(fmt::format("{}: {}: node {}.{} already has a FINS/TCP connection",
+                                    at(source, t.source()), p, r.network, r.node));
         settings.remotes.push_back(std::move(r));
     }
     return {};
@@ -230,6 +251,15 @@ tl::expected<void, std::string> load_schedule(const toml::key& key, const toml::
 
 tl::expected<void, std::string> check_schedule(const Settings& settings,
                                                const plc::IoMemory& memory) {
+    // W596 1-4: the connection limit counts server and client connections.
+    const auto clients = static_cast<std::size_t>(std::count_if(
+        settings.remotes.begin(), settings.remotes.end(), [](const auto& r) { return r.tcp; }));
+    if (clients > settings.max_connections)
+        return Fail(
+            fmt::format("{} [[remote]] entries with transport = \"tcp\", but "
+                        "max_connections is {} (W596 1-4: server and client "
+                        "connections together)",
+                        clients, settings.max_connections));
     for (std::size_t i = 0; i < settings.schedule.size(); ++i) {
         const auto& e = settings.schedule[i];
         if (const auto why = server::check_instruction(e.scheduled.request, memory))

@@ -4,6 +4,9 @@
 //   network = 0                this node's IP with the last octet = node, same port)
 //   node = 5
 //   address = "127.0.1.5:9600" (IPv6 "[::1]:9600"; no port: 9600)
+//   transport = "udp"          "tcp": finsd opens a FINS/TCP client connection to it
+//                              (tcp_client.hpp; one of max_connections)
+//   client_node = 0            tcp: our node on it, 0 = allocated by the server (default)
 //
 //   [[schedule]]               an instruction run every period
 //   every = "1s"               "250ms", "2s", "1min" (10 ms at least)
@@ -46,7 +49,8 @@ tl::expected<void, std::string> load_remotes(const toml::key& key, const toml::n
                                              std::string_view source, Settings& settings);
 tl::expected<void, std::string> load_schedule(const toml::key& key, const toml::node& node,
                                               std::string_view source, Settings& settings);
-// Each entry against the model (local words exist, ranges): the first problem, named.
+// Each entry against the model (local words exist, ranges) and the FINS/TCP client
+// connections against max_connections: the first problem, named.
 tl::expected<void, std::string> check_schedule(const Settings& settings,
                                                const plc::IoMemory& memory);
 

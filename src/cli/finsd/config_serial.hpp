@@ -8,7 +8,7 @@
 //   KEYS    baud, parity, data, stop (transport/serial_options.hpp; Host Link defaults
 //           9600 7E2), unit (Host Link unit number 0-31, default 0), mode (cpu:
 //           "hostlink"; scu/board: "gateway" by default, or "hostlink"), timeout
-//           (seconds, 0.1-25.5, default 5: the Serial Gateway response timeout, W336).
+//           (seconds, 0.1-25.5, default 1: the Serial Gateway response timeout, W336).
 //
 // In the file, each port is a string with the same syntax after "NAME=", or a table:
 //   [serial]
@@ -33,6 +33,16 @@
 
 namespace fins::cli::finsd {
 
+// The Serial Gateway response timeout (W336 6-6-2; W342 5-3-46 .. 5-3-48 name none). A
+// real Serial Communications Unit waits 5 s by default, but a FINS client gives up first:
+// `fins` and the NX SendCmd instruction wait 2 s (W596 p. 3-16: timeout 0 = 2.0 s), so a
+// missing slave would look like "no answer" instead of the port's 0205. 1 s answers
+// 0205 within their default with room for the round trip, and leaves a Modbus slave
+// (answering in tens of milliseconds) ample time.
+inline constexpr double default_serial_timeout = 1.0;
+inline constexpr double min_serial_timeout = 0.1;
+inline constexpr double max_serial_timeout = 25.5;
+
 struct SerialPortConfig {
     enum class Kind { cpu, scu, board };
     std::string name;  // as written: "cpu", "scu0.1", "board.2"
@@ -42,16 +52,12 @@ struct SerialPortConfig {
     SerialSettings line;
     unsigned host_link_unit = 0;  // unit=
     std::string mode;             // "hostlink" or "gateway"
-    double timeout_seconds = 5.0;
+    double timeout_seconds = default_serial_timeout;
     // network=: the FINS network of the Host Link PLCs behind a gateway port (W342 5-1-1,
     // a routing table naming the serial path); none: the port's unit address.
     std::optional<unsigned> network;
     std::string where;  // "--serial" or "file:line:column", for messages
 };
-
-inline constexpr double default_serial_timeout = 5.0;  // W336-6 p. 257
-inline constexpr double min_serial_timeout = 0.1;
-inline constexpr double max_serial_timeout = 25.5;
 
 // "cpu", "scuN.P", "board.P" into kind, unit_number, port (and the default mode).
 tl::expected<SerialPortConfig, std::string> parse_serial_name(std::string_view name);

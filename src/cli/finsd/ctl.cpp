@@ -1,5 +1,7 @@
-// `finsd ctl --socket PATH VERB ...` (options before or after the verb): sends one request to a
-// running finsd's control channel (server/control/control.hpp) and prints the answer line.
+// `finsd ctl [--socket PATH] [--plc NAME|NET.NODE] VERB ...` (options before or after the
+// verb): sends one request to a running finsd's control channel (server/control/control.hpp)
+// and prints the answer line. Without --socket: $FINSD_SOCKET, else the default path finsd
+// itself uses (control_setup.hpp). --plc picks a CPU Unit of a plant (default the first).
 //
 //   status                          the JSON snapshot
 //   battery-error on|off            low battery (error 00F7) / battery replaced
@@ -21,6 +23,7 @@
 // Exit codes: 0 the server answered "ok"; 2 usage error or the server refused the
 // request (its message on stderr); 3 cannot connect, or no answer within 5 s.
 #include "cli/finsd/ctl.hpp"
+#include "cli/finsd/control_setup.hpp"
 #include "cli/finsd/ctl_instructions.hpp"
 
 #include <poll.h>
@@ -112,7 +115,13 @@ int run_ctl(int argc, char** argv) {
     // Options may follow the verb, as with `fins`: `finsd ctl status --socket PATH`.
     app.fallthrough(true);
     std::string socket;
-    app.add_option("--socket", socket, "The control socket (finsd --control PATH)")->required();
+    app.add_option("--socket", socket,
+                   "The control socket (finsd --control PATH; default $FINSD_SOCKET, "
+                   "$XDG_RUNTIME_DIR/finsd.sock or /run/finsd/finsd.sock)");
+    std::string plc;
+    app.add_option("--plc", plc,
+                   "The CPU Unit of a plant: its [[plc]] name or FINS address NET.NODE "
+                   "(default the first)");
 
     Json request;
     std::string on_off;
@@ -210,6 +219,8 @@ int run_ctl(int argc, char** argv) {
         return exit_usage;
     }
     const bool raw_line = verbs.send->parsed() && !verbs.raw.empty();
+    if (!plc.empty() && !raw_line) request["plc"] = plc;
+    if (socket.empty()) socket = default_control_socket().string();
     const std::string line = raw_line ? verbs.raw : request.dump();
     if (line.find('\n') != std::string::npos) {
         std::fprintf(stderr, "finsd ctl: a request is one line\n");

@@ -3,6 +3,8 @@
 
 #include <cstdio>
 #include <memory>
+#include <stdexcept>
+#include <string>
 
 namespace fins::cli {
 
@@ -19,15 +21,30 @@ constexpr int exit_not_sent = 6;
 struct Common {
     std::string dest, local, remote, command;
     unsigned count = 1;
-    unsigned timeout = 0;
+    double timeout_seconds = 0;  // as `fins --timeout`: seconds, decimals allowed
     unsigned retries = 0;
     bool no_response = false;
 };
 
 void add_common(CLI::App* c, Common& o, InstructionVerbs& verbs) {
     c->add_option("--dest", o.dest, "Destination NET.NODE.UNIT, e.g. 0.5.0 (network 0 = local)");
-    c->add_option("--timeout", o.timeout, "Response timeout in 0.1 s (0 = 2 s; default 0)")
-        ->check(CLI::Range(0, 65535));
+    // Seconds, as `fins --timeout` (issue 18 newcomer 12); the instruction's field counts
+    // 0.1 s (W596 3-3: 0000-FFFF), so 0.1 to 6553.5 s, and 0 = the default 2 s.
+    c->add_option("--timeout", o.timeout_seconds,
+                  "Response timeout in seconds, 0.1-6553.5 (decimals allowed; 0 = 2 s)")
+        ->check(CLI::Range(0.0, 6553.5))
+        ->check(
+            [](const std::string& text) {
+                double v = 0;
+                try {
+                    v = std::stod(text);
+                } catch (const std::exception&) {
+                    return std::string("not a number of seconds");
+                }
+                return v == 0 || v >= 0.05 ? std::string{}
+                                           : std::string("a timeout is at least 0.1 s (0 = 2 s)");
+            },
+            "0 or 0.1-6553.5");
     c->add_option("--retries", o.retries, "Retries after a timeout, 0-15 (default 0)")
         ->check(CLI::Range(0, 15));
     c->add_flag("--no-response", o.no_response, "Send with the ICF no-response bit (not recv)");
@@ -35,11 +52,12 @@ void add_common(CLI::App* c, Common& o, InstructionVerbs& verbs) {
 }
 
 Json common_request(const char* cmd, const Common& o, InstructionVerbs& verbs) {
-    const auto per_try = std::chrono::milliseconds(100U * (o.timeout == 0 ? 20U : o.timeout));
+    const auto tenths = static_cast<unsigned>(o.timeout_seconds * 10.0 + 0.5);
+    const auto per_try = std::chrono::milliseconds(100U * (tenths == 0 ? 20U : tenths));
     verbs.wait = per_try * (o.retries + 1) + std::chrono::seconds(5);
     return Json{{"cmd", cmd},
                 {"dest", o.dest},
-                {"timeout", o.timeout},
+                {"timeout", tenths},  // the control protocol keeps W596's 0.1 s
                 {"retries", o.retries},
                 {"no_response", o.no_response}};
 }

@@ -4,7 +4,8 @@
 //   send    --dest N.N.U --local D100 --remote D200 [--count 1]   local words -> remote
 //   recv    --dest N.N.U --remote D200 --local D300 [--count 1]   remote words -> local
 //   sendcmd --dest N.N.U --command "0501"                         any command, its answer
-//   common: [--timeout T (0.1 s, 0 = 2 s)] [--retries R (0-15)] [--no-response] [--json]
+//   common: [--timeout SECONDS (as fins: 0.5 = 0.5 s; 0 = 2 s)] [--retries R (0-15)]
+//           [--no-response] [--json]
 //   instructions                                                  ports in use, counters
 // `send JSON` (a single argument starting with '{') still sends one raw request line.
 //

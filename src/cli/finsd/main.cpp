@@ -10,11 +10,13 @@
 //
 // Exit codes: 0 clean shutdown (SIGINT/SIGTERM: the state file is closed cleanly, with
 // checksums), 2 usage or configuration error, 3 start-up failure (cannot bind, state
-// file refused, in use or without room on disk, control socket).
+// file refused, in use or without room on disk, control socket), 4 the state file shrank
+// while finsd ran (truncated from outside: plc/storage_guard.hpp).
 #include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <memory>
 #include <optional>
@@ -27,9 +29,11 @@
 #include <CLI/CLI.hpp>
 #include <asio/io_context.hpp>
 #include <asio/signal_set.hpp>
+#include <asio/steady_timer.hpp>
 
 #include "cli/finsd/config.hpp"
 #include "cli/finsd/config_plant.hpp"
+#include "cli/finsd/control_setup.hpp"
 #include "cli/finsd/ctl.hpp"
 #include "cli/finsd/serial_gateway_setup.hpp"
 #include "cli/finsd/serial_ports.hpp"
@@ -37,6 +41,7 @@
 #include "plc/profile.hpp"
 #include "plc/storage.hpp"
 #include "plc/storage_format.hpp"
+#include "plc/storage_guard.hpp"
 #include "server/control/control.hpp"
 #include "server/instructions/instruction_schedule.hpp"
 #include "server/serial/serial_ports.hpp"
@@ -87,10 +92,12 @@ int configure(int argc, char** argv, Settings& settings) {
     CLI::App app{"finsd: a virtual Omron CPU Unit speaking FINS/UDP and FINS/TCP"};
     app.set_version_flag("--version", std::string("finsd ") + FINSKIT_VERSION);
     app.footer(
-        "finsd ctl --socket PATH VERB ...: change a running finsd through its control channel\n"
-        "(--control PATH); `finsd ctl --help` lists the verbs.\n"
+        "finsd ctl [--socket PATH] VERB ...: change a running finsd through its control channel\n"
+        "(--control PATH, else $FINSD_SOCKET, else $XDG_RUNTIME_DIR/finsd.sock or, for root,\n"
+        "/run/finsd/finsd.sock); `finsd ctl --help` lists the verbs.\n"
         "Logs go to stderr; stdout carries only \"listening <port>\" once serving.\n"
-        "Exit codes: 0 clean shutdown, 2 usage or configuration error, 3 start-up failure.");
+        "Exit codes: 0 clean shutdown, 2 usage or configuration error, 3 start-up failure,\n"
+        "4 the state file shrank (was truncated) while finsd ran.");
     std::string config;
     Overrides o;
     std::string profile, mode, data_dir, control, log_level, bind, protection;
@@ -107,11 +114,16 @@ int configure(int argc, char** argv, Settings& settings) {
     auto* o_data = app.add_option(
         "--data-dir", data_dir,
         "Keep retained memory in DIR/finsd.state (DIR and its parents are created if missing)");
-    auto* o_control = app.add_option("--control", control, "Control channel socket path");
+    auto* o_control = app.add_option(
+        "--control", control,
+        "Control channel socket path (default $FINSD_SOCKET, $XDG_RUNTIME_DIR/finsd.sock or "
+        "/run/finsd/finsd.sock)");
     auto* o_bind =
         app.add_option("--bind", bind, "Address to listen on (IPv4 or IPv6; default 127.0.0.1)");
     auto* o_port =
-        app.add_option("--port", port, "UDP and TCP port (0 = any free port; default 9600)");
+        app.add_option("--port", port,
+                       "UDP and TCP port (0 = any free port; default 9600); in a plant, of each "
+                       "[[plc.ethernet]] unit without a port of its own");
     auto* o_node =
         app.add_option("--node", node,
                        "FINS node address 1-254 (default: last octet of --bind, 1 on loopback)")
@@ -164,7 +176,7 @@ int configure(int argc, char** argv, Settings& settings) {
             ->check(CLI::IsMember({"process", "power"}));
     app.add_option("--serial", o.serial,
                    "Serial port NAME=DEVICE[,baud=9600,parity=even,data=7,stop=2,unit=0,mode=..."
-                   ",timeout=5]; NAME cpu, scuN.P or board.P (repeatable; README Host Link)");
+                   ",timeout=1]; NAME cpu, scuN.P or board.P (repeatable; README Host Link)");
     app.add_flag("--reset-state", o.reset_state,
                  "Move a refused state file aside (never deleted) and start with a new one");
     try {
@@ -285,31 +297,12 @@ int serve(const Settings& s) {
     plc.change_mode(s.mode, std::chrono::system_clock::now());
     fins::cli::finsd::apply_cpu_options(s, plc);
     // File memory (22 xx): <data_dir>/card and <data_dir>/em; else a temp dir removed at exit.
-    if (s.card_kbytes) {
-        if (*s.card_kbytes == 0)
-            plc.files().remove_card();
-        else
-            plc.files().insert_card(*s.card_kbytes);
-    }
-    if (s.em_file_bank) plc.files().set_em_file_bank(*s.em_file_bank);
-    if (s.cassette) plc.files().mount_cassette(*s.cassette);
-    if (s.data_dir)
-        if (auto r = plc.files().attach(*s.data_dir); !r)
-            return fail(3, "file memory in " + s.data_dir->string() + ": " + r.error().message());
+    if (const auto refused = fins::server::set_up_file_memory(plc, s, s.data_dir, ""))
+        return fail(3, refused->message);
 
-    fins::server::ServerOptions options;
-    options.bind_address = s.bind;
-    options.port = s.port;
-    options.udp = s.udp;
-    options.tcp = s.tcp;
-    options.node = s.node;
-    options.network = s.network;
-    options.max_tcp_connections = s.max_connections;
-    options.tcp_limits.handshake_timeout = std::chrono::seconds(s.tcp_handshake_timeout);
-    options.tcp_limits.frame_timeout = std::chrono::seconds(s.tcp_frame_timeout);
-    options.tcp_limits.idle_timeout = std::chrono::seconds(s.tcp_idle_timeout);
-    options.tcp_limits.keepalive = std::chrono::seconds(s.tcp_keepalive);
-    options.tcp_limits.max_pending = s.tcp_max_pending;
+    // The same translation as each unit of a plant gets (server/routing/plant.hpp).
+    auto options = fins::server::options_for(fins::cli::finsd::single_unit(s),
+                                             fins::cli::finsd::tcp_limits(s));
     options.remotes = s.remotes;
     asio::io_context io{1};
     auto server = fins::server::Server::start(io, plc, options);
@@ -327,15 +320,15 @@ int serve(const Settings& s) {
     fins::server::SerialPorts gateway_ports;
     fins::cli::finsd::open_gateway_ports(io, s.serial, gateway_ports);
     (*server)->attach_serial_ports(&gateway_ports);
-    std::unique_ptr<fins::server::ControlServer> control;
-    if (s.control_socket) {
-        auto started = fins::server::ControlServer::start(io, plc, *s.control_socket,
-                                                          &(*server)->instructions(), &schedule);
-        if (!started)
-            return fail(3, "control channel " + s.control_socket->string() + ": " +
-                               started.error().message());
-        control = std::move(*started);
-    }
+    // --control, FINSD_SOCKET or the default path (control_setup.hpp).
+    fins::server::ControlTarget target;
+    target.plc = &plc;
+    target.addresses = {{(*server)->address().network, (*server)->address().node}};
+    target.instructions = &(*server)->instructions();
+    target.schedule = &schedule;
+    auto control_start = fins::cli::start_control(io, {std::move(target)}, s.control_socket);
+    if (control_start.exit_code >= 0) return fail(control_start.exit_code, control_start.error);
+    auto& control = control_start.server;
     fins::cli::finsd::SerialPorts serial;
     if (auto r = start_serial_ports(io, (*server)->dispatcher(), s.serial, serial); !r)
         return fail(2, r.error());
@@ -351,8 +344,7 @@ int serve(const Settings& s) {
     std::printf("listening %u\n", port);
     std::fflush(stdout);
 
-    signals.async_wait([&](std::error_code, int signal) {
-        spdlog::info("finsd: signal {}, shutting down", signal);
+    const auto shut_down = [&] {
         schedule.stop();
         (*server)->stop();
         gateway_ports.close_all();
@@ -360,8 +352,29 @@ int serve(const Settings& s) {
         serial.stop();
         plc.storage().flush();
         io.stop();
+    };
+    signals.async_wait([&](std::error_code, int signal) {
+        spdlog::info("finsd: signal {}, shutting down", signal);
+        shut_down();
     });
+    // A state file truncated from outside is caught by the SIGBUS guard at the next
+    // access; this look once a second also catches it while nothing touches the file.
+    asio::steady_timer file_check{io};
+    std::function<void()> check_file = [&] {
+        file_check.expires_after(std::chrono::seconds(1));
+        file_check.async_wait([&](std::error_code ec) {
+            if (ec) return;
+            if (!plc.storage().intact()) return shut_down();
+            check_file();
+        });
+    };
+    if (s.data_dir) check_file();
     io.run();
+    if (!plc.storage().intact()) {
+        std::fputs(fins::plc::state_file_lost_message(plc.storage().path().string()).c_str(),
+                   stderr);
+        return fins::plc::state_file_lost_exit_code;
+    }
     plc.storage().close();  // sections on disk, then their checksums and "stopped cleanly"
     return 0;
 }

@@ -3,10 +3,26 @@
 // write protection, ...). A Unix-domain stream socket; one JSON request per line, one
 // JSON answer per line. Runs on the server's io_context, so it touches the Plc on the
 // same thread as the FINS sessions.
+//
+// The verbs: control_requests.hpp (the PLC's state) and control_instructions.hpp
+// (PLC-initiated messages). Any request may carry "plc": the CPU Unit it is for, by
+// its [[plc]] name or by one of its FINS addresses "NET.NODE" (a plant); without it,
+// the first CPU Unit.
+//
+// Connections (issue 18 item 4): at most `max_connections` clients wait for a request
+// line at once; a new client is always served: when every slot is taken, the one idle
+// the longest is closed. A client silent for `idle_timeout` is closed. A client whose
+// instruction (send / recv / sendcmd) is in flight holds no slot (the instruction
+// engine bounds those), so it can never crowd out a `status`.
 #pragma once
 
+#include <chrono>
+#include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <asio/io_context.hpp>
 
@@ -21,11 +37,30 @@ namespace fins::server {
 class NetworkInstructions;
 class InstructionSchedule;
 
+// One CPU Unit the channel drives.
+struct ControlTarget {
+    plc::Plc* plc = nullptr;
+    std::string name;  // its [[plc]] name ("" for a single node)
+    std::vector<std::pair<std::uint8_t, std::uint8_t>> addresses;  // its (network, node)s
+    // With an engine, the send / recv / sendcmd verbs run on it.
+    NetworkInstructions* instructions = nullptr;
+    const InstructionSchedule* schedule = nullptr;
+};
+
+struct ControlOptions {
+    std::size_t max_connections = 16;
+    std::chrono::milliseconds idle_timeout{std::chrono::seconds(60)};  // 0: never
+};
+
 class ControlServer {
   public:
-    // Listens on `socket_path` (an existing stale socket file is replaced). With
-    // `instructions`, the send / recv / sendcmd verbs run on that node's engine
-    // (control_instructions.hpp).
+    // Listens on `socket_path` (an existing stale socket file is replaced) for the CPU
+    // Units `targets` (at least one; the first is the default).
+    static Result<std::unique_ptr<ControlServer>> start(asio::io_context& io,
+                                                        std::vector<ControlTarget> targets,
+                                                        const std::filesystem::path& socket_path,
+                                                        ControlOptions options = {});
+    // One CPU Unit.
     static Result<std::unique_ptr<ControlServer>> start(
         asio::io_context& io, plc::Plc& plc, const std::filesystem::path& socket_path,
         NetworkInstructions* instructions = nullptr, const InstructionSchedule* schedule = nullptr);

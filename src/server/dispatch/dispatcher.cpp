@@ -1,11 +1,12 @@
-// Dispatcher::handle: header checks, command lookup, execution conditions, handler,
-// response frame (see dispatcher.hpp for the contract).
+// Dispatcher::handle: the stages of a request in order (length, route, destination,
+// command, execution conditions, handler; see dispatcher.hpp for the contract).
 #include "server/dispatch/dispatcher.hpp"
 
 #include <algorithm>
 
 #include "fins/command_table.hpp"
 #include "plc/plc.hpp"
+#include "server/dispatch/relay_error.hpp"
 #include "server/handlers/handlers.hpp"
 #include "server/routing/router.hpp"
 #include "server/serial/serial_ports.hpp"
@@ -64,89 +65,140 @@ void Dispatcher::attach(Router& router, std::size_t port) noexcept {
     port_ = port;
 }
 
+Dispatcher::Destination Dispatcher::find_destination(const Header& header) const noexcept {
+    // Host Link FINS conversion (W342 5-1-1): the network of the PLCs behind one of this
+    // node's gateway ports is reached through that port (with routing tables, the table
+    // names that network for the serial port).
+    const auto network = header.destination.network;
+    if (serial_ != nullptr && network != local_network && network != self_.network)
+        if (SerialGatewayPort* port = serial_->host_link_port(network))
+            return {Route::host_link, self_, port};
+    // In a plant the router decides whether the frame is for this CPU Unit (any of its
+    // ports) and as which address it answers.
+    if (router_ != nullptr) {
+        const auto local = router_->local_address(port_, header.destination);
+        if (!local) return {Route::router, self_, nullptr};
+        return {Route::this_node, *local, nullptr};
+    }
+    return {Route::this_node, self_, nullptr};
+}
+
 std::size_t Dispatcher::handle(Bytes request, MutableBytes out, const RequestContext& context) {
     // Without a header and command code there is no SID to answer.
     if (request.size() < header_size + command_code_size) return 0;
     ByteReader reader(request);
     const Header header = read_header(reader);
     const CommandCode command{reader.u8(), reader.u8()};
-    // In a plant, a frame for another node (command or answer) goes on to it.
-    NodeAddress self = self_;
-    bool deliverable = true;
-    if (router_ != nullptr) {
-        deliverable = router_->note_source(port_, header, context);
-        const auto local = router_->local_address(port_, header.destination);
-        if (!local) return router_->forward(port_, request, out, context);
-        self = *local;
-    }
+    // In a plant the arrival port learns where the source's answers go (router.hpp).
+    const bool deliverable = router_ == nullptr || router_->note_source(port_, header, context);
+    const Destination to = find_destination(header);
+
+    // 1. Length, before any route: nothing past this point (a router's or the Host Link
+    //    relay's copy of the frame, the codec) sees more than a FINS frame (W596 1-2).
+    if (request.size() > max_frame_size)
+        return refuse_too_long(header, command, to, deliverable, out);
+
+    // 2. Destination: a frame for another node goes on, command or answer (a plant's
+    //    router, the Host Link relay); on this node, the unit must be there (0201, 0202).
+    if (to.route == Route::router) return router_->forward(port_, request, out, context);
+    if (to.route == Route::host_link)
+        return handlers::relay_to_host_link(*to.host_link, request, header, to.self, out, context);
     if (header.is_response()) return 0;
-    const bool reply =
-        deliverable && header.response_required() && out.size() >= response_prefix_size;
 
-    Header response = response_header(header, self);
-    if (header.destination.node == broadcast_node) response.source.node = self.node;
-
-    // Bits 6/7 of every end code report the CPU Unit's non-fatal/fatal errors (W342
-    // 5-1-3): 0040 is a normal completion on a CPU Unit with a battery error.
-    // Read when the answer is built, so an ERROR CLEAR that removed the last error
-    // already answers without the flag.
-    bool cpu_reached = false;
-    const auto answer = [&](EndCode code) -> std::size_t {
-        if (!reply) return 0;
-        const std::uint16_t flags = cpu_reached ? plc_.errors().end_code_flags() : 0;
-        ByteWriter w(out);
-        write_response_prefix(w, response, command, static_cast<std::uint16_t>(code) | flags);
-        return w.overflowed() ? 0 : w.size();
-    };
-
-    // Host Link FINS conversion (W342 5-1-1): a frame for a PLC behind a gateway port.
-    if (serial_ != nullptr && header.destination.network != local_network &&
-        header.destination.network != self.network)
-        if (SerialGatewayPort* port = serial_->host_link_port(header.destination.network))
-            return handlers::relay_to_host_link(*port, request, header, self, out, context);
-
-    if (const auto code = check_destination(header.destination, self, plc_.profile(), serial_);
+    Reply reply{plc_, header, command, to.self, deliverable, out};
+    if (const auto code = check_destination(header.destination, to.self, plc_.profile(), serial_);
         code != EndCode::normal_completion)
-        return answer(code);
+        return reply.answer(code);
 
+    // 3. Command: its parameters (the codec's 10xx, 11xx) and who serves it (0401).
     plc_.scan_cycle().advance(context.now);
-    cpu_reached = true;
-    const auto decoded = decode_request(request);  // 1001 above 2,012 bytes
-    if (!decoded) return answer(handlers::to_end_code(decoded.error()));
+    reply.cpu_reached = true;
+    const auto decoded = decode_request(request);
+    if (!decoded) return reply.answer(handlers::to_end_code(decoded.error()));
 
     const CommandInfo* info = find_command(command);
     const handlers::HandlerEntry* entry = handlers::find_handler(command);
     if (info == nullptr || entry == nullptr || !plc_.profile().supports(command) ||
         !served_by(plc_.profile(), serial_, header.destination.unit, command))
-        return answer(EndCode::undefined_command);
+        return reply.answer(EndCode::undefined_command);
 
+    // 4. Execution conditions (W342 5-1-2).
     if (const auto code = handlers::check_execution_conditions(info->conditions, plc_,
                                                                header.source, context.link);
         code != EndCode::normal_completion)
-        return answer(code);
+        return reply.answer(code);
 
+    // 5. The command's handler, and the answer now or later.
+    return run(reply, *info, *entry, decoded->parameters, context);
+}
+
+Dispatcher::Reply::Reply(plc::Plc& cpu_unit, const Header& request, CommandCode command_code,
+                         const NodeAddress& self, bool deliverable,
+                         MutableBytes out_buffer) noexcept
+    : plc(cpu_unit),
+      header(request),
+      response(response_header(request, self)),
+      command(command_code),
+      wanted(deliverable && request.response_required() &&
+             out_buffer.size() >= response_prefix_size),
+      out(out_buffer) {
+    if (request.destination.node == broadcast_node) response.source.node = self.node;
+}
+
+std::size_t Dispatcher::Reply::answer(EndCode code) const noexcept {
+    if (!wanted) return 0;
+    // Bits 6/7 of every end code report the CPU Unit's non-fatal/fatal errors (W342
+    // 5-1-3): 0040 is a normal completion on a CPU Unit with a battery error. Read when
+    // the answer is built, so an ERROR CLEAR that removed the last error already answers
+    // without the flag.
+    const std::uint16_t flags = cpu_reached ? plc.errors().end_code_flags() : 0;
+    ByteWriter w(out);
+    write_response_prefix(w, response, command, static_cast<std::uint16_t>(code) | flags);
+    return w.overflowed() ? 0 : w.size();
+}
+
+std::size_t Dispatcher::refuse_too_long(const Header& header, CommandCode command,
+                                        const Destination& to, bool deliverable,
+                                        MutableBytes out) noexcept {
+    // An answer too long to be a FINS frame is not passed on (there is no one to tell).
+    if (header.is_response()) return 0;
+    // W342 5-1-3 1001 "Command too long", answered by the unit that received the frame:
+    // for another node (a router, the Host Link relay) it is a relay error naming this
+    // node, as every fault that stops a frame on its way (router.hpp); for this node, the
+    // plain end code (the frame never reached the CPU Unit: no error flags).
+    if (to.route != Route::this_node)
+        return write_relay_error(header, command, self_, EndCode::command_too_long, out);
+    Reply reply{plc_, header, command, to.self, deliverable, out};
+    return reply.answer(EndCode::command_too_long);
+}
+
+std::size_t Dispatcher::run(Reply& reply, const CommandInfo& info,
+                            const handlers::HandlerEntry& entry, Bytes parameters,
+                            const RequestContext& context) {
+    const MutableBytes out = reply.out;
     // The handler writes its data directly after the prefix, at most 1,998 bytes.
     const auto data_offset = std::min(out.size(), response_prefix_size);
     ByteWriter data(
         out.subspan(data_offset, std::min(out.size() - data_offset, max_response_data_size)));
-    handlers::HandlerContext handler_context{plc_, header, context};
+    handlers::HandlerContext handler_context{plc_, reply.header, context};
     handler_context.serial = serial_;
-    handler_context.self = response.source;
-    auto code = entry->function(handler_context, decoded->parameters, data);
+    handler_context.self = reply.response.source;
+    auto code = entry.function(handler_context, parameters, data);
     if (handler_context.deferred) return 0;
     if (data.overflowed()) code = EndCode::response_too_long;
     // A write is a command whose row network write protection refuses, or a write
     // variant of a shared code (09 20 MESSAGE CLEAR) its handler flagged.
-    const bool is_write = !info->conditions.network_write_protected || handler_context.write;
+    const bool is_write = !info.conditions.network_write_protected || handler_context.write;
     // W342 5-3-30: the CPU Unit logs every FINS write command it receives.
-    if (is_write) plc_.write_access_log().record(header.source, command, code, context.now);
+    if (is_write)
+        plc_.write_access_log().record(reply.header.source, reply.command, code, context.now);
     // [storage] durability = "power": what a write command changed is on disk before
     // its answer; when that fails the answer says so.
     if (is_write && !plc_.storage().commit() && code == EndCode::normal_completion)
         code = EndCode::memory_error;
-    if (code != EndCode::normal_completion && !handler_context.keep_data) return answer(code);
+    if (code != EndCode::normal_completion && !handler_context.keep_data) return reply.answer(code);
 
-    const auto prefix = answer(code);
+    const auto prefix = reply.answer(code);
     return prefix == 0 ? 0 : prefix + data.size();
 }
 

@@ -2,9 +2,14 @@
 // No sockets and no clock of its own (the caller passes `now`), so it is unit-tested
 // directly and fuzzed. Sessions (udp_server, tcp_server) only read, call, write.
 //
-// Path of a request: decode header -> address check (is it for this node/unit?) ->
-// command table lookup (unknown -> 0401) -> execution conditions of W342 5-1-2 ->
-// the command's handler (src/server/handlers/<group>.cpp) -> response frame.
+// Path of a request, the stages of handle() in order, each answering its own end code:
+//   1. length: over 2,012 bytes (W596 1-2) -> 1001, before any route (relay error
+//      9001 + relay word when the frame is for another node, W342 5-1-3);
+//   2. destination: another node -> the plant's router (router.hpp) or the Host Link
+//      relay (handlers/host_link_relay.cpp); this node -> is the unit there (0201, 0202);
+//   3. command: the codec (10xx, 11xx), the command table and who serves it (0401);
+//   4. execution conditions of W342 5-1-2;
+//   5. the command's handler (src/server/handlers/<group>.cpp) -> response frame.
 #pragma once
 
 #include <chrono>
@@ -15,6 +20,8 @@
 #include <sys/socket.h>
 
 #include "fins/byte_io.hpp"
+#include "fins/command_table.hpp"
+#include "fins/error.hpp"
 #include "fins/frame.hpp"
 
 namespace fins::plc {
@@ -24,6 +31,11 @@ class Plc;
 namespace fins::server {
 
 class Router;
+class SerialGatewayPort;
+
+namespace handlers {
+struct HandlerEntry;
+}
 
 // serial: the CPU Unit's Host Link port (server/serial/serial_session.hpp).
 enum class Link : std::uint8_t { udp, tcp, local, serial };
@@ -87,6 +99,35 @@ class Dispatcher {
     void attach(Router& router, std::size_t port) noexcept;
 
   private:
+    enum class Route : std::uint8_t { this_node, router, host_link };
+    struct Destination {
+        Route route = Route::this_node;
+        NodeAddress self;                        // the address this node answers as
+        SerialGatewayPort* host_link = nullptr;  // Route::host_link: the port
+    };
+    // The answer of this node to one request: the response header and the end-code
+    // flags of the CPU Unit once the request reached it.
+    struct Reply {
+        Reply(plc::Plc& cpu_unit, const Header& request, CommandCode command_code,
+              const NodeAddress& self, bool deliverable, MutableBytes out_buffer) noexcept;
+        // Writes the response prefix with `code`; its length, 0 when none is wanted.
+        [[nodiscard]] std::size_t answer(EndCode code) const noexcept;
+
+        plc::Plc& plc;
+        const Header& header;
+        Header response;
+        CommandCode command;
+        bool wanted;
+        bool cpu_reached = false;
+        MutableBytes out;
+    };
+
+    [[nodiscard]] Destination find_destination(const Header& header) const noexcept;
+    std::size_t refuse_too_long(const Header& header, CommandCode command, const Destination& to,
+                                bool deliverable, MutableBytes out) noexcept;
+    std::size_t run(Reply& reply, const CommandInfo& info, const handlers::HandlerEntry& entry,
+                    Bytes parameters, const RequestContext& context);
+
     plc::Plc& plc_;
     NodeAddress self_;
     SerialPorts* serial_ = nullptr;

@@ -4,6 +4,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "server/sessions/tcp_client.hpp"
 #include "server/sessions/udp_session.hpp"
 
 namespace fins::server {
@@ -13,6 +14,7 @@ UdpInstructionTransport::UdpInstructionTransport(std::shared_ptr<UdpSession> udp
                                                  std::vector<RemoteNode> remotes)
     : udp_(std::move(udp)), local_(std::move(local)), self_(self) {
     for (const auto& r : remotes) {
+        if (r.tcp) continue;  // reached over its TCP client connection only
         std::error_code ec;
         const auto ip = asio::ip::make_address(r.host, ec);
         if (ec) {
@@ -48,14 +50,25 @@ std::optional<asio::ip::udp::endpoint> UdpInstructionTransport::resolve(
 }
 
 InstructionTransport::Sent UdpInstructionTransport::send_frame(const NodeAddress& destination,
-                                                               Bytes frame) {
-    const bool local = destination.network == local_network || destination.network == self_.network;
-    if (local && tcp_route_ && destination.node != 0 && destination.node != broadcast_node &&
-        tcp_route_(destination.node, frame))
+                                                               Bytes frame,
+                                                               InstructionRoute& route) {
+    for (TcpClient* client : clients_) {
+        if (!client->reaches(destination)) continue;
+        if (!client->send_frame(frame)) return Sent::not_established;
+        route = InstructionRoute{{}, client, client->client_node()};
         return Sent::ok;
+    }
+    const bool local = destination.network == local_network || destination.network == self_.network;
+    if (local && tcp_route_ && destination.node != 0 && destination.node != broadcast_node) {
+        if (const void* connection = tcp_route_(destination.node, frame)) {
+            route = InstructionRoute{{}, connection, 0};
+            return Sent::ok;
+        }
+    }
     if (!udp_ || !udp_->open()) return Sent::no_port;
     const auto to = resolve(destination);
     if (!to) return Sent::no_route;
+    route = InstructionRoute{*to, nullptr, 0};
     return udp_->send_to(frame, to->data(), static_cast<socklen_t>(to->size())) ? Sent::ok
                                                                                 : Sent::failed;
 }

@@ -162,6 +162,7 @@ struct NetworkInstructions::Port {
     std::size_t frame_size = 0;
     std::uint8_t sid = 0;
     CommandCode command;
+    InstructionRoute route;  // the way the last transmission went
     unsigned transmissions = 0;
     std::uint64_t generation = 0;
     asio::steady_timer timer;
@@ -278,7 +279,7 @@ void NetworkInstructions::transmit(std::size_t index) {
     Port& p = *ports_[index];
     ++p.transmissions;
     const auto sent =
-        transport_.send_frame(p.request.destination, Bytes{p.frame.data(), p.frame_size});
+        transport_.send_frame(p.request.destination, Bytes{p.frame.data(), p.frame_size}, p.route);
     if (sent == InstructionTransport::Sent::no_route)
         return finish(index, communications_error(EndCode::destination_address_setting_error,
                                                   "no IP address for that network/node "
@@ -287,6 +288,10 @@ void NetworkInstructions::transmit(std::size_t index) {
         return finish(index, communications_error(EndCode::local_node_not_in_network,
                                                   "FINS/UDP is off on this node and no FINS/TCP "
                                                   "connection holds that node"));
+    if (sent == InstructionTransport::Sent::not_established)
+        return finish(index, communications_error(EndCode::local_node_not_in_network,
+                                                  "the FINS/TCP connection to that node is not "
+                                                  "established"));
     if (sent == InstructionTransport::Sent::failed && p.transmissions > p.request.options.retries)
         return finish(index,
                       communications_error(EndCode::retries_failed, "the frame could not be sent"));
@@ -324,7 +329,24 @@ void NetworkInstructions::on_timeout(std::size_t index, std::uint64_t generation
                       fmt::format("no response after {} transmission(s)", p.transmissions)));
 }
 
-bool NetworkInstructions::on_response(Bytes frame) {
+bool NetworkInstructions::answers(const Port& p, const Header& h,
+                                  const InstructionRoute& from) const noexcept {
+    if (!p.route.same_way(from)) return false;
+    const auto& dest = p.request.destination;
+    // Network 00 is the local network: its nodes answer with 00 or its number.
+    const auto local = [&](std::uint8_t network) {
+        return network == local_network || network == self_.network;
+    };
+    const bool network =
+        h.source.network == dest.network || (local(dest.network) && local(h.source.network));
+    // Node 00 addresses "this PLC": its answer comes from our own node number.
+    const std::uint8_t node = dest.node == 0 ? self_.node : dest.node;
+    const std::uint8_t me = p.route.local_node != 0 ? p.route.local_node : self_.node;
+    return network && h.source.node == node && h.source.unit == dest.unit &&
+           (h.destination.node == me || h.destination.node == 0);
+}
+
+bool NetworkInstructions::on_response(Bytes frame, const InstructionRoute& from) {
     const auto view = decode_response(frame);
     if (!view) {
         ++counters_.unmatched;
@@ -332,12 +354,8 @@ bool NetworkInstructions::on_response(Bytes frame) {
     }
     const Header& h = view->header;
     const auto it = std::find_if(ports_.begin(), ports_.end(), [&](const auto& p) {
-        if (!p->busy || p->sid != h.service_id || p->command != view->command) return false;
-        const auto& dest = p->request.destination;
-        // Node 00 addresses "this PLC": its answer comes from our own node number.
-        const std::uint8_t node = dest.node == 0 ? self_.node : dest.node;
-        return h.source.node == node &&
-               (h.destination.node == self_.node || h.destination.node == 0);
+        return p->busy && p->sid == h.service_id && p->command == view->command &&
+               answers(*p, h, from);
     });
     if (it == ports_.end()) {
         ++counters_.unmatched;

@@ -8,6 +8,13 @@
 // through on_response(), which the node's UDP session calls for every frame whose ICF
 // response bit is set (udp_session.cpp) instead of handing it to the dispatcher.
 //
+// An answer is the instruction's only when it comes back the way the command went
+// (issue 18 item 6): FINS/UDP from the address and port the node address table gives
+// for that node, FINS/TCP on the connection the command was put on; and its header
+// names the destination's network, node and unit as source and this node as
+// destination. Any other process can send a datagram to port 9600: a forged answer
+// is counted as unmatched and the instruction goes on waiting (then retries, 0205).
+//
 // W596 3 parameters and limits:
 //   destination network 0-127, node 0-254 (255 = broadcast: Send/SendCmd only, no
 //   response), unit 00-FF; words 0-990 (0: Done without sending); timeout in 0.1 s
@@ -18,8 +25,9 @@
 // code (W596: "the end code for the communication command"): the response's end code
 // when it is not normal, 0205 response timeout after the last retry, 0104 when 32
 // instructions are already running (the 33rd), 0501 no IP address for that network or
-// node, 0101 the node has no FINS/UDP port, 0103 the frame could not be sent. README "PLC-initiated
-// messages" lists them.
+// node, 0101 the node has no FINS/UDP port or its FINS/TCP connection is not
+// established (W596 3 Send error g, Rcv j, SendCmd h), 0103 the frame could not be sent.
+// README "PLC-initiated messages" lists them.
 //
 // CS/CJ profiles also show the instruction ports in the Auxiliary Area as their CPU
 // Units do: A202 bits 0-7 Communications Port Enabled Flags (ON = port free), A203-A210
@@ -39,6 +47,7 @@
 #include <vector>
 
 #include <asio/any_io_executor.hpp>
+#include <asio/ip/udp.hpp>
 #include <asio/steady_timer.hpp>
 
 #include "fins/address.hpp"
@@ -97,14 +106,31 @@ struct InstructionResult {
 
 using InstructionCallback = std::function<void(const InstructionResult&)>;
 
+// The way a frame went out, so the way its answer must come back.
+struct InstructionRoute {
+    asio::ip::udp::endpoint udp;       // FINS/UDP: the remote node's address and port
+    const void* connection = nullptr;  // FINS/TCP: the connection (null: FINS/UDP)
+    // This node's FINS node number on that way (a FINS/TCP client's is the one its
+    // handshake gave it); 0: this node's own.
+    std::uint8_t local_node = 0;
+    // Same way: same connection, or (FINS/UDP) same address and port.
+    [[nodiscard]] bool same_way(const InstructionRoute& other) const noexcept {
+        return connection == other.connection && (connection != nullptr || udp == other.udp);
+    }
+};
+
 // Where an instruction's frames go.
 class InstructionTransport {
   public:
     // ok; no_route: no IP address for that network/node; no_port: the node has no
-    // FINS/UDP port; failed: the kernel refused the frame.
-    enum class Sent : std::uint8_t { ok, no_route, no_port, failed };
+    // FINS/UDP port; not_established: the node is reached over a FINS/TCP client
+    // connection ([[remote]] transport = "tcp") that is down; failed: the kernel
+    // refused the frame.
+    enum class Sent : std::uint8_t { ok, no_route, no_port, not_established, failed };
     virtual ~InstructionTransport() = default;
-    virtual Sent send_frame(const NodeAddress& destination, Bytes frame) = 0;
+    // Sends `frame` to `destination`; on ok, `route` says which way it went.
+    virtual Sent send_frame(const NodeAddress& destination, Bytes frame,
+                            InstructionRoute& route) = 0;
 };
 
 // The request's parameters against W596's ranges and the local model: empty when it
@@ -138,9 +164,10 @@ class NetworkInstructions {
 
     // Runs `request`; `done` is called once, later, on the executor (never inside start).
     void start(InstructionRequest request, InstructionCallback done);
-    // A frame with the ICF response bit set that arrived at the node. True when it was
-    // the answer an instruction waited for; false leaves it to the caller (dropped).
-    bool on_response(Bytes frame);
+    // A frame with the ICF response bit set that arrived at the node by `from`. True
+    // when it was the answer an instruction waited for (and came back the way the
+    // command went); false leaves it to the caller (dropped).
+    bool on_response(Bytes frame, const InstructionRoute& from);
     // Ends every running instruction without calling back (shutdown).
     void stop();
 
@@ -158,6 +185,9 @@ class NetworkInstructions {
     void finish(std::size_t port, InstructionResult result);
     void complete_later(InstructionCallback done, InstructionResult result);
     void show_port(std::size_t port, bool busy, std::optional<std::uint16_t> completion);
+    // True when `h`, arrived by `from`, is the answer port `p`'s command asked for.
+    [[nodiscard]] bool answers(const Port& p, const Header& h,
+                               const InstructionRoute& from) const noexcept;
     std::uint8_t next_sid() noexcept;
 
     asio::any_io_executor executor_;

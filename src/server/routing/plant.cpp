@@ -28,6 +28,65 @@ std::uint8_t port_node(const PlantPortConfig& p) noexcept {
 
 }  // namespace
 
+ServerOptions options_for(const PlantPortConfig& unit, const TcpLimits& limits) {
+    ServerOptions options;
+    options.bind_address = unit.bind;
+    options.port = unit.port;
+    options.udp = unit.udp;
+    options.tcp = unit.tcp;
+    options.node = unit.node;
+    options.network = unit.network;
+    options.max_tcp_connections = unit.max_connections;
+    options.tcp_limits = limits;
+    return options;
+}
+
+std::optional<FileMemoryRefusal> set_up_file_memory(
+    plc::Plc& plc, const FileMemoryOptions& options,
+    const std::optional<std::filesystem::path>& data_dir, std::string_view who) {
+    auto& files = plc.files();
+    if (options.card_kbytes) {
+        if (*options.card_kbytes == 0)
+            files.remove_card();
+        else
+            files.insert_card(*options.card_kbytes);
+    }
+    if (options.em_file_bank) files.set_em_file_bank(*options.em_file_bank);
+    if (options.cassette) files.mount_cassette(*options.cassette);
+    if (!data_dir) return std::nullopt;
+    const auto r = files.attach(*data_dir);
+    // A device directory that is a symlink is followed (plc/file_memory.hpp): say so.
+    for (const auto& link : files.device_links()) {
+        const auto path = (*data_dir / link.device).string();
+        if (link.error)
+            return FileMemoryRefusal{
+                link.error, fmt::format("{}file memory: {} is a symlink to {}, not a usable "
+                                        "directory: {}",
+                                        who, path, link.target.string(), link.error.message())};
+        // A warning: files then live outside the data directory, which backups of that
+        // directory miss; the operator should see it at any log level but error.
+        spdlog::warn("finsd: {}file memory: {} is a symlink to {}: followed (nothing below it is)",
+                     who, path, link.target.string());
+    }
+    if (!r)
+        return FileMemoryRefusal{r.error(), fmt::format("{}file memory in {}: {}", who,
+                                                        data_dir->string(), r.error().message())};
+    return std::nullopt;
+}
+
+std::size_t unit_toward(const PlantCpuConfig& cpu, std::uint8_t network) noexcept {
+    const auto on = [&](std::uint8_t n) -> std::optional<std::size_t> {
+        for (std::size_t i = 0; i < cpu.ports.size(); ++i)
+            if (cpu.ports[i].network == n) return i;
+        return std::nullopt;
+    };
+    if (const auto local = on(network)) return *local;
+    for (const auto& r : cpu.relays)
+        if (r.network == network)
+            if (const auto via = on(r.relay_network)) return *via;
+    return 0;
+}
+
 std::string validate_plant(const PlantConfig& config) {
     if (config.cpus.empty()) return "plc: no CPU Unit";
     std::set<std::string> names;
@@ -104,7 +163,7 @@ namespace {
 // Unit and the file, as finsd --reset-state words them for a single node.
 Result<std::unique_ptr<plc::Plc>> open_cpu(const PlantCpuConfig& c, const plc::Profile& profile,
                                            bool reset_state) {
-    auto opened = plc::open_plc(profile, c.data_dir, {}, reset_state);
+    auto opened = plc::open_plc(profile, c.data_dir, {c.durability}, reset_state);
     const std::string file =
         c.data_dir ? (*c.data_dir / "finsd.state").string() : std::string("(heap)");
     if (!opened) {
@@ -142,10 +201,16 @@ Result<std::unique_ptr<Plant>> Plant::start(asio::io_context& io, const PlantCon
     auto impl = std::make_unique<Impl>();
     impl->cpus.reserve(config.cpus.size());
     for (const auto& c : config.cpus) {
-        const plc::Profile profile = *plc::find_profile(c.profile);
+        plc::Profile profile = *plc::find_profile(c.profile);
+        if (c.units) profile.units = *c.units;
         auto plc = open_cpu(c, profile, config.reset_state);
         if (!plc) return Unexpected(plc.error());
         (*plc)->change_mode(c.mode, std::chrono::system_clock::now());
+        if (const auto refused = set_up_file_memory(**plc, c.files, c.data_dir,
+                                                    fmt::format("plc \"{}\": ", c.name))) {
+            spdlog::error("finsd: {}", refused->message);
+            return Unexpected(refused->error);
+        }
 
         plc::RoutingTables tables;
         tables.gateway_count = c.gateway_count;
@@ -162,17 +227,12 @@ Result<std::unique_ptr<Plant>> Plant::start(asio::io_context& io, const PlantCon
         for (const auto& p : c.ports) {
             const NodeAddress self{p.network, port_node(p), cpu_unit};
             const auto index = impl->router.add_port(cpu, p.unit_number, self);
-            ServerOptions options;
-            options.bind_address = p.bind;
-            options.port = p.port;
-            options.udp = p.udp;
-            options.tcp = p.tcp;
-            options.node = self.node;
-            options.network = self.network;
-            options.max_tcp_connections = p.max_connections;
-            options.tcp_limits = config.tcp_limits;
+            PlantPortConfig unit = p;
+            unit.node = self.node;
+            auto options = options_for(unit, config.tcp_limits);
             options.router = &impl->router;
             options.router_port = index;
+            options.remotes = c.remotes;
             auto server = Server::start(io, *owner.plc, options);
             if (!server) {
                 spdlog::error("finsd: plc \"{}\" unit {}: cannot listen on {} port {}: {}", c.name,

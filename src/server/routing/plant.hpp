@@ -4,7 +4,8 @@
 // connections, handshake and limits) whose Dispatcher is attached to the router.
 //
 // Start-up per CPU Unit: its Storage (data_dir/finsd.state, or memory that costs
-// nothing until touched), the Plc, the operating mode, the routing tables written into
+// nothing until touched), the Plc, the operating mode, its file memory (data_dir/card,
+// em, cassette, or a temporary root), the routing tables written into
 // parameter area 8013 from the configuration (local network table from the ports,
 // relay network table from `relays`), then one Server per port.
 //
@@ -20,14 +21,20 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
+#include <system_error>
 #include <vector>
 
 #include <asio/io_context.hpp>
 
 #include "fins/error.hpp"
 #include "plc/plc.hpp"
+#include "plc/profile.hpp"
 #include "plc/routing_tables.hpp"
+#include "plc/storage.hpp"
+#include "server/instructions/instruction_udp.hpp"
 #include "server/routing/node_address_table.hpp"
+#include "server/sessions/server.hpp"
 #include "server/sessions/tcp_limits.hpp"
 
 namespace fins::server {
@@ -49,16 +56,48 @@ struct PlantPortConfig {
     std::vector<IpTableEntry> ip_table;  // table and combined methods
 };
 
+// A CPU Unit's file memory devices at start ([files] of a single node, [plc.files] of a
+// plant's CPU Unit). Unset: the profile's.
+struct FileMemoryOptions {
+    std::optional<std::uint32_t> card_kbytes;  // memory card capacity in KB; 0 = no card
+    std::optional<std::uint8_t> em_file_bank;  // the first EM bank of EM file memory
+    std::optional<bool> cassette;              // a Memory Cassette mounted (22 20, CP1H)
+};
+
+// Sets up the file memory (22 xx) of `plc`: the devices of `options`, then, with a data
+// directory, <data_dir>/card, em and cassette (else a temporary root removed at exit).
+// A device directory that is a symlink is followed and said at warn level (its files
+// live outside the data directory, which its backups miss); `who` starts each line
+// ("" or "plc \"A\": "). The one set-up of finsd's single node and of each plant CPU Unit.
+// Empty, or the line refusing it (a symlink to no usable directory, an attach error).
+struct FileMemoryRefusal {
+    std::error_code error;
+    std::string message;
+};
+std::optional<FileMemoryRefusal> set_up_file_memory(
+    plc::Plc& plc, const FileMemoryOptions& options,
+    const std::optional<std::filesystem::path>& data_dir, std::string_view who);
+
 struct PlantCpuConfig {
     std::string name;
     std::string profile = "cj2h";
     plc::OperatingMode mode = plc::OperatingMode::run;
-    std::optional<std::filesystem::path> data_dir;  // none: nothing kept
+    // none: nothing kept; else finsd.state and the file memory's card, em, cassette
+    std::optional<std::filesystem::path> data_dir;
+    FileMemoryOptions files;  // [plc.files]
     std::vector<PlantPortConfig> ports;
     std::vector<plc::RelayNetwork> relays;  // relay network table
     std::uint8_t gateway_count = 0x02;      // the 02/07 option of the routing tables
     // false: 8013 is left as the state file holds it (02 02 changes survive restarts).
     bool write_routing_tables = true;
+    // What an acknowledged write survives ([storage] durability of a single node).
+    plc::Durability durability = plc::Durability::process;
+    // The units the CPU Unit reports (05 02), when more than its profile's: a Serial
+    // Communications Unit or Board mounted for Serial Gateway ports. None: the profile's.
+    std::optional<std::vector<plc::UnitInfo>> units;
+    // Where remote nodes are for this CPU Unit's Send/Rcv/SendCmd ([[remote]]), on each
+    // of its units.
+    std::vector<RemoteNode> remotes;
 };
 
 struct PlantConfig {
@@ -68,6 +107,17 @@ struct PlantConfig {
     // --reset-state); without it the plant does not start.
     bool reset_state = false;
 };
+
+// The server options of one Ethernet unit (address, ports, transports, FINS/TCP limits):
+// the one translation used for finsd's single node and for each unit of a plant. The
+// caller adds what only it knows (router, remotes). `unit.node` is passed as is (0 =
+// derived by the server, server.hpp).
+ServerOptions options_for(const PlantPortConfig& unit, const TcpLimits& limits);
+
+// The unit through which CPU Unit `cpu` sends a network instruction to `network` (W342
+// 5-1-1 routing tables): the unit on that network, else the unit on the relay network
+// of the relay entry for it, else the first unit (network 00, the local network).
+std::size_t unit_toward(const PlantCpuConfig& cpu, std::uint8_t network) noexcept;
 
 // Cross-field checks: names, unique unit numbers per CPU Unit (at most 16 ports),
 // unique (network, node) in the plant, automatic methods with node = last octet, at

@@ -10,6 +10,7 @@
 
 #include "plc/plc.hpp"
 #include "plc/routing_tables.hpp"
+#include "server/dispatch/relay_error.hpp"
 
 namespace fins::server {
 
@@ -22,6 +23,37 @@ constexpr std::uint32_t address_slots = 128 * 256;
 std::uint32_t slot(std::uint8_t network, std::uint8_t node) noexcept {
     return static_cast<std::uint32_t>(((network & 0x7F) << 8) | node);
 }
+
+// The answer crosses this router on its way back: its GCT drops by one (not below 00).
+void cross_back(MutableBytes answer) noexcept {
+    if (answer.size() > gateway_count_offset && answer[gateway_count_offset] > 0)
+        --answer[gateway_count_offset];
+}
+
+// A later answer (a Serial Gateway port's, dispatcher.hpp "ReplyPath") crosses this
+// router as an answer on the call stack does. Lives on forward()'s stack: defer() is only
+// called while the next node handles the frame.
+class CrossingReplyPath final : public ReplyPath {
+  public:
+    explicit CrossingReplyPath(ReplyPath* outer) noexcept : outer_(outer) {}
+    CrossingReplyPath(const CrossingReplyPath&) = delete;
+    CrossingReplyPath& operator=(const CrossingReplyPath&) = delete;
+    ~CrossingReplyPath() = default;
+
+    Completion defer() override {
+        return [reply = outer_->defer()](Bytes frame) {
+            if (!reply) return;
+            std::array<std::uint8_t, max_frame_size> answer{};
+            const std::size_t n = std::min(frame.size(), answer.size());
+            std::memcpy(answer.data(), frame.data(), n);
+            cross_back(MutableBytes{answer.data(), n});
+            reply(Bytes{answer.data(), n});
+        };
+    }
+
+  private:
+    ReplyPath* outer_;
+};
 
 }  // namespace
 
@@ -103,18 +135,7 @@ std::uint8_t Router::network_for_local(std::size_t cpu) const noexcept {
 
 std::size_t Router::relay_error(const Header& request, CommandCode command, const Port& arrival,
                                 EndCode code, MutableBytes out) const noexcept {
-    if (!request.response_required()) return 0;
-    // The answer names the node the command was sent to as its source, so the requester
-    // matches it with its request; the relay word names the router that failed.
-    Header response = response_header(request, request.destination);
-    response.gateway_count = default_gateway_count;
-    ByteWriter w(out);
-    write_response_prefix(w, response, command,
-                          static_cast<std::uint16_t>(static_cast<std::uint16_t>(code) |
-                                                     ResponseCode::relay_error_bit));
-    w.u8(arrival.address.network);
-    w.u8(arrival.address.node);
-    return w.overflowed() ? 0 : w.size();
+    return write_relay_error(request, command, arrival.address, code, out);
 }
 
 std::size_t Router::forward(std::size_t port, Bytes frame, MutableBytes out,
@@ -170,6 +191,8 @@ std::size_t Router::forward(std::size_t port, Bytes frame, MutableBytes out,
         copy[source_network_offset] = arrival.address.network;
     const Bytes relayed{copy.data(), frame.size()};
 
+    if (hop_node == broadcast_node) return broadcast(arrival.cpu, hop_network, relayed, context);
+
     const auto next = find_port(hop_network, hop_node);
     if (!next) {
         if (wire_ && wire_(*out_port, hop_node, relayed)) return 0;
@@ -180,10 +203,28 @@ std::size_t Router::forward(std::size_t port, Bytes frame, MutableBytes out,
     // The hand-off is not a datagram: the next node learns no address from it.
     RequestContext inner = context;
     inner.peer = nullptr;
+    // An answer now (on the call stack) or later (through the reply path) crosses this
+    // router on its way back.
+    CrossingReplyPath crossing(context.reply_path);
+    if (context.reply_path != nullptr) inner.reply_path = &crossing;
     const std::size_t n = dispatcher->handle(relayed, out, inner);
-    // The answer crosses this router on its way back.
-    if (n > gateway_count_offset && out[gateway_count_offset] > 0) --out[gateway_count_offset];
+    cross_back(out.first(n));
     return n;
+}
+
+std::size_t Router::broadcast(std::size_t cpu, std::uint8_t network, Bytes frame,
+                              const RequestContext& context) {
+    // Each node runs it as a broadcast on its own network; what it answers stays there.
+    std::array<std::uint8_t, max_frame_size> discarded{};
+    RequestContext inner = context;
+    inner.peer = nullptr;
+    inner.reply_path = nullptr;
+    for (const Port& port : ports_) {
+        if (port.address.network != network || port.cpu == cpu || port.dispatcher == nullptr)
+            continue;
+        (void)port.dispatcher->handle(frame, discarded, inner);
+    }
+    return 0;
 }
 
 }  // namespace fins::server

@@ -18,6 +18,12 @@
 //       0502 no routing tables, 0503 broken tables or a table naming a unit that is not
 //       mounted, 0501 a network in neither table, 0504 GCT already 00 (too many relays),
 //       0201 the next node is not reachable (no address known for it).
+//   a broadcast (DA1 FF, fins-frames.md 1.3) for a network in the local network table
+//     is relayed as a broadcast on that network: every other CPU Unit of this process
+//     with a unit on it runs the command; their answers are not passed back (one
+//     request, many answers; a broadcast goes without one, W343 08 03), so the requester
+//     gets none. Nodes in other processes do not get it (the loopback plant has no
+//     broadcast address).
 // An answer from a node of this process comes back on the call stack, the reverse route,
 // with its GCT decremented at each router it crosses.
 #pragma once
@@ -109,6 +115,11 @@ class Router {
 
     std::size_t relay_error(const Header& request, CommandCode command, const Port& arrival,
                             EndCode code, MutableBytes out) const noexcept;
+    // A broadcast (DA1 FF) for a network of the local network table, from `cpu`: handed
+    // to the unit of every other CPU Unit of this process on `network`; no answer comes
+    // back (returns 0).
+    std::size_t broadcast(std::size_t cpu, std::uint8_t network, Bytes frame,
+                          const RequestContext& context);
 
     std::vector<Cpu> cpus_;
     std::vector<Port> ports_;

@@ -29,12 +29,13 @@ SerialGatewayPort::~SerialGatewayPort() = default;
 std::error_code SerialGatewayPort::open() {
     last_open_attempt_ = std::chrono::steady_clock::now();
     if (auto ec = port_.open(config_.line)) return ec;
+    ++opened_;
     read_more();
     return {};
 }
 
 void SerialGatewayPort::close() {
-    port_.close();
+    close_device();
     timer_.cancel();
     silence_.cancel();
     // Whatever waits is answered: nothing will go out on this port any more.
@@ -43,14 +44,18 @@ void SerialGatewayPort::close() {
 }
 
 void SerialGatewayPort::submit(SerialFraming framing, Bytes frame, bool expect_answer,
-                               SerialCompletion done) {
+                               SerialCompletion done, SerialAnswerCheck is_answer) {
     // One in progress plus max_queued waiting; a flood beyond gets 0204 at once.
     if (queue_.size() > max_queued || frame.size() > max_frame) {
         ++counters_.busy;
         done(EndCode::destination_node_busy, {});
         return;
     }
-    queue_.push_back(Job{framing, {frame.begin(), frame.end()}, expect_answer, std::move(done)});
+    queue_.push_back(Job{framing,
+                         {frame.begin(), frame.end()},
+                         expect_answer,
+                         std::move(done),
+                         std::move(is_answer)});
     if (!active_) start_next();
 }
 
@@ -72,11 +77,15 @@ void SerialGatewayPort::start_next() {
     auto self = shared_from_this();
     const Job& job = queue_.front();
     asio::async_write(port_.port(), asio::buffer(job.frame),
-                      [self](std::error_code ec, std::size_t) { self->on_written(ec); });
+                      [self, generation = generation_](std::error_code ec, std::size_t) {
+                          self->on_written(generation, ec);
+                      });
 }
 
-void SerialGatewayPort::on_written(std::error_code ec) {
-    if (!active_) return;
+void SerialGatewayPort::on_written(std::uint64_t generation, std::error_code ec) {
+    // The write of a job that already finished (the port was closed or lost meanwhile):
+    // it must not act on the job now active.
+    if (!active_ || generation != generation_) return;
     if (ec) {
         lost(ec);
         return;
@@ -96,14 +105,24 @@ void SerialGatewayPort::on_written(std::error_code ec) {
     try_answer();  // the answer may already be in
 }
 
+void SerialGatewayPort::close_device() {
+    port_.close();
+    // The read in progress on it ends (aborted) whenever its handler runs; a read on the
+    // device opened next is another one.
+    reading_ = false;
+}
+
 void SerialGatewayPort::read_more() {
     if (reading_ || !port_.is_open()) return;
     reading_ = true;
-    port_.port().async_read_some(asio::buffer(read_buffer_),
-                                 [self = shared_from_this()](std::error_code ec, std::size_t n) {
-                                     self->reading_ = false;
-                                     self->on_read(ec, n);
-                                 });
+    port_.port().async_read_some(
+        asio::buffer(read_buffer_),
+        [self = shared_from_this(), opened = opened_](std::error_code ec, std::size_t n) {
+            // A read of a device closed since: the one open now has its own.
+            if (opened != self->opened_) return;
+            self->reading_ = false;
+            self->on_read(ec, n);
+        });
 }
 
 void SerialGatewayPort::on_read(std::error_code ec, std::size_t n) {
@@ -180,14 +199,28 @@ bool SerialGatewayPort::try_answer() {
             break;
         }
         case SerialFraming::host_link: {
-            // The whole frame up to '*' CR; the caller checks its FCS (0206 when wrong).
-            const auto end = std::search(rx_.begin(), rx_.end(), host_link_terminator.begin(),
-                                         host_link_terminator.end());
-            if (end == rx_.end()) break;
-            const auto start = std::find(rx_.begin(), end, std::uint8_t{'@'});
-            const auto size = static_cast<std::size_t>(end - start) + host_link_terminator.size();
-            finish(EndCode::normal_completion, Bytes{rx_.data() + (start - rx_.begin()), size});
-            return true;
+            // Whole frames up to '*' CR; the caller checks their FCS (0206 when wrong). A
+            // frame the job's check refuses is dropped: the job keeps waiting.
+            for (;;) {
+                const auto end = std::search(rx_.begin(), rx_.end(), host_link_terminator.begin(),
+                                             host_link_terminator.end());
+                if (end == rx_.end()) break;
+                const auto start = std::find(rx_.begin(), end, std::uint8_t{'@'});
+                const auto size =
+                    static_cast<std::size_t>(end - start) + host_link_terminator.size();
+                const Bytes frame{rx_.data() + (start - rx_.begin()), size};
+                const Job& job = queue_.front();
+                if (!job.is_answer || job.is_answer(frame)) {
+                    finish(EndCode::normal_completion, frame);
+                    return true;
+                }
+                ++counters_.foreign_answers;
+                spdlog::debug("fins/serial: {}: dropped an answer to another request",
+                              config_.name);
+                rx_.erase(rx_.begin(),
+                          end + static_cast<std::ptrdiff_t>(host_link_terminator.size()));
+            }
+            break;
         }
     }
     if (rx_.size() >= max_frame) {
@@ -216,7 +249,7 @@ void SerialGatewayPort::finish(EndCode code, Bytes payload) {
 void SerialGatewayPort::lost(const std::error_code& ec) {
     spdlog::warn("fins/serial: {}: {}: {} (closed; each request tries to reopen it)", config_.name,
                  config_.line.device, ec.message());
-    port_.close();
+    close_device();
     last_open_attempt_ = std::chrono::steady_clock::now();
     if (active_) finish(EndCode::response_timeout, {});
 }

@@ -61,6 +61,10 @@ struct GatewayPortConfig {
 // The result a completion receives: the FINS end code and, on 0000, the payload (valid
 // only during the call).
 using SerialCompletion = std::function<void(EndCode code, Bytes payload)>;
+// Host Link framing only: is this whole frame ("@" .. "*" CR) the answer to the job? A
+// frame it refuses (an answer to an earlier request: another SID) is dropped and
+// counted, and the job keeps waiting within its timeout. Empty: every frame is.
+using SerialAnswerCheck = std::function<bool(Bytes frame)>;
 
 class SerialGatewayPort : public std::enable_shared_from_this<SerialGatewayPort> {
   public:
@@ -71,6 +75,7 @@ class SerialGatewayPort : public std::enable_shared_from_this<SerialGatewayPort>
 
     struct Counters {
         std::uint64_t answered = 0, timeouts = 0, bad_checksums = 0, busy = 0, late_bytes = 0;
+        std::uint64_t foreign_answers = 0;  // Host Link frames the job's check refused
     };
 
     SerialGatewayPort(asio::io_context& io, GatewayPortConfig config);
@@ -84,7 +89,8 @@ class SerialGatewayPort : public std::enable_shared_from_this<SerialGatewayPort>
 
     // Queues one framed request. `expect_answer` false: complete with 0000 once sent.
     // Over max_queued waiting: completes at once with 0204.
-    void submit(SerialFraming framing, Bytes frame, bool expect_answer, SerialCompletion done);
+    void submit(SerialFraming framing, Bytes frame, bool expect_answer, SerialCompletion done,
+                SerialAnswerCheck is_answer = {});
 
     [[nodiscard]] const GatewayPortConfig& config() const noexcept { return config_; }
     [[nodiscard]] const Counters& counters() const noexcept { return counters_; }
@@ -96,10 +102,14 @@ class SerialGatewayPort : public std::enable_shared_from_this<SerialGatewayPort>
         std::vector<std::uint8_t> frame;
         bool expect_answer;
         SerialCompletion done;
+        SerialAnswerCheck is_answer;
     };
 
     void start_next();
-    void on_written(std::error_code ec);
+    // Every asynchronous completion carries the generation of the job it was started
+    // for; a late one (its job already finished: closed, lost, timed out) does nothing.
+    void on_written(std::uint64_t generation, std::error_code ec);
+    void close_device();
     void read_more();
     void on_read(std::error_code ec, std::size_t n);
     // Looks for the active job's answer in rx_; true when the job finished.
@@ -117,7 +127,8 @@ class SerialGatewayPort : public std::enable_shared_from_this<SerialGatewayPort>
     std::deque<Job> queue_;       // front() is active when active_
     bool active_ = false;
     bool reading_ = false;
-    std::uint64_t generation_ = 0;  // tells a stale timer from the current job's
+    std::uint64_t opened_ = 0;      // counts opens; tells a stale read from the open device's
+    std::uint64_t generation_ = 0;  // the active job's; tells a stale completion from its
     std::chrono::steady_clock::time_point last_open_attempt_{};
     std::array<std::uint8_t, 512> read_buffer_{};
     std::vector<std::uint8_t> rx_;  // bytes of the active job's answer so far

@@ -7,18 +7,14 @@
 #include <memory>
 #include <vector>
 
+#include "fins/commands/serial_gateway.hpp"
 #include "server/serial/serial_gateway_port.hpp"
 
 namespace fins::server {
 
-// W342 5-3-46 tables: Serial Communications Unit N port 1 = 80 + 4N, port 2 = 81 + 4N
-// (N = 0-F); the Board's ports E4 and E5.
-constexpr std::uint8_t scu_port_unit_address(unsigned unit_number, unsigned port) noexcept {
-    return static_cast<std::uint8_t>(0x80U + 4U * unit_number + (port - 1U));
-}
-constexpr std::uint8_t board_port_unit_address(unsigned port) noexcept {
-    return static_cast<std::uint8_t>(0xE4U + (port - 1U));
-}
+// The port unit addresses (W342 5-3-46 tables) are public: `fins modbus --gateway` uses them.
+using fins::board_port_unit_address;
+using fins::scu_port_unit_address;
 
 class SerialPorts {
   public:

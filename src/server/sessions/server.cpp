@@ -69,8 +69,12 @@ struct Server::Impl {
             evict_oldest_pending();
             auto session =
                 std::make_shared<TcpSession>(std::move(socket), dispatcher, nodes, limits);
+            // The session checked the answer's source is its client node; the route
+            // checks it came on the connection the command went on.
             session->set_response_hook(
-                [engine = instructions.get()](Bytes frame) { return engine->on_response(frame); });
+                [engine = instructions.get(), connection = session.get()](Bytes frame) {
+                    return engine->on_response(frame, InstructionRoute{{}, connection, 0});
+                });
             sessions.push_back(session);
             session->start();
             accept_tcp();
@@ -87,8 +91,9 @@ struct Server::Impl {
         if (pending < limits.max_pending) return;
         for (const auto& weak : sessions)
             if (auto s = weak.lock(); s && s->pending()) {
-                spdlog::info("fins/tcp: {} connections without a handshake, closing the oldest",
-                             pending);
+                log_summarised(nodes.log().evictions, spdlog::level::info,
+                               "fins/tcp: {} connections without a handshake, closing the oldest",
+                               pending);
                 s->close();
                 return;
             }
@@ -126,10 +131,11 @@ struct Server::Impl {
         });
     }
 
-    // The frame on the FINS/TCP connection that holds client node `node`, if one does.
-    bool push_to_tcp_node(std::uint8_t node, Bytes frame) {
+    // The frame on the FINS/TCP connection that holds client node `node`, if one does:
+    // that connection, or null.
+    const TcpSession* push_to_tcp_node(std::uint8_t node, Bytes frame) {
         TcpSession* session = nodes.owner(node);
-        return session != nullptr && session->push_frame(frame);
+        return session != nullptr && session->push_frame(frame) ? session : nullptr;
     }
 
     Dispatcher dispatcher;
@@ -137,6 +143,7 @@ struct Server::Impl {
     // PLC-initiated messages: answers arriving at the UDP session go to `instructions`.
     std::unique_ptr<UdpInstructionTransport> transport;
     std::unique_ptr<NetworkInstructions> instructions;
+    std::vector<std::unique_ptr<TcpClient>> clients;  // [[remote]] transport = "tcp"
     asio::ip::tcp::acceptor acceptor;
     TcpNodeTable nodes;
     TcpLimits limits;
@@ -186,11 +193,34 @@ Result<std::unique_ptr<Server>> Server::start(asio::io_context& io, plc::Plc& pl
     });
     impl->instructions =
         std::make_unique<NetworkInstructions>(io.get_executor(), plc, self, *impl->transport);
+    std::vector<TcpClient*> clients;
+    for (const auto& remote : options.remotes) {
+        if (!remote.tcp) continue;
+        auto& client = impl->clients.emplace_back(
+            std::make_unique<TcpClient>(io, impl->dispatcher, remote, options.tcp_client_timing));
+        // The answer's source node was checked against the connection's remote node;
+        // the route checks it came on the connection the command went on.
+        client->set_response_hook(
+            [engine = impl->instructions.get()](Bytes frame, const TcpClient& connection) {
+                return engine->on_response(
+                    frame, InstructionRoute{{}, &connection, connection.client_node()});
+            });
+        clients.push_back(client.get());
+    }
+    impl->nodes.reserve_for_clients(clients.size());
+    impl->transport->set_tcp_clients(clients);
     if (impl->udp)
-        impl->udp->set_response_hook([engine = impl->instructions.get()](Bytes frame) {
-            return engine->on_response(frame);
-        });
+        impl->udp->set_response_hook(
+            [engine = impl->instructions.get()](Bytes frame, const sockaddr* peer, socklen_t size) {
+                InstructionRoute from;
+                if (size > from.udp.capacity()) return false;
+                std::memcpy(from.udp.data(), peer, size);
+                from.udp.resize(size);
+                return engine->on_response(frame, from);
+            });
     if (options.tcp) impl->accept_tcp();
+    for (auto& client : impl->clients)
+        client->start();
     if (impl->udp) impl->udp->start();
     return std::unique_ptr<Server>(new Server(std::move(impl)));
 }
@@ -233,7 +263,7 @@ bool Server::send_datagram(Bytes frame, const std::array<std::uint8_t, 4>& ip,
 }
 
 bool Server::send_to_tcp_node(std::uint8_t node, Bytes frame) {
-    return impl_->push_to_tcp_node(node, frame);
+    return impl_->push_to_tcp_node(node, frame) != nullptr;
 }
 
 std::size_t Server::tcp_connections() const noexcept {
@@ -244,9 +274,18 @@ NetworkInstructions& Server::instructions() noexcept {
     return *impl_->instructions;
 }
 
+std::vector<const TcpClient*> Server::tcp_clients() const {
+    std::vector<const TcpClient*> out;
+    for (const auto& c : impl_->clients)
+        out.push_back(c.get());
+    return out;
+}
+
 void Server::stop() {
     std::error_code ignored;
     impl_->instructions->stop();
+    for (auto& client : impl_->clients)
+        client->stop();
     if (impl_->udp) impl_->udp->close();
     impl_->acceptor.close(ignored);
     impl_->accept_timer.cancel();

@@ -25,6 +25,7 @@
 #include "fins/error.hpp"
 #include "fins/frame.hpp"
 #include "server/instructions/instruction_udp.hpp"
+#include "server/sessions/tcp_client.hpp"
 #include "server/sessions/tcp_limits.hpp"
 
 namespace fins::plc {
@@ -56,8 +57,11 @@ struct ServerOptions {
     // In a plant: the router and this server's port in it (router.hpp); null: one node.
     Router* router = nullptr;
     std::size_t router_port = 0;
-    // PLC-initiated messages: where remote nodes are ([[remote]], instruction_udp.hpp).
+    // PLC-initiated messages: where remote nodes are ([[remote]], instruction_udp.hpp);
+    // those with `tcp` get a FINS/TCP client connection each (tcp_client.hpp), which
+    // holds one of the max_tcp_connections slots.
     std::vector<RemoteNode> remotes;
+    TcpClientTiming tcp_client_timing;
 };
 
 // The node number finsd takes when none is given (see ServerOptions::node).
@@ -85,6 +89,8 @@ class Server {
     bool send_to_tcp_node(std::uint8_t node, Bytes frame);
     // This node's Send/Rcv/SendCmd engine (network_instructions.hpp).
     NetworkInstructions& instructions() noexcept;
+    // The FINS/TCP client connections, in [[remote]] order.
+    [[nodiscard]] std::vector<const TcpClient*> tcp_clients() const;
     // Serves these Serial Gateway ports (W342 5-3-46 .. 5-3-48) from now on; they must
     // outlive the server's use of them.
     void attach_serial_ports(SerialPorts* ports) noexcept;

@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "fins/error.hpp"
+#include "server/sessions/tcp_session_log.hpp"
 
 namespace fins::server {
 
@@ -25,14 +26,23 @@ class TcpNodeTable {
     void release(std::uint8_t node, const TcpSession* owner) noexcept;
     // The session holding `node`, or nullptr.
     [[nodiscard]] TcpSession* owner(std::uint8_t node) const noexcept { return owners_[node]; }
+    // Connections accepted from clients and holding a node.
     [[nodiscard]] std::size_t in_use() const noexcept { return count_; }
-    [[nodiscard]] bool full() const noexcept { return count_ >= max_connections_; }
+    // W596 1-4: the limit counts "server and client connections"; each configured
+    // FINS/TCP client connection (tcp_client.hpp) holds one of the slots for good.
+    void reserve_for_clients(std::size_t clients) noexcept { reserved_ = clients; }
+    [[nodiscard]] std::size_t reserved() const noexcept { return reserved_; }
+    [[nodiscard]] bool full() const noexcept { return count_ + reserved_ >= max_connections_; }
+    // The server's FINS/TCP log lines, bounded per interval (tcp_session_log.hpp).
+    TcpSessionLog& log() noexcept { return log_; }
 
   private:
     std::array<TcpSession*, 256> owners_{};
     std::uint8_t server_node_;
     std::size_t max_connections_;
     std::size_t count_ = 0;
+    std::size_t reserved_ = 0;
+    TcpSessionLog log_;
 };
 
 }  // namespace fins::server

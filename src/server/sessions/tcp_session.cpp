@@ -5,6 +5,7 @@
 #include <sys/socket.h>
 
 #include <algorithm>
+#include <cassert>
 #include <cerrno>
 #include <cstring>
 
@@ -123,8 +124,9 @@ bool TcpSession::serve_buffered() {
         if (parsed.status == TcpParse::Status::error) {
             ByteWriter w{out_};
             write_tcp_error(w, TcpCommand::frame_error, parsed.error);
-            spdlog::warn("fins/tcp: {}: envelope error {:#04x}, closing", peer_.to_string(),
-                         static_cast<int>(parsed.error));
+            log_summarised(nodes_.log().envelope_errors, spdlog::level::warn,
+                           "fins/tcp: {}: envelope error {:#04x}, closing", peer_.to_string(),
+                           static_cast<int>(parsed.error));
             start = in_size_;
             go_on = send_answer(w.size(), true);
             break;
@@ -159,7 +161,7 @@ bool TcpSession::serve_buffered() {
 }
 
 bool TcpSession::send_answer(std::size_t size, bool close_after) {
-    if (close_after || writing_ || confirming_ || late_writing_) {
+    if (close_after || write_ != Write::idle) {
         send_and_continue(size, close_after);
         return false;
     }
@@ -200,12 +202,19 @@ bool TcpSession::handle_packet(const TcpPacket& packet) {
     }
     if (!from_bound_node(packet.data)) {
         // Not executed as another node and not answered: W421 sends a node's answers only
-        // on the connection paired with it. One warning per connection, no log flood.
-        const auto level = logged_foreign_source_ ? spdlog::level::debug : spdlog::level::warn;
-        logged_foreign_source_ = true;
-        spdlog::log(level, "fins/tcp: {}: dropped a frame from {}.{} on the connection of node {}",
-                    peer_.to_string(), packet.data[source_network_offset],
-                    packet.data[source_node_offset], client_node_);
+        // on the connection paired with it. One warning per connection, and at most one
+        // per interval for all connections (tcp_session_log.hpp): no log flood.
+        if (logged_foreign_source_) {
+            spdlog::debug("fins/tcp: {}: dropped a frame from {}.{} on the connection of node {}",
+                          peer_.to_string(), packet.data[source_network_offset],
+                          packet.data[source_node_offset], client_node_);
+        } else {
+            logged_foreign_source_ = true;
+            log_summarised(nodes_.log().foreign_sources, spdlog::level::warn,
+                           "fins/tcp: {}: dropped a frame from {}.{} on the connection of node {}",
+                           peer_.to_string(), packet.data[source_network_offset],
+                           packet.data[source_node_offset], client_node_);
+        }
         return true;
     }
     // An answer to one of this node's own instructions, sent to the client's node.
@@ -249,15 +258,18 @@ bool TcpSession::handshake(const TcpPacket& packet) {
         write_node_address_response(w, echoed, dispatcher_.self().node,
                                     static_cast<std::uint32_t>(claimed.error().value()));
         out_size_pending_ = w.size();
-        spdlog::info("fins/tcp: {}: refused client node {:#010x}: {}", peer_.to_string(), echoed,
-                     claimed.error().message());
+        // The node as the client sent it, in decimal (0 asks for one), and why.
+        log_summarised(nodes_.log().refused, spdlog::level::info,
+                       "fins/tcp: {}: refused client node {}{}: {}", peer_.to_string(), echoed,
+                       echoed == 0 ? " (automatic allocation)" : "", claimed.error().message());
         return false;
     }
     client_node_ = *claimed;
     state_ = State::established;
     write_node_address_response(w, client_node_, dispatcher_.self().node);
     out_size_pending_ = w.size();
-    spdlog::info("fins/tcp: {}: client node {} connected", peer_.to_string(), client_node_);
+    log_summarised(nodes_.log().connected, spdlog::level::info,
+                   "fins/tcp: {}: client node {} connected", peer_.to_string(), client_node_);
     return true;
 }
 
@@ -269,22 +281,39 @@ bool TcpSession::from_bound_node(Bytes frame) const noexcept {
     return local && frame[source_node_offset] == client_node_;
 }
 
+void TcpSession::start_write(Write what) noexcept {
+    assert(write_ == Write::idle && what != Write::idle);
+    write_ = what;
+}
+
+void TcpSession::write_next() {
+    if (write_ != Write::idle) return;
+    if (deferred_) {
+        const DeferredResponse next = *deferred_;
+        deferred_.reset();
+        send_and_continue(next.size, next.close_after);
+    } else if (confirm_wanted_) {
+        confirm_wanted_ = false;
+        send_confirmation();
+    } else if (!late_.empty()) {
+        write_late();
+    }
+}
+
 void TcpSession::send_and_continue(std::size_t size, bool close_after) {
-    if (confirming_ || late_writing_) {
-        // Command 6 is on its way; this packet follows it whole, never interleaved.
-        deferred_ = true;
-        deferred_size_ = size;
-        deferred_close_ = close_after;
+    if (write_ != Write::idle) {
+        // Command 6 or a late frame is on its way; this packet follows it whole.
+        deferred_ = DeferredResponse{size, close_after};
         return;
     }
-    writing_ = true;
+    start_write(Write::response);
     // The peer must take the response: a client that stops reading is a stalled frame.
     if (state_ == State::established) set_deadline(Deadline::frame, limits_.frame_timeout);
     auto self = shared_from_this();
     // One write per response: clients that read one response per recv() depend on it.
     asio::async_write(socket_, asio::buffer(out_.data(), size),
                       [self, close_after](std::error_code ec, std::size_t) {
-                          self->writing_ = false;
+                          self->write_ = Write::idle;
                           if (!self->open()) return;
                           if (ec) {
                               self->close();
@@ -294,19 +323,14 @@ void TcpSession::send_and_continue(std::size_t size, bool close_after) {
                               self->close_after_notice();
                               return;
                           }
-                          if (self->confirm_wanted_) {
-                              self->confirm_wanted_ = false;
-                              self->send_confirmation();
-                          } else if (!self->late_.empty()) {
-                              self->write_late();
-                          }
+                          self->write_next();
                           self->resume();
                       });
 }
 
 void TcpSession::confirm_connection() {
-    if (state_ != State::established || confirming_) return;
-    if (writing_ || late_writing_) {
+    if (state_ != State::established || write_ == Write::confirmation) return;
+    if (write_ != Write::idle) {
         confirm_wanted_ = true;
         return;
     }
@@ -314,26 +338,22 @@ void TcpSession::confirm_connection() {
 }
 
 void TcpSession::send_confirmation() {
-    confirming_ = true;
+    start_write(Write::confirmation);
     ByteWriter w{confirmation_};
     write_tcp_header(w, TcpCommand::connection_confirmation, 0);
-    spdlog::info("fins/tcp: {}: node {} asked for again, confirming the connection",
-                 peer_.to_string(), client_node_);
+    log_summarised(nodes_.log().confirmations, spdlog::level::info,
+                   "fins/tcp: {}: node {} asked for again, confirming the connection",
+                   peer_.to_string(), client_node_);
     auto self = shared_from_this();
     asio::async_write(socket_, asio::buffer(confirmation_),
                       [self](std::error_code ec, std::size_t) {
-                          self->confirming_ = false;
+                          self->write_ = Write::idle;
                           if (!self->open()) return;
                           if (ec) {
                               self->close();
                               return;
                           }
-                          if (self->deferred_) {
-                              self->deferred_ = false;
-                              self->send_and_continue(self->deferred_size_, self->deferred_close_);
-                          } else if (!self->late_.empty() && !self->writing_) {
-                              self->write_late();
-                          }
+                          self->write_next();
                       });
 }
 
@@ -353,7 +373,8 @@ Completion TcpSession::defer() {
 void TcpSession::queue_late(Bytes frame) {
     if (state_ != State::established) return;
     if (late_.size() >= max_late) {
-        spdlog::warn("fins/tcp: {}: late answer dropped (peer not reading)", peer_.to_string());
+        log_summarised(nodes_.log().late_dropped, spdlog::level::warn,
+                       "fins/tcp: {}: late answer dropped (peer not reading)", peer_.to_string());
         return;
     }
     std::vector<std::uint8_t> packet(tcp_header_size + frame.size());
@@ -361,30 +382,22 @@ void TcpSession::queue_late(Bytes frame) {
     write_tcp_header(w, TcpCommand::frame, frame.size());
     w.bytes(frame);
     late_.push_back(std::move(packet));
-    if (!writing_ && !confirming_ && !late_writing_) write_late();
+    if (write_ == Write::idle) write_late();
 }
 
 void TcpSession::write_late() {
-    late_writing_ = true;
+    start_write(Write::late_frame);
     auto self = shared_from_this();
     asio::async_write(socket_, asio::buffer(late_.front()),
                       [self](std::error_code ec, std::size_t) {
-                          self->late_writing_ = false;
+                          self->write_ = Write::idle;
                           if (!self->late_.empty()) self->late_.pop_front();
                           if (!self->open()) return;
                           if (ec) {
                               self->close();
                               return;
                           }
-                          if (self->deferred_) {
-                              self->deferred_ = false;
-                              self->send_and_continue(self->deferred_size_, self->deferred_close_);
-                          } else if (self->confirm_wanted_) {
-                              self->confirm_wanted_ = false;
-                              self->send_confirmation();
-                          } else if (!self->late_.empty() && !self->writing_) {
-                              self->write_late();
-                          }
+                          self->write_next();
                       });
 }
 

@@ -34,6 +34,7 @@
 #include <deque>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <asio/ip/tcp.hpp>
@@ -132,12 +133,26 @@ class TcpSession : public std::enable_shared_from_this<TcpSession>, private Repl
     Clock::time_point timer_at_ = Clock::time_point::max();
     bool timer_armed_ = false;
     std::uint64_t timer_generation_ = 0;
-    bool writing_ = false;           // a response or notice is being written
-    bool confirming_ = false;        // command 6 is being written
-    bool confirm_wanted_ = false;    // command 6 waits for the current write
-    std::size_t deferred_size_ = 0;  // a response that waits for command 6
-    bool deferred_close_ = false;
-    bool deferred_ = false;
+    // The writer (issue 18 layout): one write on the wire at a time, so packets never
+    // interleave, and what waits for it. The transitions, all of them:
+    //   idle -> response      send_and_continue (a response or an error notice)
+    //   idle -> confirmation  send_confirmation (command 6)
+    //   idle -> late_frame    write_late (a deferred answer or a pushed frame)
+    //   any  -> idle          that write's completion, which then calls write_next()
+    // Asked to write while not idle: a response waits in deferred_, command 6 in
+    // confirm_wanted_, a late frame in late_; write_next() starts them in that order.
+    // Reading waits while a response is written (and resumes after it), so at most one
+    // response is ever deferred.
+    enum class Write : std::uint8_t { idle, response, confirmation, late_frame };
+    struct DeferredResponse {
+        std::size_t size = 0;
+        bool close_after = false;
+    };
+    void start_write(Write what) noexcept;
+    void write_next();
+    Write write_ = Write::idle;
+    bool confirm_wanted_ = false;
+    std::optional<DeferredResponse> deferred_;
     bool logged_foreign_source_ = false;  // one warning per connection
     std::size_t drained_ = 0;
     std::size_t served_ = 0;  // packets answered by the last serve_buffered()
@@ -153,7 +168,6 @@ class TcpSession : public std::enable_shared_from_this<TcpSession>, private Repl
     static constexpr std::size_t max_late = 64;
     std::deque<std::vector<std::uint8_t>> late_;
     std::function<bool(Bytes)> response_hook_;
-    bool late_writing_ = false;
 };
 
 }  // namespace fins::server

@@ -100,7 +100,8 @@ void TcpSession::on_timer() {
                        : deadline_kind_ == Deadline::frame   ? "frame"
                        : deadline_kind_ == Deadline::idle    ? "idle"
                                                              : "drain";
-    spdlog::info("fins/tcp: {}: {} timeout, closing", peer_.to_string(), what);
+    log_summarised(nodes_.log().timeouts, spdlog::level::info, "fins/tcp: {}: {} timeout, closing",
+                   peer_.to_string(), what);
     close();
 }
 

@@ -19,7 +19,6 @@ namespace {
 // A datagram one byte longer than the largest frame is still received long enough for
 // the dispatcher to answer 1001 instead of seeing a silently truncated frame.
 constexpr std::size_t receive_size = max_frame_size + 1;
-constexpr auto drop_log_interval = std::chrono::seconds(10);
 
 bool would_block(int error) noexcept {
     return error == EAGAIN || error == EWOULDBLOCK;
@@ -152,7 +151,9 @@ int UdpSession::serve_batch() {
         // An answer to one of this node's own Send/Rcv/SendCmd instructions.
         // One it did not wait for goes on to the dispatcher: in a plant the router
         // relays answers for other nodes; a single node drops them there.
-        if (response_hook_ && size > 0 && (frame[0] & icf_response) != 0 && response_hook_(frame))
+        if (response_hook_ && size > 0 && (frame[0] & icf_response) != 0 &&
+            response_hook_(frame, reinterpret_cast<const sockaddr*>(context.peer),
+                           request.msg_hdr.msg_namelen))
             continue;
         const std::size_t n = dispatcher_.handle(
             Bytes{s.in[static_cast<std::size_t>(i)].data(), size}, s.out[replies], context);
@@ -233,15 +234,9 @@ void UdpSession::send_late(Bytes frame, const sockaddr_storage& peer, socklen_t 
 
 void UdpSession::note_dropped(std::uint64_t count) {
     counters_.dropped += count;
-    dropped_unlogged_ += count;
-    const auto now = std::chrono::steady_clock::now();
-    if (last_drop_log_ != std::chrono::steady_clock::time_point{} &&
-        now - last_drop_log_ < drop_log_interval)
-        return;
-    spdlog::warn("fins/udp: send buffer full, {} replies dropped (clients resend on timeout)",
-                 dropped_unlogged_);
-    dropped_unlogged_ = 0;
-    last_drop_log_ = now;
+    if (const auto n = drops_logged_.note(count))
+        spdlog::warn("fins/udp: send buffer full, {} replies dropped (clients resend on timeout)",
+                     n);
 }
 
 }  // namespace fins::server

@@ -32,6 +32,7 @@
 
 #include "fins/frame.hpp"
 #include "server/dispatch/dispatcher.hpp"
+#include "server/sessions/log_summary.hpp"
 
 namespace fins::server {
 
@@ -69,7 +70,8 @@ class UdpSession : public std::enable_shared_from_this<UdpSession>, private Repl
     // PLC-initiated messages (network_instructions.hpp): every received frame whose ICF
     // response bit is set goes to `hook` instead of the dispatcher (which drops
     // responses); the hook returns false for an answer nobody waited for (dropped).
-    using ResponseHook = std::function<bool(Bytes frame)>;
+    // `peer` is the datagram's source address: an answer must come from the node's.
+    using ResponseHook = std::function<bool(Bytes frame, const sockaddr* peer, socklen_t size)>;
     void set_response_hook(ResponseHook hook) { response_hook_ = std::move(hook); }
     // Sends one frame from this socket (the node's own port) to `to`, without blocking.
     // False when the kernel refused it or the send buffer is full.
@@ -95,8 +97,7 @@ class UdpSession : public std::enable_shared_from_this<UdpSession>, private Repl
     Counters counters_;
     std::size_t current_ = 0;  // the datagram being dispatched (defer() answers it)
     ResponseHook response_hook_;
-    std::uint64_t dropped_unlogged_ = 0;
-    std::chrono::steady_clock::time_point last_drop_log_{};
+    LogSummary drops_logged_;  // one warning per interval (log_summary.hpp)
 };
 
 }  // namespace fins::server

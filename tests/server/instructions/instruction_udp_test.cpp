@@ -56,14 +56,31 @@ TEST_F(InstructionUdp, RemoteEntriesComeFirstAndNameOtherNetworks) {
 TEST_F(InstructionUdp, AWildcardBindHasNoPrefix) {
     UdpInstructionTransport t(udp_, asio::ip::make_address("0.0.0.0"), self_, {});
     EXPECT_EQ(endpoint(t, {0, 5, 0}), "none");
-    EXPECT_EQ(t.send_frame({0, 5, 0}, Bytes{}), server::InstructionTransport::Sent::no_route);
+    server::InstructionRoute route;
+    EXPECT_EQ(t.send_frame({0, 5, 0}, Bytes{}, route),
+              server::InstructionTransport::Sent::no_route);
 }
 
 TEST_F(InstructionUdp, WithoutUdpNothingIsSent) {
     UdpInstructionTransport t(nullptr, asio::ip::make_address("127.0.0.1"), self_, {});
     const std::uint8_t frame[12]{0x80};
-    EXPECT_EQ(t.send_frame({0, 5, 0}, Bytes{frame, sizeof frame}),
+    server::InstructionRoute route;
+    EXPECT_EQ(t.send_frame({0, 5, 0}, Bytes{frame, sizeof frame}, route),
               server::InstructionTransport::Sent::no_port);
+}
+
+// Issue 18 item 6: the way a frame went is the node address table's entry, the only
+// address and port its answer is accepted from.
+TEST_F(InstructionUdp, Issue18_TheRouteIsTheAddressAndPortTheFrameWentTo) {
+    UdpInstructionTransport t(udp_, asio::ip::make_address("127.0.0.1"), self_,
+                              {RemoteNode{0, 5, "127.0.0.1", 9700}});
+    const std::uint8_t frame[12]{0x80};
+    server::InstructionRoute route;
+    ASSERT_EQ(t.send_frame({0, 5, 0}, Bytes{frame, sizeof frame}, route),
+              server::InstructionTransport::Sent::ok);
+    EXPECT_EQ(route.connection, nullptr);
+    EXPECT_EQ(route.udp.address().to_string() + ":" + std::to_string(route.udp.port()),
+              "127.0.0.1:9700");
 }
 
 }  // namespace

@@ -23,12 +23,16 @@ using server::InstructionTransport;
 using server::NetworkInstructions;
 
 struct FakeTransport : InstructionTransport {
-    Sent send_frame(const NodeAddress& destination, Bytes frame) override {
+    Sent send_frame(const NodeAddress& destination, Bytes frame,
+                    server::InstructionRoute& way) override {
         destinations.push_back(destination);
         frames.emplace_back(frame.begin(), frame.end());
+        way = route;
         return answer;
     }
     Sent answer = Sent::ok;
+    // Where the remote node is (the node address table's entry).
+    server::InstructionRoute route{{asio::ip::make_address("127.0.0.5"), 9600}, nullptr, 0};
     std::vector<NodeAddress> destinations;
     std::vector<std::vector<std::uint8_t>> frames;
 };
@@ -91,6 +95,10 @@ class Engine : public ::testing::Test {
         io_.restart();
         io_.poll();
     }
+    // An answer arriving the way the command went.
+    bool respond(const std::vector<std::uint8_t>& frame) {
+        return engine_.on_response(Bytes{frame.data(), frame.size()}, transport_.route);
+    }
     std::uint16_t a(std::size_t word) { return plc_.memory().words(Region::auxiliary)[word]; }
 
     asio::io_context io_;
@@ -112,7 +120,7 @@ TEST_F(Engine, W596_3_SendWritesTheLocalWordsWith0102FromTheNodesOwnAddress) {
                                              0x00, 0x02, 0x12, 0x34, 0xAB, 0xCD};
     EXPECT_EQ(f, expected);
     EXPECT_EQ(transport_.destinations[0], remote);
-    EXPECT_TRUE(engine_.on_response(answer(f, 0x0000)));
+    EXPECT_TRUE(respond(answer(f, 0x0000)));
     wait(result);
     EXPECT_TRUE(result->done());
     EXPECT_EQ(result->port, 0);
@@ -128,7 +136,7 @@ TEST_F(Engine, W596_3_RcvStoresTheAnswerInLocalMemory) {
     const auto& f = transport_.frames[0];
     EXPECT_EQ(std::vector<std::uint8_t>(f.begin() + 10, f.end()),
               (std::vector<std::uint8_t>{0x01, 0x01, 0x82, 0x00, 0xC8, 0x00, 0x00, 0x02}));
-    EXPECT_TRUE(engine_.on_response(answer(f, 0x0000, {0x11, 0x22, 0x33, 0x44})));
+    EXPECT_TRUE(respond(answer(f, 0x0000, {0x11, 0x22, 0x33, 0x44})));
     wait(result);
     EXPECT_TRUE(result->done());
     EXPECT_EQ(result->words, (std::vector<std::uint16_t>{0x1122, 0x3344}));
@@ -144,7 +152,7 @@ TEST_F(Engine, W596_3_SendCmdReturnsTheWholeAnswer) {
     start(r, result);
     ASSERT_EQ(transport_.frames.size(), 1u);
     EXPECT_EQ(transport_.frames[0].size(), 12u);
-    EXPECT_TRUE(engine_.on_response(answer(transport_.frames[0], 0x0000, {0xAA, 0xBB})));
+    EXPECT_TRUE(respond(answer(transport_.frames[0], 0x0000, {0xAA, 0xBB})));
     wait(result);
     EXPECT_TRUE(result->done());
     EXPECT_EQ(result->response, (std::vector<std::uint8_t>{0x05, 0x01, 0x00, 0x00, 0xAA, 0xBB}));
@@ -153,7 +161,7 @@ TEST_F(Engine, W596_3_SendCmdReturnsTheWholeAnswer) {
 TEST_F(Engine, W596_3_EndCodeOtherThanNormalIsErrorId0800WithTheEndCode) {
     std::optional<InstructionResult> result;
     start(recv(2), result);
-    EXPECT_TRUE(engine_.on_response(answer(transport_.frames[0], 0x1103)));
+    EXPECT_TRUE(respond(answer(transport_.frames[0], 0x1103)));
     wait(result);
     EXPECT_EQ(result->error_id, 0x0800);
     EXPECT_EQ(result->error_id_ex, 0x1103);
@@ -161,7 +169,7 @@ TEST_F(Engine, W596_3_EndCodeOtherThanNormalIsErrorId0800WithTheEndCode) {
     // W342 5-1-3: 0040 is a normal completion at a CPU Unit with a non-fatal error.
     std::optional<InstructionResult> flagged;
     start(send(1), flagged);
-    EXPECT_TRUE(engine_.on_response(answer(transport_.frames[1], 0x0040)));
+    EXPECT_TRUE(respond(answer(transport_.frames[1], 0x0040)));
     wait(flagged);
     EXPECT_TRUE(flagged->done());
     EXPECT_EQ(flagged->end_code, 0x0040);
@@ -182,7 +190,7 @@ TEST_F(Engine, W596_3_TimeoutRetriesTheSameFrameThenEndsWith0205) {
     EXPECT_EQ(engine_.counters().timeouts, 1u);
     EXPECT_EQ(engine_.counters().retransmissions, 2u);
     // A late answer finds nobody waiting.
-    EXPECT_FALSE(engine_.on_response(answer(transport_.frames[0], 0x0000)));
+    EXPECT_FALSE(respond(answer(transport_.frames[0], 0x0000)));
 }
 
 TEST_F(Engine, W596_3_TimeoutZeroMeansTwoSeconds) {
@@ -221,7 +229,7 @@ TEST_F(Engine, W596_3_TheThirtyThirdInstructionGets0104) {
     for (const auto& f : transport_.frames)
         EXPECT_EQ(seen[f[9]]++, 0);
     // One ends: a port is free again.
-    EXPECT_TRUE(engine_.on_response(answer(transport_.frames[7], 0x0000)));
+    EXPECT_TRUE(respond(answer(transport_.frames[7], 0x0000)));
     poll();
     ASSERT_TRUE(results[7].has_value());
     EXPECT_EQ(results[7]->port, 7);
@@ -282,14 +290,67 @@ TEST_F(Engine, AnswersFromAnotherNodeOrWithAnotherSidAreNotTaken) {
     start(send(1), result);
     auto other = answer(transport_.frames[0], 0);
     other[7] = 6;  // from node 6
-    EXPECT_FALSE(engine_.on_response(other));
+    EXPECT_FALSE(respond(other));
     auto sid = answer(transport_.frames[0], 0);
     ++sid[9];
-    EXPECT_FALSE(engine_.on_response(sid));
-    EXPECT_FALSE(engine_.on_response(std::vector<std::uint8_t>{0xC0, 0x00}));
+    EXPECT_FALSE(respond(sid));
+    EXPECT_FALSE(respond(std::vector<std::uint8_t>{0xC0, 0x00}));
     EXPECT_EQ(engine_.counters().unmatched, 3u);
-    EXPECT_TRUE(engine_.on_response(answer(transport_.frames[0], 0)));
+    EXPECT_TRUE(respond(answer(transport_.frames[0], 0)));
     wait(result);
+}
+
+// Issue 18 item 6: any local process can send a datagram to port 9600 and answer for a
+// node. An answer counts only when it comes the way the command went (the node address
+// table's address and port, or the command's FINS/TCP connection) and names the
+// destination's network, node and unit: a forged one leaves the instruction waiting,
+// and it ends with 0205 (W596 3: "the end code for the communication command").
+TEST_F(Engine, Issue18_ForgedAnswersFromAnotherAddressPortOrConnectionAreIgnored) {
+    std::optional<InstructionResult> result;
+    start(send(1), result);
+    const auto real = answer(transport_.frames[0], 0);
+    const auto from = [&](const char* ip, std::uint16_t port, const void* connection) {
+        server::InstructionRoute r{{asio::ip::make_address(ip), port}, connection, 0};
+        return engine_.on_response(Bytes{real.data(), real.size()}, r);
+    };
+    EXPECT_FALSE(from("127.0.0.5", 9601, nullptr));   // another port of the right host
+    EXPECT_FALSE(from("127.0.0.66", 9600, nullptr));  // another host
+    int other_connection = 0;
+    EXPECT_FALSE(from("127.0.0.5", 9600, &other_connection));  // a FINS/TCP connection
+    auto network = real;
+    network[6] = 0x03;  // SNA: another network
+    EXPECT_FALSE(respond(network));
+    auto unit = real;
+    unit[8] = 0x10;  // SA2: a CPU Bus Unit, not the CPU Unit asked
+    EXPECT_FALSE(respond(unit));
+    auto to_other = real;
+    to_other[4] = 0x09;  // DA1: another node
+    EXPECT_FALSE(respond(to_other));
+    EXPECT_EQ(engine_.counters().unmatched, 6u);
+    wait(result);
+    EXPECT_EQ(result->error_id, server::instruction_communications_error);
+    EXPECT_EQ(result->error_id_ex, 0x0205);
+
+    // The same answer the right way completes the next instruction.
+    result.reset();
+    start(send(1), result);
+    EXPECT_TRUE(respond(answer(transport_.frames[1], 0)));
+    wait(result);
+    EXPECT_TRUE(result->done()) << result->detail;
+}
+
+// W596 3 (Send error g, Rcv j, SendCmd h): "FINS/TCP connection has not been
+// established" ends the instruction at once: ErrorID 0800, ErrorIDEx 0101 (W342 5-1-3
+// "Local node not in network": the node's end of that connection is not up).
+TEST_F(Engine, W596_3_FinsTcpConnectionNotEstablishedIs0800With0101) {
+    std::optional<InstructionResult> result;
+    transport_.answer = InstructionTransport::Sent::not_established;
+    start(send(1), result);
+    wait(result);
+    EXPECT_EQ(result->error_id, server::instruction_communications_error);
+    EXPECT_EQ(result->error_id_ex, 0x0101);
+    EXPECT_EQ(result->transmissions, 1u);
+    EXPECT_NE(result->detail.find("not established"), std::string::npos) << result->detail;
 }
 
 TEST_F(Engine, NoRouteAndFailedSendsEndWithTheirEndCodes) {
@@ -323,7 +384,7 @@ TEST_F(Engine, CsCjPortFlagsA202A203A219FollowTheInstruction) {
     EXPECT_EQ(a(219), 0x0001);
     result.reset();
     start(send(1), result);
-    EXPECT_TRUE(engine_.on_response(answer(transport_.frames[1], 0)));
+    EXPECT_TRUE(respond(answer(transport_.frames[1], 0)));
     wait(result);
     EXPECT_EQ(a(203), 0x0000);
     EXPECT_EQ(a(219), 0x0000);

@@ -9,6 +9,8 @@
 #include <pty.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <string>
 #include <vector>
 
@@ -164,6 +166,54 @@ TEST_F(PortTest, W336_6_1_4_SixthWaitingRequestIsBusy) {
         EXPECT_TRUE(results[i].done);
         EXPECT_EQ(results[i].code, EndCode::response_timeout);
     }
+}
+
+// Every completion belongs to its job (W336 6-1-4: one request at a time on the line):
+// the write of a request that was ended meanwhile (the port closed and opened again)
+// completes late, after the next request started; it must not act on that one (before:
+// its "operation aborted" made the port drop the next request with 0205 and close).
+TEST_F(PortTest, W336_6_1_4_LateWriteCompletionOfAnEndedJobDoesNotTouchTheNext) {
+    // Fill the line so that the first request's write cannot finish at once.
+    ::fcntl(slave_, F_SETFL, O_NONBLOCK);
+    const std::vector<std::uint8_t> filler(4096, 0x55);
+    std::size_t filled = 0;
+    for (int i = 0; i < 10'000; ++i) {
+        const auto n = ::write(slave_, filler.data(), filler.size());
+        if (n <= 0) break;
+        filled += static_cast<std::size_t>(n);
+    }
+    ASSERT_GT(filled, 0U);
+    Result first;
+    const auto request = rtu({0x01, 0x03, 0x00, 0x00, 0x00, 0x01});
+    submit(SerialFraming::modbus_rtu, request, first);
+    port_->close();  // ends the first (0205); its write completes later, aborted
+    ASSERT_TRUE(first.done);
+    EXPECT_EQ(first.code, EndCode::response_timeout);
+    ASSERT_FALSE(port_->open());
+    Result second;
+    submit(SerialFraming::modbus_rtu, request, second);
+    // Drain the line until the second request is on it, then answer it.
+    std::vector<std::uint8_t> line;
+    ::fcntl(master_, F_SETFL, O_NONBLOCK);
+    for (int i = 0; i < 400 && !second.done; ++i) {
+        io_.run_for(5ms);
+        std::array<std::uint8_t, 4096> buf{};
+        for (int reads = 0; reads < 64; ++reads) {
+            const auto n = ::read(master_, buf.data(), buf.size());
+            if (n <= 0) break;
+            line.insert(line.end(), buf.begin(), buf.begin() + n);
+        }
+        if (line.size() >= request.size() &&
+            std::equal(request.begin(), request.end(),
+                       line.end() - static_cast<long>(request.size())))
+            break;
+    }
+    ASSERT_FALSE(second.done) << "ended by the first request's write";
+    line_write(rtu({0x01, 0x03, 0x02, 0x12, 0x34}));
+    run_until(second);
+    ASSERT_TRUE(second.done);
+    EXPECT_EQ(second.code, EndCode::normal_completion);
+    EXPECT_TRUE(port_->is_open());
 }
 
 }  // namespace

@@ -1,0 +1,159 @@
+// `finsd ctl` against a running finsd (issue 18): the CPU Unit selector --plc in a plant
+// of two, the default socket shared with finsd ($FINSD_SOCKET), and --timeout in
+// seconds as `fins --timeout`. Every wait is bounded (process.hpp).
+#include <poll.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "cli/finsd/control_setup.hpp"
+#include "finsd_run.hpp"
+#include "raw_socket.hpp"
+
+namespace fins::test {
+namespace {
+
+using Json = nlohmann::json;
+
+bool has(const std::string& text, const std::string& part) {
+    return text.find(part) != std::string::npos;
+}
+
+RunResult ctl(const std::string& socket, std::vector<std::string> args) {
+    std::vector<std::string> argv{finsd_path, "ctl", "--socket", socket};
+    argv.insert(argv.end(), args.begin(), args.end());
+    return run(argv);
+}
+
+// Plant item: `finsd ctl` reached only the first [[plc]]. --plc NAME or NET.NODE picks
+// any CPU Unit; without it, the first.
+TEST(FinsdCtl, PlcSelectsACpuUnitOfAPlantOfTwo) {
+    ScratchDir dir("ctlplant");
+    const std::string socket = (dir.path() / "ctl.sock").string();
+    const auto config = dir.write("plant.toml", "control = \"" + socket + R"("
+[[plc]]
+name = "press"
+  [[plc.ethernet]]
+  network = 1
+  bind = "127.0.1.1"
+  port = 0
+[[plc]]
+name = "oven"
+  [[plc.ethernet]]
+  network = 1
+  bind = "127.0.1.2"
+  port = 0
+)");
+    Finsd d({"--config", config});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    EXPECT_EQ(ctl(socket, {"--plc", "oven", "mode", "program"}).exit_code, 0);
+    EXPECT_EQ(ctl(socket, {"fal", "3", "--plc", "1.2"}).exit_code, 0);
+    const auto oven = ctl(socket, {"status", "--plc", "oven"});
+    ASSERT_EQ(oven.exit_code, 0) << oven.err;
+    const Json o = Json::parse(oven.out, nullptr, false);
+    EXPECT_EQ(o["status"]["plc"], "oven");
+    EXPECT_EQ(o["status"]["mode"], "program");
+    EXPECT_EQ(o["status"]["error_code"], "4103");
+    const Json p = Json::parse(ctl(socket, {"status"}).out, nullptr, false);
+    EXPECT_EQ(p["status"]["plc"], "press");
+    EXPECT_EQ(p["status"]["mode"], "run");
+    EXPECT_EQ(p["status"]["error_code"], "0000");
+    const auto unknown = ctl(socket, {"status", "--plc", "mixer"});
+    EXPECT_EQ(unknown.exit_code, 2);
+    EXPECT_TRUE(has(unknown.err, "no CPU Unit \"mixer\" here (CPU Units: press, oven)"))
+        << unknown.err;
+    EXPECT_EQ(d.stop().exit_code, 0);
+}
+
+// Newcomer 6: finsd and finsd ctl find the socket the same way, $FINSD_SOCKET first.
+TEST(FinsdCtl, Newcomer6_FinsdAndCtlShareTheDefaultSocket) {
+    ScratchDir dir("ctldefault");
+    const std::string socket = (dir.path() / "default.sock").string();
+    Child d({"/usr/bin/env", "FINSD_SOCKET=" + socket, finsd_path, "--port", "0", "--log-level",
+             "warn"});
+    ASSERT_EQ(d.read_line().rfind("listening ", 0), 0u);
+    const auto r = run({"/usr/bin/env", "FINSD_SOCKET=" + socket, finsd_path, "ctl", "status"});
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(has(r.out, "\"ok\":true")) << r.out;
+    d.terminate();
+    EXPECT_EQ(d.wait().exit_code, 0);
+
+    // The rule itself: FINSD_SOCKET, else XDG_RUNTIME_DIR (not root), else /run/finsd.
+    const char* saved = std::getenv("FINSD_SOCKET");
+    const std::string before = saved != nullptr ? saved : "";
+    ::setenv("FINSD_SOCKET", "/tmp/x.sock", 1);
+    EXPECT_EQ(cli::default_control_socket(), "/tmp/x.sock");
+    ::unsetenv("FINSD_SOCKET");
+    const char* xdg = std::getenv("XDG_RUNTIME_DIR");
+    if (::geteuid() == 0 || xdg == nullptr || *xdg == '\0')
+        EXPECT_EQ(cli::default_control_socket(), "/run/finsd/finsd.sock");
+    else
+        EXPECT_EQ(cli::default_control_socket(), std::filesystem::path(xdg) / "finsd.sock");
+    if (!before.empty()) ::setenv("FINSD_SOCKET", before.c_str(), 1);
+}
+
+// A stand-in control channel: accepts one client, returns its request line, answers.
+class FakeChannel {
+  public:
+    explicit FakeChannel(std::string path) : path_(std::move(path)) {
+        fd_ = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+        sockaddr_un a{};
+        a.sun_family = AF_UNIX;
+        std::strncpy(a.sun_path, path_.c_str(), sizeof a.sun_path - 1);
+        ::bind(fd_, reinterpret_cast<const sockaddr*>(&a), sizeof a);
+        ::listen(fd_, 4);
+    }
+    ~FakeChannel() { ::close(fd_); }
+    std::string serve_one(const std::string& answer) {
+        pollfd p{fd_, POLLIN, 0};
+        if (::poll(&p, 1, 10'000) <= 0) return "";
+        const int c = ::accept(fd_, nullptr, nullptr);
+        if (c < 0) return "";
+        set_receive_timeout(c, 10);
+        std::string line;
+        char ch = 0;
+        while (line.size() < 65536 && ::recv(c, &ch, 1, 0) == 1 && ch != '\n')
+            line += ch;
+        ::send(c, answer.data(), answer.size(), MSG_NOSIGNAL);
+        ::close(c);
+        return line;
+    }
+
+  private:
+    std::string path_;
+    int fd_ = -1;
+};
+
+// Newcomer 12: `finsd ctl --timeout 5` meant 0.5 s while `fins --timeout 5` means 5 s.
+// Both are seconds now, decimals allowed; the control protocol keeps W596's 0.1 s.
+TEST(FinsdCtl, Newcomer12_TimeoutIsSecondsAsInFins) {
+    ScratchDir dir("ctltimeout");
+    const std::string socket = (dir.path() / "fake.sock").string();
+    FakeChannel channel(socket);
+    const std::string done =
+        R"({"ok":true,"result":{"instruction":"send","done":true,"error_id":"0000",)"
+        R"("error_id_ex":"0000","end_code":"0000","port":0,"transmissions":1,"detail":""}})"
+        "\n";
+    for (const auto& [given, tenths] :
+         std::vector<std::pair<std::string, int>>{{"5", 50}, {"0.5", 5}, {"2.3", 23}}) {
+        Child c({finsd_path, "ctl", "--socket", socket, "send", "--dest", "0.5.0", "--local", "D0",
+                 "--remote", "D0", "--timeout", given});
+        const Json request = Json::parse(channel.serve_one(done), nullptr, false);
+        EXPECT_EQ(request["timeout"], tenths) << given;
+        EXPECT_EQ(c.wait().exit_code, 0) << given;
+    }
+    const auto tiny = run({finsd_path, "ctl", "--socket", socket, "send", "--dest", "0.5.0",
+                           "--local", "D0", "--remote", "D0", "--timeout", "0.01"});
+    EXPECT_EQ(tiny.exit_code, 2);
+    EXPECT_TRUE(has(tiny.err, "at least 0.1 s")) << tiny.err;
+}
+
+}  // namespace
+}  // namespace fins::test
