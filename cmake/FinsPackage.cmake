@@ -65,8 +65,10 @@ foreach(pc fins fins-static)
 endforeach()
 
 install(TARGETS finsd fins RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
-install(FILES ${PROJECT_SOURCE_DIR}/README.md ${PROJECT_SOURCE_DIR}/docs/architecture.md
-  ${PROJECT_SOURCE_DIR}/docs/benchmarks.md DESTINATION ${CMAKE_INSTALL_DOCDIR} COMPONENT runtime)
+# README.md and its pages under docs/ keep their relative links.
+install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR} COMPONENT runtime)
+file(GLOB fins_doc_pages CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/docs/*.md)
+install(FILES ${fins_doc_pages} DESTINATION ${CMAKE_INSTALL_DOCDIR}/docs COMPONENT runtime)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/examples/ DESTINATION ${CMAKE_INSTALL_DOCDIR}/examples
   COMPONENT dev FILES_MATCHING PATTERN "*.cpp" PATTERN "*.toml" PATTERN "CMakeLists.txt")
 

@@ -127,14 +127,16 @@ $sudo rm -rf /run/finsd
 [[ -s /var/lib/finsd/finsd.state ]] || fail "state kept in the StateDirectory"
 check "state kept in the StateDirectory"
 
-# What the installed README says about the installed finsd holds.
-readme=/usr/share/doc/finskit/README.md
+# What the installed documentation says about the installed finsd holds.
+[[ -s /usr/share/doc/finskit/README.md ]] || fail "README installed"
+readme=/usr/share/doc/finskit/docs/finsd.md
 said=$(sed -n 's/.*The cj2h file is \([0-9.]*\) MB.*/\1/p' "$readme")
 size=$(stat -c %s /var/lib/finsd/finsd.state)
 measured=$(awk -v s="$size" 'BEGIN { printf "%.1f", s / 1e6 }')
 [[ "$said" == "$measured" ]] || fail "README says the cj2h state file is $said MB, it is $measured MB"
 check "README's state file size ($said MB) is the default profile's"
-# The README's [serial] configuration example loads on the default profile, its devices
+readme=/usr/share/doc/finskit/docs/serial.md
+# The documentation's [serial] configuration example loads on the default profile, its devices
 # replaced by pseudo terminals (socat pairs).
 tmp=$(mktemp -d)
 awk '/^```toml$/ { b = ""; in_block = 1; next }

@@ -1,5 +1,7 @@
-// The README's sample sessions are what the programs print today.
+// The documentation's sample sessions are what the programs print today, and its links
+// lead somewhere.
 //
+// Pages: README.md and every docs/*.md, one test each (a failure names the page).
 // Checked: every fenced block with at least one line starting with "$ ". Such a block
 // is a session against a finsd started for it alone (port 0, a control socket, a
 // scratch working directory); an HTML comment on the line before the fence adds finsd
@@ -12,9 +14,15 @@
 //                       means none. A line "..." stands for any number of lines, and
 //                       "..." inside a line for any text (clock, cycle times).
 // Blocks without "$ " lines (shell recipes, TOML, C++) are not run.
+// Links: every relative link outside code blocks names an existing file, and its #anchor
+// a heading of that page (GitHub's rule: lower case, punctuation dropped, blanks to '-').
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <regex>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -27,7 +35,7 @@
 namespace fins::test {
 namespace {
 
-const std::string readme_path = std::string(FINS_SOURCE_DIR) + "/README.md";
+const std::filesystem::path source_dir = FINS_SOURCE_DIR;
 const std::string fins_bin = std::string(FINS_BIN_DIR) + "/fins";
 constexpr std::string_view wildcard = "...";
 constexpr std::string_view marker = "<!-- readme-test: finsd";
@@ -157,12 +165,101 @@ TEST(Readme, ParsesItsOwnRules) {
     EXPECT_FALSE(lines_match({}, 0, {"unexpected"}, 0));
 }
 
-TEST(Readme, EverySampleSessionPrintsWhatTheReadmeShows) {
-    const auto blocks = checked_blocks(readme_path);
-    ASSERT_GE(blocks.size(), 4u) << "no sample sessions found in " << readme_path;
+// README.md and docs/*.md, as paths relative to the source tree.
+std::vector<std::string> doc_pages() {
+    std::vector<std::string> pages{"README.md"};
+    for (const auto& entry : std::filesystem::directory_iterator(source_dir / "docs"))
+        if (entry.is_regular_file() && entry.path().extension() == ".md")
+            pages.push_back("docs/" + entry.path().filename().string());
+    std::sort(pages.begin() + 1, pages.end());
+    return pages;
+}
+
+// GitHub's anchor for a heading.
+std::string slug(std::string_view heading) {
+    std::string s;
+    for (const char c : heading) {
+        const auto u = static_cast<unsigned char>(c);
+        if (std::isalnum(u) || c == '_' || c == '-')
+            s += static_cast<char>(std::tolower(u));
+        else if (c == ' ')
+            s += '-';
+    }
+    return s;
+}
+
+struct PageText {
+    std::set<std::string> anchors;
+    std::vector<std::pair<int, std::string>> links;  // line, url
+};
+
+PageText read_page(const std::filesystem::path& path) {
+    std::ifstream f(path);
+    PageText page;
+    static const std::regex link(R"(\[[^\]]*\]\(([^)\s]+)\))");
+    std::string line;
+    bool fence = false;
+    int number = 0;
+    while (std::getline(f, line)) {
+        ++number;
+        if (line.rfind("```", 0) == 0) fence = !fence;
+        if (fence) continue;
+        if (const auto hashes = line.find_first_not_of('#');
+            hashes > 0 && hashes != std::string::npos && line[hashes] == ' ')
+            page.anchors.insert(slug(line.substr(hashes + 1)));
+        for (std::sregex_iterator it(line.begin(), line.end(), link), end; it != end; ++it)
+            page.links.emplace_back(number, (*it)[1].str());
+    }
+    return page;
+}
+
+std::string test_name(const testing::TestParamInfo<std::string>& info) {
+    std::string name;
+    for (const char c : info.param)
+        if (std::isalnum(static_cast<unsigned char>(c))) name += c;
+    return name;
+}
+
+class Doc : public testing::TestWithParam<std::string> {};
+
+TEST(Doc, EveryPageIsFoundAndTheSessionsAreMany) {
+    const auto pages = doc_pages();
+    EXPECT_GE(pages.size(), 9u) << "README.md and the docs/ pages";
+    std::size_t blocks = 0;
+    for (const auto& page : pages)
+        blocks += checked_blocks((source_dir / page).string()).size();
+    EXPECT_GE(blocks, 6u) << "sample sessions found in all pages";
+    EXPECT_EQ(slug("FINS/TCP identity and limits"), "finstcp-identity-and-limits");
+    EXPECT_EQ(slug("The `fins` CLI"), "the-fins-cli");
+}
+
+TEST_P(Doc, EveryLinkLeadsToAFileAndAHeading) {
+    const auto here = source_dir / GetParam();
+    const auto page = read_page(here);
+    for (const auto& [line, url] : page.links) {
+        if (url.find("://") != std::string::npos || url.rfind("mailto:", 0) == 0) continue;
+        const auto hash = url.find('#');
+        const auto file = url.substr(0, hash);
+        const auto target = file.empty() ? here : here.parent_path() / file;
+        EXPECT_TRUE(std::filesystem::exists(target))
+            << GetParam() << ":" << line << ": " << url << " names no file";
+        if (hash == std::string::npos || target.extension() != ".md" ||
+            !std::filesystem::exists(target))
+            continue;
+        EXPECT_EQ(read_page(target).anchors.count(url.substr(hash + 1)), 1u)
+            << GetParam() << ":" << line << ": " << url << " names no heading";
+    }
+}
+
+TEST_P(Doc, EverySampleSessionPrintsWhatThePageShows) {
+    const auto& name = GetParam();
+    const auto blocks = checked_blocks((source_dir / name).string());
+    if (name == "README.md") {
+        ASSERT_GE(blocks.size(), 1u) << "the README's tour is gone";
+    }
     const auto home = std::filesystem::current_path();
     for (const auto& block : blocks) {
-        SCOPED_TRACE("README.md:" + std::to_string(block.line));
+        SCOPED_TRACE(name + ":" + std::to_string(block.line));
         ScratchDir dir("readme");
         const std::string socket = (dir.path() / "ctl.sock").string();
         auto args = block.finsd_args;
@@ -182,19 +279,22 @@ TEST(Readme, EverySampleSessionPrintsWhatTheReadmeShows) {
                 argv.erase(argv.begin() + 4);  // the second "ctl"
             }
             ASSERT_FALSE(argv.empty())
-                << "README.md:" << step.line
+                << name << ":" << step.line
                 << ": only fins and finsd ctl run in a session: " << step.command;
             if (words[0] == "fins") argv.insert(argv.end(), words.begin() + 1, words.end());
             const auto r = run(argv);
             const auto actual = lines_of(r.out + r.err);
             EXPECT_TRUE(lines_match(step.expected, 0, actual, 0))
-                << "README.md:" << step.line << ": $ " << step.command << "\nREADME shows:\n"
+                << name << ":" << step.line << ": $ " << step.command << "\n"
+                << name << " shows:\n"
                 << joined(step.expected) << "the program printed (exit " << r.exit_code << "):\n"
                 << joined(actual);
         }
         std::filesystem::current_path(home);
     }
 }
+
+INSTANTIATE_TEST_SUITE_P(Pages, Doc, testing::ValuesIn(doc_pages()), test_name);
 
 }  // namespace
 }  // namespace fins::test
