@@ -2,6 +2,7 @@
 #include "server/instructions/network_instructions.hpp"
 
 #include <algorithm>
+#include <iterator>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -36,7 +37,8 @@ InstructionResult communications_error(EndCode code, std::string why) {
 }
 
 }  // namespace
-// One instruction port: its request, frame and retry timer (allocated once).
+// One instruction port: its request, frame and retry timer (allocated on first use, then
+// kept).
 struct NetworkInstructions::Port {
     explicit Port(const asio::any_io_executor& ex) : timer(ex) {}
     bool busy = false;
@@ -55,9 +57,9 @@ struct NetworkInstructions::Port {
 NetworkInstructions::NetworkInstructions(asio::any_io_executor executor, plc::Plc& plc,
                                          NodeAddress self, InstructionTransport& transport)
     : executor_(std::move(executor)), plc_(plc), self_(self), transport_(transport) {
+    // Ports are made on first use (start()): a plant of 1,000 CPU Units that never sends
+    // would otherwise keep 32 ports of 2 KB frames resident in each (74 KB per unit).
     ports_.reserve(max_instructions);
-    for (std::size_t i = 0; i < max_instructions; ++i)
-        ports_.push_back(std::make_unique<Port>(executor_));
     const auto& profile = plc_.profile();
     flags_ = !profile.nx_fixed_values && profile.auxiliary_words > a_port_error;
     for (std::size_t i = 0; i < flagged_ports; ++i)
@@ -109,7 +111,13 @@ void NetworkInstructions::start(InstructionRequest request, InstructionCallback 
         r.detail = "nothing to send (size 0)";
         return complete_later(std::move(done), std::move(r));
     }
-    const auto free = std::find_if(ports_.begin(), ports_.end(), [](auto& p) { return !p->busy; });
+    auto free = std::find_if(ports_.begin(), ports_.end(), [](auto& p) { return !p->busy; });
+    // Every port made so far is busy: the next one (the lowest free index, as when all 32
+    // existed from the start), up to W596's 32.
+    if (free == ports_.end() && ports_.size() < max_instructions) {
+        ports_.push_back(std::make_unique<Port>(executor_));
+        free = std::prev(ports_.end());
+    }
     if (free == ports_.end()) {
         ++counters_.errors;
         return complete_later(std::move(done),
