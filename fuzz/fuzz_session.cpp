@@ -32,6 +32,7 @@
 #include <spdlog/spdlog.h>
 #include <asio/io_context.hpp>
 
+#include "every_route.hpp"
 #include "fins/frame.hpp"
 #include "fins/tcp.hpp"
 #include "plc/plc.hpp"
@@ -87,13 +88,7 @@ struct Session {
             dispatcher->attach(router, port);
             router.set_dispatcher(port, *dispatcher);
         }
-        plc::RoutingTables tables;
-        tables.local[0] = {1, 0};
-        tables.local[1] = {2, 1};
-        tables.local_count = 2;
-        tables.relay[0] = {3, 2, 5};
-        tables.relay_count = 1;
-        plc::encode_routing_tables(tables, plc.parameters().words(plc::routing_table_area));
+        fins_fuzz::write_routing_tables(plc);
 
         server::ServerOptions options;
         options.bind_address = "127.0.0.1";
@@ -107,16 +102,7 @@ struct Session {
         server = std::move(*started);
         router.set_dispatcher(a1_port, server->dispatcher());
 
-        server::GatewayPortConfig gateway;
-        gateway.name = "scu0.1";
-        gateway.unit_address = 0x80;
-        gateway.line.device = "/nonexistent/fuzz-gateway";
-        ports.add(std::make_shared<server::SerialGatewayPort>(io, gateway));
-        server::GatewayPortConfig host_link = gateway;
-        host_link.name = "scu0.2";
-        host_link.unit_address = 0x81;
-        host_link.network = 5;
-        ports.add(std::make_shared<server::SerialGatewayPort>(io, host_link));
+        fins_fuzz::add_gateway_ports(io, ports);
         server->attach_serial_ports(&ports);
         udp = client_socket(SOCK_DGRAM, server->udp_port());
     }
