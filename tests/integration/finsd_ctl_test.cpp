@@ -72,6 +72,53 @@ name = "oven"
     EXPECT_EQ(d.stop().exit_code, 0);
 }
 
+// Plant item, W596 3: `finsd ctl --plc NAME send` runs on that CPU Unit's own instruction
+// engine (it used to answer "no network instructions" in a plant): each CPU Unit sends
+// its own words to the other, over FINS/UDP on their fixed loopback addresses.
+TEST(FinsdCtl, W596_3_SendRunsOnTheCpuUnitPlcNames) {
+    const FixedPorts fixed_ports;  // 127.0.82.x:9611 (finsd_run.hpp)
+    ScratchDir dir("ctlsend");
+    const std::string socket = (dir.path() / "ctl.sock").string();
+    const auto config = dir.write("plant.toml", "control = \"" + socket + R"("
+[[plc]]
+name = "press"
+  [[plc.ethernet]]
+  network = 1
+  node = 1
+  bind = "127.0.82.1"
+  port = 9611
+[[plc]]
+name = "oven"
+  [[plc.ethernet]]
+  network = 1
+  node = 2
+  bind = "127.0.82.2"
+  port = 9611
+)");
+    Finsd d({"--config", config});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    const std::string fins = std::string(FINS_BIN_DIR) + "/fins";
+    const auto at = [&](const std::string& host, const std::string& dest,
+                        std::vector<std::string> args) {
+        std::vector<std::string> argv{fins,     "--host", host,        "--port", "9611",
+                                      "--dest", dest,     "--timeout", "5"};
+        argv.insert(argv.end(), args.begin(), args.end());
+        return run(argv);
+    };
+    ASSERT_EQ(at("127.0.82.2", "1.2.0", {"write", "D0", "7", "8"}).exit_code, 0);
+    const auto sent = ctl(socket, {"--plc", "oven", "send", "--dest", "1.1.0", "--local", "D0",
+                                   "--remote", "D100", "--count", "2"});
+    ASSERT_EQ(sent.exit_code, 0) << sent.out << sent.err;
+    EXPECT_TRUE(has(sent.out, "wrote 2 words")) << sent.out;
+    EXPECT_EQ(at("127.0.82.1", "1.1.0", {"read", "D100", "2"}).out, "D100  7\nD101  8\n");
+    ASSERT_EQ(ctl(socket, {"--plc", "press", "send", "--dest", "1.2.0", "--local", "D100",
+                           "--remote", "D300", "--count", "2"})
+                  .exit_code,
+              0);
+    EXPECT_EQ(at("127.0.82.2", "1.2.0", {"read", "D300", "2"}).out, "D300  7\nD301  8\n");
+    EXPECT_EQ(d.stop().exit_code, 0);
+}
+
 // Newcomer 6: finsd and finsd ctl find the socket the same way, $FINSD_SOCKET first.
 TEST(FinsdCtl, Newcomer6_FinsdAndCtlShareTheDefaultSocket) {
     ScratchDir dir("ctldefault");
