@@ -36,7 +36,8 @@ int fail(int code, const std::string& message) {
     return code;
 }
 
-// Above this many units the "unit N is FINS node ..." lines are logged at debug level.
+// Above this many units (CPU Units) the lines for each ("unit N is FINS node ...", "N
+// memory entries written") are logged at debug level.
 constexpr std::size_t units_logged_at_info = 64;
 
 // The plant keeps a socket or two per unit open (server::plant_descriptors): the soft
@@ -149,8 +150,11 @@ int set_up_cpu(asio::io_context& io, const Settings& s, server::Plant& plant, st
     if (auto r = check_schedule(scheduled, plc.memory()); !r)
         return fail(2, in_plant(r.error(), plc_path(i)));
     const auto written = apply_initial_memory(cpu.memory, plc.memory(), plc.storage().restored());
+    // A line per CPU Unit at info for a plant a person reads; a site's go to debug.
     if (!cpu.memory.empty())
-        spdlog::info("finsd: plc \"{}\": {} memory entries written", config.name, written);
+        spdlog::log(
+            plant.cpu_count() <= units_logged_at_info ? spdlog::level::info : spdlog::level::debug,
+            "finsd: plc \"{}\": {} memory entries written", config.name, written);
     apply_cpu_options(cpu, plc);  // [plc.protection], [plc.inject]
 
     // Serial Gateway ports answer on every unit of the CPU Unit; the Host Link slave
