@@ -1,8 +1,12 @@
 // fins_plant_load: (1) the relayed 1-word read rate through two routers at 32 in flight,
 // as a ratio of the direct rate in the same run (three-network plant of
-// examples/three-networks.toml on free ports); (2) a plant of --nodes CJ2H CPU Units on
-// 4 networks (127.0.20-23.x): time until every unit answers, RSS, and RSS after a client
-// polled 10 words from each (docs/benchmarks.md "A plant of several networks").
+// examples/three-networks.toml on free ports; --relay false skips it); (2) a plant of
+// --nodes CJ2H CPU Units, 250 per network on at least 4 networks (127.0.20.x,
+// 127.0.21.x ...; --tcp false: FINS/UDP only): time until every unit is bound, RSS, a
+// first round reading 10 words from each unit one at a time (its answer must come from
+// its own address and node), RSS then, and the poll rate over every unit at 64 in flight
+// for --seconds (docs/benchmarks.md "A site of 10,000 CPU Units"). Exit 1 when a unit
+// did not answer.
 #include <algorithm>
 #include <array>
 #include <chrono>
