@@ -120,7 +120,10 @@ IoMemory::IoMemory(Profile profile, Storage& storage) : profile_(std::move(profi
     completion_forced_ = take(storage, "io.tc.forced", flag_words, C);
 
     // Cleared parts of the partly retained sections: the timers (indexes below
-    // counter_base; counter_base is a multiple of 16, so whole flag words) and A.
+    // counter_base; counter_base is a multiple of 16, so whole flag words) and A. Only
+    // a restored state file holds anything there: fresh sections are zero already, and
+    // clearing them would make their pages resident (10 KB a CPU Unit, issue 19).
+    if (!storage.restored()) return;
     const WordRange counters{counter_base, tc};
     clear_except(timer_counter_pv_, std::span<const WordRange>(&counters, 1));
     const WordRange counter_flags{counter_base / bits_per_word, flag_words};

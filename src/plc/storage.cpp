@@ -61,6 +61,8 @@ Unexpected fail(std::error_code e) {
 }  // namespace
 
 constexpr std::size_t lazy_section_bytes = 16 * 1024;
+// The chunk the small heap sections are packed into (on_heap); a CJ2H's fit in one.
+constexpr std::size_t chunk_bytes = 128 * 1024;
 
 struct Storage::Impl {
     // Heap sections, 8-byte aligned (enough for every stored type).
@@ -70,10 +72,12 @@ struct Storage::Impl {
     sf::Header* header = nullptr;
     std::vector<std::pair<void*, std::size_t>> maps;
     std::vector<std::pair<void*, std::size_t>> anonymous;  // heap sections, lazily backed
-    std::vector<std::span<std::byte>> sections;            // by entry index
-    std::vector<bool> claimed;                             // per existing entry
-    bool existing = false;                                 // restored from finsd.state
-    bool creating = false;                                 // building finsd.state.new
+    std::byte* chunk_next = nullptr;  // the free rest of the last small-section chunk
+    std::size_t chunk_left = 0;
+    std::vector<std::span<std::byte>> sections;  // by entry index
+    std::vector<bool> claimed;                   // per existing entry
+    bool existing = false;                       // restored from finsd.state
+    bool creating = false;                       // building finsd.state.new
     bool verified = false;
     bool sealed = false;
     bool closed = false;
@@ -85,19 +89,40 @@ struct Storage::Impl {
     std::vector<std::pair<void*, std::size_t>> guarded;
     std::unique_ptr<StateFileGuard> guard;
 
+    // Anonymous memory the kernel backs lazily with zero pages (nullptr: refused).
+    void* reserve(std::size_t length) {
+        void* p = ::mmap(nullptr, length, PROT_READ | PROT_WRITE,
+                         MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
+        if (p == MAP_FAILED) return nullptr;
+        anonymous.emplace_back(p, length);
+        return p;
+    }
+
     std::span<std::byte> on_heap(std::size_t bytes) {
-        // Large sections (EM banks, DM) come from anonymous memory the kernel backs
-        // lazily with zero pages: a plant of 1,000 CPU Units pays only for the pages its
-        // clients touch (issue 10; docs/benchmarks.md "A plant of 1,000 CPU Units").
+        // Every section comes from anonymous memory the kernel backs lazily with zero
+        // pages: a plant of 10,000 CPU Units pays only for the pages its clients touch
+        // (issues 10 and 19; docs/benchmarks.md). Large sections (EM banks, DM) get a
+        // mapping each; the small ones (about 28 per CPU Unit, 67 KB in all for a CJ2H)
+        // are packed into shared chunks, where zeroed heap blocks made each resident.
         if (bytes >= lazy_section_bytes) {
-            const std::size_t length = round_up(bytes);
-            void* p = ::mmap(nullptr, length, PROT_READ | PROT_WRITE,
-                             MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
-            if (p != MAP_FAILED) {
-                anonymous.emplace_back(p, length);
-                return {static_cast<std::byte*>(p), bytes};
+            if (void* p = reserve(round_up(bytes))) return {static_cast<std::byte*>(p), bytes};
+        } else {
+            const std::size_t size = (std::max<std::size_t>(bytes, 1) + 15) / 16 * 16;
+            if (chunk_left < size) {
+                chunk_left = 0;
+                if (void* p = reserve(chunk_bytes)) {
+                    chunk_next = static_cast<std::byte*>(p);
+                    chunk_left = chunk_bytes;
+                }
+            }
+            if (chunk_left >= size) {
+                std::byte* p = chunk_next;
+                chunk_next += size;
+                chunk_left -= size;
+                return {p, bytes};
             }
         }
+        // No mapping to be had: zeroed heap memory, resident but correct.
         heap.emplace_back((bytes + 7) / 8 + 1, 0);
         return {reinterpret_cast<std::byte*>(heap.back().data()), bytes};
     }

@@ -4,11 +4,13 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -82,6 +84,29 @@ TEST(Storage, HeapModeIsZeroedAndNeverRestored) {
     EXPECT_TRUE(s.path().empty());
     s.flush();
     EXPECT_TRUE(s.array<std::uint16_t>("empty", 0, R).empty());
+}
+
+// Small heap sections are packed together (many per chunk, more than one chunk): each
+// starts zeroed and aligned, and none overlaps another; large ones sit beside them.
+TEST(Storage, PackedHeapSectionsAreZeroedAlignedAndApart) {
+    Storage s;
+    std::vector<std::span<std::uint8_t>> sections;
+    for (std::size_t i = 0; i < 400; ++i)  // about 1.2 MB in all: several chunks
+        sections.push_back(s.array<std::uint8_t>("s" + std::to_string(i), 1 + i * 15, C));
+    auto large = s.array<std::uint16_t>("large", 40'000, R);
+    for (std::size_t i = 0; i < sections.size(); ++i) {
+        ASSERT_EQ(sections[i].size(), 1 + i * 15);
+        EXPECT_EQ(reinterpret_cast<std::uintptr_t>(sections[i].data()) % 16, 0u) << i;
+        for (auto b : sections[i])
+            ASSERT_EQ(b, 0) << i;
+        std::memset(sections[i].data(), static_cast<int>(i % 251) + 1, sections[i].size());
+    }
+    for (auto& w : large)
+        ASSERT_EQ(w, 0);
+    std::fill(large.begin(), large.end(), std::uint16_t{0xFFFF});
+    for (std::size_t i = 0; i < sections.size(); ++i)
+        for (auto b : sections[i])
+            ASSERT_EQ(b, static_cast<std::uint8_t>(i % 251 + 1)) << i;
 }
 
 TEST_F(StorageFile, RetainedSectionsAreRestoredClearedOnesAreNot) {

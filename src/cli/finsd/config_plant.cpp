@@ -3,7 +3,9 @@
 
 #include <cctype>
 #include <chrono>
+#include <cstdio>
 #include <optional>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -33,6 +35,10 @@ class PlantLoader {
             const auto* table = (*array)[i].as_table();
             const std::string path = fmt::format("plc[{}]", i);
             if (table == nullptr) return fail((*array)[i].source(), path, "must be a table");
+            if (const auto* repeat = table->get("repeat")) {
+                if (auto r = load_repeated(*table, *repeat, path, settings); !r) return r;
+                continue;
+            }
             PlantCpuConfig cpu;
             Settings::PlantCpuSettings extra;
             if (auto r = load_cpu(*table, path, cpu, extra); !r) return r;
@@ -43,6 +49,105 @@ class PlantLoader {
     }
 
   private:
+    // A [[plc]] with `repeat = { networks = "20-59", nodes = "1-250" }` is a template:
+    // one CPU Unit per network and node (networks outer, nodes inner), each loaded from
+    // the same table with {network}, {node} and {index} (0, 1, ... in that order)
+    // replaced in its strings (name, bind, data_dir ...), and each [[plc.ethernet]]
+    // without a network on the repeated network. Errors name the table's position and
+    // the CPU Unit: "plc[0](20.3).ethernet[0].bind".
+    Expected<void> load_repeated(const toml::table& t, const toml::node& repeat,
+                                 const std::string& path, Settings& settings) {
+        const auto* r = repeat.as_table();
+        const std::string rp = path + ".repeat";
+        if (r == nullptr)
+            return fail(repeat.source(), rp,
+                        "must be a table: { networks = \"20-59\", nodes = \"1-250\" }");
+        std::optional<std::pair<int, int>> networks, nodes;
+        for (auto&& [k, v] : *r) {
+            const std::string key(k.str());
+            const std::string p = rp + "." + key;
+            if (key != "networks" && key != "nodes") return fail(k.source(), p, "unknown key");
+            auto range = span_of(v, p, 1, key == "networks" ? 127 : 254);
+            if (!range) return tl::unexpected(range.error());
+            (key == "networks" ? networks : nodes) = *range;
+        }
+        if (!networks || !nodes) return fail(repeat.source(), rp, "needs networks and nodes");
+        // Each CPU Unit needs a name of its own.
+        const auto name = t.get_as<std::string>("name");
+        if (name != nullptr) {
+            const std::string& n = name->get();
+            const bool index = n.find("{index}") != std::string::npos;
+            const bool node = n.find("{node}") != std::string::npos;
+            const bool network = n.find("{network}") != std::string::npos;
+            if (!index && !(node && (network || networks->first == networks->second)))
+                return fail(name->source(), path + ".name",
+                            "with repeat, must contain {index}, or {node} (and {network} "
+                            "when several networks repeat)");
+        }
+        const auto* ethernet = t.get_as<toml::array>("ethernet");
+        std::size_t index = 0;
+        for (int network = networks->first; network <= networks->second; ++network)
+            for (int node = nodes->first; node <= nodes->second; ++node) {
+                substitution_ = Substitution{network, node, index++};
+                PlantCpuConfig cpu;
+                Settings::PlantCpuSettings extra;
+                const auto r2 =
+                    load_cpu(t, fmt::format("{}({}.{})", path, network, node), cpu, extra);
+                substitution_.reset();
+                if (!r2) return r2;
+                for (std::size_t k = 0; k < cpu.ports.size(); ++k) {
+                    const auto* e = ethernet != nullptr ? (*ethernet)[k].as_table() : nullptr;
+                    if (e != nullptr && !e->contains("network"))
+                        cpu.ports[k].network = static_cast<std::uint8_t>(network);
+                }
+                settings.plant.cpus.push_back(std::move(cpu));
+                settings.plant_cpu.push_back(std::move(extra));
+            }
+        return {};
+    }
+
+    // An integer or "FIRST-LAST", within lo-hi.
+    Expected<std::pair<int, int>> span_of(const toml::node& v, const std::string& path, int lo,
+                                          int hi) const {
+        if (const auto* i = v.as_integer()) {
+            if (i->get() < lo || i->get() > hi)
+                return fail(v.source(), path, fmt::format("{} is not {}-{}", i->get(), lo, hi));
+            return std::pair<int, int>(static_cast<int>(i->get()), static_cast<int>(i->get()));
+        }
+        const auto* s = v.as_string();
+        int first = 0, last = 0;
+        char dash = 0, extra = 0;
+        if (s == nullptr ||
+            std::sscanf(s->get().c_str(), "%d %c %d %c", &first, &dash, &last, &extra) != 3 ||
+            dash != '-')
+            return fail(v.source(), path, "must be an integer or a range \"FIRST-LAST\"");
+        if (first < lo || last > hi || first > last)
+            return fail(v.source(), path,
+                        fmt::format("{}-{} is not a range within {}-{}", first, last, lo, hi));
+        return std::pair<int, int>(first, last);
+    }
+
+    // The placeholders of the CPU Unit a repeated [[plc]] is being loaded for.
+    struct Substitution {
+        int network;
+        int node;
+        std::size_t index;
+    };
+    std::string substituted(std::string s) const {
+        if (!substitution_) return s;
+        const auto replace = [&s](std::string_view name, const std::string& value) {
+            for (auto at = s.find(name); at != std::string::npos; at = s.find(name, at)) {
+                s.replace(at, name.size(), value);
+                at += value.size();
+            }
+        };
+        replace("{network}", std::to_string(substitution_->network));
+        replace("{node}", std::to_string(substitution_->node));
+        replace("{index}", std::to_string(substitution_->index));
+        return s;
+    }
+    std::optional<Substitution> substitution_;
+
     tl::unexpected<Error> fail(const toml::source_region& where, std::string_view path,
                                std::string_view message) const {
         return tl::unexpected<Error>(fmt::format("{}:{}:{}: {}: {}", source_, where.begin.line,
@@ -60,7 +165,7 @@ class PlantLoader {
     Expected<std::string> text(const toml::node& v, const std::string& path) const {
         const auto* s = v.as_string();
         if (s == nullptr) return fail(v.source(), path, "must be a string");
-        return s->get();
+        return substituted(s->get());
     }
     Expected<bool> flag(const toml::node& v, const std::string& path) const {
         const auto* b = v.as_boolean();
@@ -85,6 +190,7 @@ class PlantLoader {
         std::optional<toml::source_region> storage_at, files_at;
         for (auto&& [k, v] : t) {
             const std::string key(k.str());
+            if (key == "repeat") continue;  // load_repeated's
             const std::string p = path + "." + key;
             Expected<void> r;
             if (key == "name") {

@@ -1,6 +1,8 @@
 // finsd with [[plc]] tables: the plant (server/routing/plant.hpp) on one I/O thread, and
 // what each CPU Unit has beyond its units: memory table, protections, injections, serial
 // ports and scheduled network instructions, set up as finsd sets them up for one node.
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <chrono>
 #include <csignal>
@@ -33,6 +35,25 @@ namespace {
 int fail(int code, const std::string& message) {
     std::fprintf(stderr, "finsd: %s\n", message.c_str());
     return code;
+}
+
+// Above this many units (CPU Units) the lines for each ("unit N is FINS node ...", "N
+// memory entries written") are logged at debug level.
+constexpr std::size_t units_logged_at_info = 64;
+
+// The plant keeps a socket or two per unit open (server::plant_descriptors): the soft
+// limit on open files goes up to the hard one when the plant needs more than it allows
+// (a shell's 1,024 is a plant of ~480 units). Plant::start refuses what still does not fit.
+void raise_descriptor_limit(std::size_t needed) {
+    rlimit limit{};
+    if (::getrlimit(RLIMIT_NOFILE, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return;
+    if (needed + server::descriptor_reserve <= limit.rlim_cur || limit.rlim_cur >= limit.rlim_max)
+        return;
+    const rlim_t was = limit.rlim_cur;
+    limit.rlim_cur = limit.rlim_max;
+    if (::setrlimit(RLIMIT_NOFILE, &limit) == 0)
+        spdlog::info("finsd: open files limit raised from {} to {} for the plant's sockets", was,
+                     limit.rlim_cur);
 }
 
 std::string plc_path(std::size_t cpu) {
@@ -130,8 +151,11 @@ int set_up_cpu(asio::io_context& io, const Settings& s, server::Plant& plant, st
     if (auto r = check_schedule(scheduled, plc.memory()); !r)
         return fail(2, in_plant(r.error(), plc_path(i)));
     const auto written = apply_initial_memory(cpu.memory, plc.memory(), plc.storage().restored());
+    // A line per CPU Unit at info for a plant a person reads; a site's go to debug.
     if (!cpu.memory.empty())
-        spdlog::info("finsd: plc \"{}\": {} memory entries written", config.name, written);
+        spdlog::log(
+            plant.cpu_count() <= units_logged_at_info ? spdlog::level::info : spdlog::level::debug,
+            "finsd: plc \"{}\": {} memory entries written", config.name, written);
     apply_cpu_options(cpu, plc);  // [plc.protection], [plc.inject]
 
     // Serial Gateway ports answer on every unit of the CPU Unit; the Host Link slave
@@ -171,6 +195,7 @@ int serve_plant(const Settings& s) {
     server::PlantConfig config;
     if (const auto problem = plant_config(s, config); !problem.empty()) return fail(2, problem);
     warn_single_node_keys(s);
+    raise_descriptor_limit(server::plant_descriptors(config));
     asio::io_context io{1};
     auto plant = server::Plant::start(io, config);
     if (!plant) return fail(3, "cannot start the plant: " + plant.error().message());
@@ -202,19 +227,25 @@ int serve_plant(const Settings& s) {
     auto& control = control_start.server;
     asio::signal_set signals{io, SIGINT, SIGTERM};
     auto& router = (*plant)->router();
-    for (std::size_t i = 0; i < config.cpus.size(); ++i)
-        for (std::size_t k = 0; k < config.cpus[i].ports.size(); ++k) {
-            auto& server = (*plant)->server(i, k);
-            const auto self = server.address();
-            spdlog::info("finsd: plc \"{}\" unit {} is FINS node {}.{} on {} port {}",
-                         config.cpus[i].name, config.cpus[i].ports[k].unit_number, self.network,
-                         self.node, config.cpus[i].ports[k].bind,
-                         server.tcp_port() != 0 ? server.tcp_port() : server.udp_port());
-        }
+    // A line per unit at info for a plant a person reads; a site's 10,000 go to debug.
+    const auto unit_level =
+        router.port_count() <= units_logged_at_info ? spdlog::level::info : spdlog::level::debug;
+    if (spdlog::should_log(unit_level))
+        for (std::size_t i = 0; i < config.cpus.size(); ++i)
+            for (std::size_t k = 0; k < config.cpus[i].ports.size(); ++k) {
+                auto& server = (*plant)->server(i, k);
+                const auto self = server.address();
+                spdlog::log(unit_level,
+                            "finsd: plc \"{}\" unit {} is FINS node {}.{} on {} port {}",
+                            config.cpus[i].name, config.cpus[i].ports[k].unit_number, self.network,
+                            self.node, config.cpus[i].ports[k].bind,
+                            server.tcp_port() != 0 ? server.tcp_port() : server.udp_port());
+            }
     auto& first = (*plant)->server(0, 0);
     const unsigned port = first.tcp_port() != 0 ? first.tcp_port() : first.udp_port();
-    spdlog::info("finsd: plant of {} CPU Units, {} units", (*plant)->cpu_count(),
-                 router.port_count());
+    spdlog::info("finsd: plant of {} CPU Units, {} units{}", (*plant)->cpu_count(),
+                 router.port_count(),
+                 unit_level == spdlog::level::info ? "" : " (a line per unit at debug level)");
     std::printf("listening %u\n", port);
     std::fflush(stdout);
     signals.async_wait([&](std::error_code, int signal) {

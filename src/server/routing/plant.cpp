@@ -1,6 +1,10 @@
 // Plant: start-up of several CPU Units and their ports, glued by the Router (plant.hpp).
 #include "server/routing/plant.hpp"
 
+#include <sys/resource.h>
+
+#include <filesystem>
+#include <map>
 #include <set>
 #include <utility>
 
@@ -91,10 +95,19 @@ std::string validate_plant(const PlantConfig& config) {
     if (config.cpus.empty()) return "plc: no CPU Unit";
     std::set<std::string> names;
     std::set<std::pair<int, int>> nodes;
+    std::map<std::filesystem::path, std::string> data_dirs;
     for (const auto& cpu : config.cpus) {
         const std::string who = fmt::format("plc \"{}\"", cpu.name);
         if (cpu.name.empty()) return "plc: a CPU Unit without a name";
         if (!names.insert(cpu.name).second) return who + ": the name is used twice";
+        // Each state file is locked by its one CPU Unit (plc/storage.hpp).
+        if (cpu.data_dir) {
+            const auto [at, inserted] =
+                data_dirs.emplace(cpu.data_dir->lexically_normal(), cpu.name);
+            if (!inserted)
+                return fmt::format("{}: data_dir {} is plc \"{}\"'s too", who,
+                                   cpu.data_dir->string(), at->second);
+        }
         if (plc::find_profile(cpu.profile) == nullptr)
             return fmt::format("{}: unknown profile '{}'", who, cpu.profile);
         if (cpu.ports.empty()) return who + ": no [[plc.ethernet]] unit";
@@ -197,7 +210,49 @@ Result<std::unique_ptr<plc::Plc>> open_cpu(const PlantCpuConfig& c, const plc::P
 
 }  // namespace
 
+std::size_t plant_descriptors(const PlantConfig& config) noexcept {
+    std::size_t n = 0;
+    for (const auto& cpu : config.cpus) {
+        for (const auto& p : cpu.ports)
+            n += (p.udp ? 1u : 0u) + (p.tcp ? 1u : 0u);
+        for (const auto& r : cpu.remotes)
+            n += r.tcp ? cpu.ports.size() : 0u;
+        if (cpu.data_dir) n += 3;  // the locked directory, its state file, the file memory
+    }
+    return n;
+}
+
+namespace {
+
+// The descriptors this process has open now.
+std::size_t open_descriptors() {
+    std::error_code ec;
+    std::size_t n = 0;
+    for (std::filesystem::directory_iterator it("/proc/self/fd", ec), end; !ec && it != end;
+         it.increment(ec))
+        ++n;
+    return n;
+}
+
+}  // namespace
+
 Result<std::unique_ptr<Plant>> Plant::start(asio::io_context& io, const PlantConfig& config) {
+    // Refuse up front what would fail at the 9,000th unit: every unit's sockets, with
+    // room left for FINS/TCP connections and the process's own files.
+    if (rlimit limit{};
+        ::getrlimit(RLIMIT_NOFILE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) {
+        const std::size_t sockets = plant_descriptors(config);
+        const std::size_t open = open_descriptors();
+        const std::size_t needed = sockets + open + descriptor_reserve;
+        if (needed > limit.rlim_cur) {
+            spdlog::error(
+                "finsd: the plant needs {} descriptors ({} for its units' sockets and state "
+                "files, {} open, {} kept for connections and files) but the limit is {} "
+                "(ulimit -n): raise it, or set tcp = false on units no FINS/TCP client uses",
+                needed, sockets, open, descriptor_reserve, limit.rlim_cur);
+            return Unexpected(std::make_error_code(std::errc::too_many_files_open));
+        }
+    }
     auto impl = std::make_unique<Impl>();
     impl->cpus.reserve(config.cpus.size());
     for (const auto& c : config.cpus) {

@@ -126,6 +126,18 @@ std::size_t unit_toward(const PlantCpuConfig& cpu, std::uint8_t network) noexcep
 // Empty when the configuration is usable, else one line naming the CPU Unit.
 std::string validate_plant(const PlantConfig& config);
 
+// The descriptors a plant keeps open: a FINS/UDP socket and a FINS/TCP listener per
+// unit (each unit has its own address and port, as each Ethernet Unit has), a FINS/TCP
+// client connection per [[remote]] with tcp on each unit, and the state file, its
+// directory and the file memory's root per CPU Unit with a data_dir (without one, the
+// file memory's temporary root is made, and held, at the unit's first 22 xx command).
+// Nothing else holds a descriptor per unit (the timers share the one reactor on the one
+// I/O thread). FINS/TCP connections that clients open come on top (at most
+// max_connections per unit). Plant::start refuses a plant that would leave fewer than
+// descriptor_reserve under RLIMIT_NOFILE.
+std::size_t plant_descriptors(const PlantConfig& config) noexcept;
+inline constexpr std::size_t descriptor_reserve = 64;
+
 class Plant {
   public:
     static Result<std::unique_ptr<Plant>> start(asio::io_context& io, const PlantConfig& config);

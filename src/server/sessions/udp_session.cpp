@@ -31,8 +31,8 @@ bool would_block(int error) noexcept {
 // wired once here and only the lengths and reply addresses change per batch.
 struct UdpSession::Slots {
     // Not zeroed: only received bytes and written replies are ever read, so the pages of
-    // the 128 KB buffers are backed only once datagrams use them (a plant of 1,000 units
-    // costs little until its units are busy; docs/benchmarks.md).
+    // the 128 KB buffers are backed only once datagrams use them. One set per thread,
+    // not per session: a plant of 10,000 units had 10,000 (issue 19; docs/benchmarks.md).
     std::array<std::array<std::uint8_t, receive_size>, batch_size> in;
     std::array<std::array<std::uint8_t, max_frame_size>, batch_size> out;
     std::array<sockaddr_storage, batch_size> peers{};
@@ -54,8 +54,20 @@ struct UdpSession::Slots {
     }
 };
 
+namespace {
+
+// The batch buffers of the sessions this thread serves (udp_session.hpp): one batch is
+// served to its end before the next session's starts, and nothing in it waits.
+UdpSession::Slots& thread_slots() {
+    thread_local const std::unique_ptr<UdpSession::Slots> slots =
+        std::make_unique<UdpSession::Slots>();
+    return *slots;
+}
+
+}  // namespace
+
 UdpSession::UdpSession(asio::generic::datagram_protocol::socket socket, Dispatcher& dispatcher)
-    : socket_(std::move(socket)), dispatcher_(dispatcher), slots_(std::make_unique<Slots>()) {}
+    : socket_(std::move(socket)), dispatcher_(dispatcher) {}
 
 UdpSession::~UdpSession() = default;
 
@@ -125,7 +137,7 @@ bool UdpSession::serve_turn() {
 }
 
 int UdpSession::serve_batch() {
-    Slots& s = *slots_;
+    Slots& s = thread_slots();
     for (auto& m : s.in_msgs)
         m.msg_hdr.msg_namelen = sizeof(sockaddr_storage);
     const int received =
@@ -172,7 +184,7 @@ int UdpSession::serve_batch() {
 }
 
 void UdpSession::send_replies(unsigned count) {
-    Slots& s = *slots_;
+    Slots& s = thread_slots();
     unsigned done = 0;
     // Each pass sends at least one reply or gives up on one; EINTR retries are bounded.
     for (unsigned attempt = 0; done < count && attempt < 2 * batch_size; ++attempt) {
@@ -210,8 +222,10 @@ bool UdpSession::send_to(Bytes frame, const sockaddr* to, socklen_t to_size) noe
 }
 
 Completion UdpSession::defer() {
-    const auto& request = slots_->in_msgs[current_];
-    return [weak = weak_from_this(), peer = slots_->peers[current_],
+    // Called while serve_batch dispatches datagram current_, on this thread.
+    const Slots& s = thread_slots();
+    const auto& request = s.in_msgs[current_];
+    return [weak = weak_from_this(), peer = s.peers[current_],
             size = request.msg_hdr.msg_namelen](Bytes frame) {
         if (auto self = weak.lock(); self && self->open()) self->send_late(frame, peer, size);
     };

@@ -9,8 +9,11 @@
 //   turn goes back to the other sessions and continues after them), then wait. A turn
 //   that starts with a lone datagram waits at once (a client with one request in flight
 //   sends its next only after this reply: the extra recvmmsg would find nothing).
-// All buffers live in the session, allocated once: the path allocates nothing per
-// datagram.
+// The batch buffers (128 KB) are allocated once per thread and shared by the sessions
+// that thread serves, which take turns: a batch is received, answered and sent before
+// another session's starts, and an answer that waits (defer()) copies what it keeps.
+// The path allocates nothing per datagram, and a plant of 10,000 units one set of
+// buffers, not 10,000.
 //
 // A full socket send buffer (sendmmsg would block) drops the replies that did not fit,
 // as an Ethernet Unit whose send buffer is full does: FINS/UDP has no delivery
@@ -78,9 +81,9 @@ class UdpSession : public std::enable_shared_from_this<UdpSession>, private Repl
     // False when the kernel refused it or the send buffer is full.
     bool send_to(Bytes frame, const sockaddr* to, socklen_t to_size) noexcept;
 
-  private:
-    struct Slots;  // the per-batch buffers and message headers
+    struct Slots;  // the per-batch buffers and message headers (one set per thread)
 
+  private:
     void wait_readable();
     void on_readable();
     // Serves up to rounds_per_turn batches; false when the socket was found empty.
@@ -94,7 +97,6 @@ class UdpSession : public std::enable_shared_from_this<UdpSession>, private Repl
 
     asio::generic::datagram_protocol::socket socket_;
     Dispatcher& dispatcher_;
-    std::unique_ptr<Slots> slots_;
     Counters counters_;
     std::size_t current_ = 0;  // the datagram being dispatched (defer() answers it)
     ResponseHook response_hook_;
