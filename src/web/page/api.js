@@ -41,16 +41,19 @@ export async function postJson(path, body, params = {}) {
   }));
 }
 
-// A WebSocket that reconnects (1 s, doubling to 10 s), resumes from the last sequence
-// number it saw, and re-sends its subscriptions so the server answers with snapshots for
-// anything the resume could not replay. Subscriptions are kept by id; subscribing an
-// id again replaces it.
+// A WebSocket that reconnects (1 s, doubling to 10 s) and resumes: the server greets
+// every connection with {"type":"hello","session"}; after a reconnect the page asks
+// {"op":"resume","session","seq"} for the old session and gets what it missed
+// ("resumed"), or "resume_failed" and then subscribes again (fresh snapshots).
+// Subscriptions are kept by id; subscribing an id again replaces it on the server.
 export class Live {
   constructor(onMessage, onState) {
     this.onMessage = onMessage;
     this.onState = onState;
     this.subs = new Map();
-    this.seq = null;
+    this.session = null;   // the session whose messages we hold
+    this.seq = 0;          // the last seq seen in it
+    this.pending = [];     // subscribe/unsubscribe made while not connected
     this.ws = null;
     this.delay = 1000;
     this.timer = null;
@@ -66,12 +69,10 @@ export class Live {
       return;
     }
     this.ws = ws;
+    this.ready = false;
     this.onState('connecting');
     ws.onopen = () => {
       this.delay = 1000;
-      this.onState('live');
-      if (this.seq !== null) this.send({op: 'resume', seq: this.seq});
-      for (const sub of this.subs.values()) this.send(sub);
     };
     ws.onmessage = (event) => {
       let msg;
@@ -80,19 +81,54 @@ export class Live {
       } catch {
         return;
       }
-      if (typeof msg.seq === 'number') {
-        if (this.seq !== null && msg.seq <= this.seq) return;  // replayed twice
-        this.seq = msg.seq;
-      }
-      this.onMessage(msg);
+      this.receive(msg);
     };
     ws.onclose = () => {
       if (this.ws !== ws) return;
       this.ws = null;
+      this.ready = false;
       this.onState('offline');
       this.retry();
     };
     ws.onerror = () => ws.close();
+  }
+
+  receive(msg) {
+    switch (msg.type) {
+      case 'hello':
+        this.fresh = {session: msg.session, seq: msg.seq ?? 0};
+        if (this.session) {
+          this.raw({op: 'resume', session: this.session, seq: this.seq});
+        } else {
+          this.begin();
+        }
+        return;
+      case 'resumed':
+        this.ready = true;
+        this.onState('live');
+        for (const op of this.pending) this.raw(op);
+        this.pending = [];
+        return;
+      case 'resume_failed':
+        this.begin();  // this connection's own session, with every subscription again
+        return;
+      default:
+        break;
+    }
+    if (typeof msg.seq === 'number') {
+      if (msg.seq <= this.seq) return;  // replayed twice
+      this.seq = msg.seq;
+    }
+    this.onMessage(msg);
+  }
+
+  begin() {
+    this.session = this.fresh.session;
+    this.seq = this.fresh.seq;
+    this.pending = [];
+    this.ready = true;
+    this.onState('live');
+    for (const sub of this.subs.values()) this.raw(sub);
   }
 
   retry() {
@@ -101,8 +137,13 @@ export class Live {
     this.delay = Math.min(this.delay * 2, 10000);
   }
 
-  send(obj) {
+  raw(obj) {
     if (this.ws && this.ws.readyState === WebSocket.OPEN) this.ws.send(JSON.stringify(obj));
+  }
+
+  send(obj) {
+    if (this.ready) this.raw(obj);
+    else this.pending.push(obj);
   }
 
   subscribe(sub) {

@@ -86,11 +86,13 @@ const trend = new Trend($('trend-canvas'), $('trend-tags'), app);
 function onMessage(msg) {
   if (grid.onMessage(msg)) return;
   if (trend.onMessage(msg)) return;
-  if (msg.id === 'st') {
-    if (msg.error) return;
+  if (msg.type === 'error') {
+    if (msg.id !== 'st') toast(msg.error);
+    return;
+  }
+  if (msg.id === 'st' && msg.value && typeof msg.value === 'object') {
     state.statusLive = true;
-    const s = msg.status ?? msg.data ?? msg.value;
-    if (s && typeof s === 'object') showStatus(s);
+    showStatus(msg.value);
   }
 }
 
@@ -114,28 +116,43 @@ function areasOf(p) {
   return list;
 }
 
+function areaButton(a, text) {
+  const b = document.createElement('button');
+  b.textContent = text;
+  b.dataset.prefix = a.prefix;
+  b.dataset.test = `area-${a.prefix}`;
+  b.title = `${a.prefix}0 - ${a.prefix}${a.words - 1}`;
+  b.addEventListener('click', () => go(`${a.prefix}0`));
+  return b;
+}
+
 function renderAreas() {
   const ul = $('area-list');
   ul.textContent = '';
+  const banks = [];
   for (const a of areasOf(state.plc)) {
+    if (/^E[0-9A-F]+_$/.test(a.prefix)) {
+      banks.push(a);
+      continue;
+    }
     const li = document.createElement('li');
-    const b = document.createElement('button');
-    b.textContent = a.label;
-    b.dataset.prefix = a.prefix;
-    b.title = `${a.prefix}0 - ${a.prefix}${a.words - 1}`;
+    const b = areaButton(a, a.label);
     const size = document.createElement('span');
     size.className = 'dim';
     size.textContent = a.words >= 1024 ? `${Math.round(a.words / 1024)}K` : String(a.words);
     b.append(size);
-    b.addEventListener('click', () => go(`${a.prefix}0`));
     li.append(b);
     ul.append(li);
   }
+  const box = $('bank-list');
+  box.textContent = '';
+  $('banks').hidden = !banks.length;
+  for (const a of banks) box.append(areaButton(a, a.prefix.slice(1, -1)));
   markArea();
 }
 
 function markArea() {
-  for (const b of $('area-list').querySelectorAll('button')) {
+  for (const b of document.querySelectorAll('#area-list button, #bank-list button')) {
     b.classList.toggle('current', b.dataset.prefix === grid.area.prefix);
   }
 }
@@ -164,6 +181,7 @@ function go(text) {
     return false;
   }
   grid.show(r.area, r.word);
+  if (document.activeElement !== $('goto')) $('goto').value = grid.address(grid.selected);
   markArea();
   saveHash();
   return true;
@@ -252,7 +270,7 @@ async function refreshStatus() {
   statusInFlight = true;
   try {
     const j = await getJson('/api/status', {plc: plcKey(state.plc)});
-    showStatus(j.status && typeof j.status === 'object' ? {...j, ...j.status} : j);
+    showStatus(j);
   } catch (e) {
     $('cpu-model').textContent = e.message;
   } finally {

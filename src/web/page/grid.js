@@ -141,20 +141,31 @@ export class Grid {
   onMessage(msg) {
     const s = this.sub;
     if (!s || msg.id !== s.id) return typeof msg.id === 'string' && msg.id.startsWith('g');
-    if (msg.error) {
-      this.message.textContent = msg.error;
+    if (msg.type === 'error') {
+      this.message.textContent = `${this.address(s.first)}: ${msg.error}`;
       this.message.classList.add('bad');
       return true;
     }
     this.message.classList.remove('bad');
-    if (this.message.dataset.kind !== 'edit') this.message.textContent = '';
+    this.message.textContent = '';
     const now = performance.now();
-    const snapshot = msg.type === 'snapshot';
-    if (snapshot) for (let w = s.first; w < s.first + s.count; w++) this.words.delete(w);
-    for (const [offset, value] of msg.changes ?? []) {
-      const w = s.first + offset;
-      if (!snapshot && this.words.has(w) && this.words.get(w) !== value) this.flash.set(w, now);
-      this.words.set(w, value);
+    if (msg.type === 'snapshot') {
+      const values = msg.values ?? [];
+      for (let i = 0; i < s.count; i++) {
+        const w = s.first + i;
+        const v = values[i];
+        if (v === undefined) this.words.delete(w);
+        else {
+          if (this.words.has(w) && this.words.get(w) !== v) this.flash.set(w, now);
+          this.words.set(w, v);
+        }
+      }
+    } else {
+      for (const [offset, value] of msg.changes ?? []) {
+        const w = s.first + offset;
+        if (this.words.has(w) && this.words.get(w) !== value) this.flash.set(w, now);
+        this.words.set(w, value);
+      }
     }
     this.schedule();
     if (this.flash.size) setTimeout(() => this.schedule(), FLASH_MS + 20);

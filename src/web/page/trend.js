@@ -54,12 +54,13 @@ export class Trend {
   onMessage(msg) {
     const t = this.tags.find((x) => x.id === msg.id);
     if (!t) return false;
-    if (msg.error) {
+    if (msg.type === 'error') {
       this.app.toast(`${t.address}: ${msg.error}`);
       this.remove(t.id);
       return true;
     }
-    for (const [offset, value] of msg.changes ?? []) t.words[offset] = value;
+    if (msg.type === 'snapshot') t.words = (msg.values ?? []).slice();
+    else for (const [offset, value] of msg.changes ?? []) t.words[offset] = value;
     const v = toNumber(t.as, t.words);
     if (v !== null && v !== t.value) {
       t.value = v;
