@@ -27,6 +27,7 @@ export class Grid {
     this.words = new Map();      // absolute word -> value
     this.flash = new Map();      // absolute word -> time it changed
     this.selected = 0;           // absolute word of the selected value
+    this.bit = 15;               // the selected bit in the bits view
     this.sub = null;             // {id, first, count}
     this.subCounter = 0;
     this.editing = null;
@@ -150,6 +151,10 @@ export class Grid {
     this.message.textContent = '';
     const now = performance.now();
     if (msg.type === 'snapshot') {
+      if (!this.shown) {
+        this.shown = true;
+        performance.mark('finsd-first-values');  // bench/web_page.py: interactive
+      }
       const values = msg.values ?? [];
       for (let i = 0; i < s.count; i++) {
         const w = s.first + i;
@@ -244,7 +249,7 @@ export class Grid {
       const w = words[0] ?? 0;
       let b = 15;
       for (const el of cell.children) {
-        el.className = text !== '' && (w >> b) & 1 ? 'on' : '';
+        el.className = (text !== '' && (w >> b) & 1 ? 'on' : '') + (word === this.selected && b === this.bit ? ' sel' : '');
         b--;
       }
       cell.title = `${this.address(word)} = ${text === '' ? '?' : '0x' + (w.toString(16).toUpperCase().padStart(4, '0'))}`;
@@ -259,8 +264,10 @@ export class Grid {
     if (!cell || cell.dataset.word === undefined) return;
     const word = Number(cell.dataset.word);
     this.select(word);
-    if (this.viewId === 'bits' && e.target.dataset.bit !== undefined && e.detail === 1) {
-      this.toggleBit(word, Number(e.target.dataset.bit));
+    if (this.viewId === 'bits' && e.target.dataset.bit !== undefined) {
+      this.bit = Number(e.target.dataset.bit);
+      if (e.detail === 1) this.toggleBit(word, this.bit);
+      this.schedule();
     }
     this.root.focus({preventScroll: true});
     e.preventDefault();
@@ -293,7 +300,13 @@ export class Grid {
     const moves = {
       ArrowLeft: -per, ArrowRight: per, ArrowUp: -wpr, ArrowDown: wpr, PageUp: -page, PageDown: page,
     };
-    if (e.key in moves) {
+    if (this.viewId === 'bits' && (e.key === 'ArrowLeft' || e.key === 'ArrowRight')) {
+      // Bits run 15 (left) to 0 (right) inside a word, then on to the next word.
+      const right = e.key === 'ArrowRight';
+      if (right && this.bit === 0) { this.bit = 15; this.select(this.selected + 1); }
+      else if (!right && this.bit === 15) { this.bit = 0; this.select(this.selected - 1); }
+      else { this.bit += right ? -1 : 1; this.schedule(); }
+    } else if (e.key in moves) {
       this.select(this.selected + moves[e.key]);
     } else if (e.key === 'Home') {
       this.select(0);
@@ -302,7 +315,7 @@ export class Grid {
     } else if (e.key === 'Enter' || e.key === 'F2') {
       if (this.viewId !== 'bits') this.beginEdit(this.selected);
     } else if (e.key === ' ' && this.viewId === 'bits') {
-      this.toggleBit(this.selected, 0);
+      this.toggleBit(this.selected, this.bit);
     } else if (e.key === 't') {
       this.app.addTrend(this.selectedTag());
     } else if (/^[-+0-9.a-fA-F]$/.test(e.key) && this.viewId !== 'bits' && !(this.viewId !== 'hex' && /[a-fA-F]/.test(e.key))) {

@@ -67,10 +67,10 @@ export function renderCpu(s, plc) {
 // Switches that are control verbs of the status object: key in status -> request.
 const SWITCHES = [
   {key: 'network_write_protection', label: 'Network write protection',
-   hint: 'FINS writes from the network answer 2101 (W342 5-1-2 note 5)',
+   hint: 'FINS writes from the network answer 2102 (W342 5-1-2 note 5)',
    cmd: (on) => ({cmd: 'network_write_protection', on})},
   {key: 'um_read_protection', label: 'UM read protection',
-   hint: 'Program reads answer 2102 (protected)',
+   hint: 'The commands W342 5-1-2 disables under it answer 2002',
    cmd: (on) => ({cmd: 'um_read_protection', on})},
   {key: 'battery_low', label: 'Battery error',
    hint: 'Non-fatal error 00F7: 06 01 reports it, the ERR/ALM flag is set',
@@ -113,15 +113,16 @@ export function renderSwitches(s, app) {
     const on = sw.value ? sw.value(s) : s[sw.key];
     ul.append(switchRow(sw.label, sw.hint, on, flip(sw.cmd), `switch-${sw.key}`, sw.kind));
   }
-  // Injected faults as the server describes them: {"name": {"on": bool, "description"...}}
-  // or {"name": bool}; each switch sends {"cmd":"fault","name":..,"on":..}.
-  const faults = s.faults && typeof s.faults === 'object' ? s.faults : {};
-  for (const [name, f] of Object.entries(faults)) {
-    const on = typeof f === 'object' && f !== null ? !!(f.on ?? f.active ?? f.enabled) : !!f;
-    const hint = typeof f === 'object' && f !== null ? (f.description ?? f.hint ?? '') : '';
-    const request = typeof f === 'object' && f !== null && f.cmd
-      ? (v) => ({...f.cmd, on: v}) : (v) => ({cmd: 'fault', name, on: v});
-    ul.append(switchRow(name.replaceAll('_', ' '), hint, on, flip(request), `fault-${name}`));
+  // What cannot be switched at run time: shown, not offered.
+  const p = s.protections && typeof s.protections === 'object' ? s.protections : {};
+  if (Array.isArray(p.network_write_nodes) && p.network_write_nodes.length) {
+    ul.append(el('li', 'note', `Nodes allowed to write: ${p.network_write_nodes.join(', ')}`));
+  }
+  if (typeof p.dip_write === 'boolean') {
+    const li = switchRow('DIP switch pin 1 (UM write protection)', 'Set at start-up (--dip-write-protection)',
+                         p.dip_write, () => {}, 'switch-dip_write', 'state');
+    li.querySelector('input').disabled = true;
+    ul.append(li);
   }
   if (focused) ul.querySelector(`[data-test="${focused}"]`)?.focus();
 }
@@ -171,9 +172,9 @@ export function renderConnections(s) {
 export function renderLogs(s) {
   const access = Array.isArray(s.access_log) ? s.access_log : [];
   const errors = Array.isArray(s.error_log) ? s.error_log : [];
-  fillTable($('access-table'), access.slice().reverse(), access.length ? null : [['time', 'time'], ['node', 'node'], ['command', 'command']],
+  fillTable($('access-table'), access.slice().reverse(), [['time', 'time'], ['source', 'source (net.node.unit)'], ['command', 'command']],
             'no write recorded (W342 5-3-27 write access log)');
-  fillTable($('error-table'), errors.slice().reverse(), errors.length ? null : [['time', 'time'], ['code', 'code'], ['name', 'name']],
+  fillTable($('error-table'), errors.slice().reverse(), [['time', 'time'], ['code', 'error code'], ['detail', 'detail']],
             'the error log is empty');
   const na = s.write_access_log_records ?? access.length;
   const ne = s.error_log_records ?? errors.length;
