@@ -8,7 +8,9 @@ const MARGIN_ROWS = 12;
 const MAX_SUBSCRIBED_WORDS = 1000;
 const FLASH_MS = 700;
 
+// Rows start at round decimal addresses, as engineers count words; a double takes 4.
 function wordsPerRow(viewId) {
+  if (viewId === 'bits') return 5;
   return view(viewId).words === 4 ? 8 : 10;
 }
 
