@@ -54,6 +54,7 @@ export class Live {
     this.session = null;   // the session whose messages we hold
     this.seq = 0;          // the last seq seen in it
     this.pending = [];     // subscribe/unsubscribe made while not connected
+    this.paused = false;   // the tab is hidden
     this.ws = null;
     this.delay = 1000;
     this.timer = null;
@@ -128,7 +129,7 @@ export class Live {
     this.pending = [];
     this.ready = true;
     this.onState('live');
-    for (const sub of this.subs.values()) this.raw(sub);
+    if (!this.paused) for (const sub of this.subs.values()) this.raw(sub);
   }
 
   retry() {
@@ -146,15 +147,23 @@ export class Live {
     else this.pending.push(obj);
   }
 
+  // A hidden tab asks for nothing (an idle page costs finsd nothing); shown again, it
+  // subscribes again and gets fresh snapshots.
+  pause(paused) {
+    if (paused === this.paused) return;
+    this.paused = paused;
+    for (const sub of this.subs.values()) this.send(paused ? {op: 'unsubscribe', id: sub.id} : sub);
+  }
+
   subscribe(sub) {
     const old = this.subs.get(sub.id);
     if (old && JSON.stringify(old) === JSON.stringify(sub)) return;
     this.subs.set(sub.id, sub);
-    this.send(sub);
+    if (!this.paused) this.send(sub);
   }
 
   unsubscribe(id) {
     if (!this.subs.delete(id)) return;
-    this.send({op: 'unsubscribe', id});
+    if (!this.paused) this.send({op: 'unsubscribe', id});
   }
 }

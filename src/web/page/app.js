@@ -315,6 +315,7 @@ function wire() {
       if (tab.dataset.tab === 'trend') trend.draw();
     });
   }
+  document.addEventListener('visibilitychange', () => app.live.pause(document.hidden));
   $('help-button').addEventListener('click', () => $('help').showModal());
   document.addEventListener('keydown', (e) => {
     const typing = e.target instanceof HTMLInputElement || e.target instanceof HTMLSelectElement;

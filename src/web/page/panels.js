@@ -229,8 +229,10 @@ export function renderPlant(plcs, current, onSelect) {
   for (const net of [...byNet.keys()].sort((a, b) => a - b)) {
     box.append(el('div', 'net', `Network ${net}`));
     for (const p of byNet.get(net).sort((a, b) => a.node - b.node)) {
-      const b = el('button', 'unit');
+      // A link: a middle click opens that CPU Unit's view in a tab of its own.
+      const b = el('a', 'unit');
       b.dataset.plc = p.name || `${p.net}.${p.node}`;
+      b.href = `#plc=${encodeURIComponent(b.dataset.plc)}&addr=D0&as=uint16`;
       b.dataset.test = `unit-${b.dataset.plc}`;
       const relays = relayTotal(p.relays);
       const routes = (p.routes ?? []).length;
@@ -238,7 +240,11 @@ export function renderPlant(plcs, current, onSelect) {
                el('span', 'unit-model', p.model ?? ''),
                el('span', 'unit-meta', `${routes} route${routes === 1 ? '' : 's'} · ${relays.toLocaleString('en')} relayed`));
       b.setAttribute('aria-current', String(current === p));
-      b.addEventListener('click', () => onSelect(p));
+      b.addEventListener('click', (e) => {
+        if (e.button !== 0 || e.ctrlKey || e.metaKey || e.shiftKey) return;
+        e.preventDefault();
+        onSelect(p);
+      });
       box.append(b);
     }
   }
