@@ -46,28 +46,28 @@ class Finsd:
             cmd += ["--config", str(path)]
         self.stderr_path = self.dir / "stderr.txt"
         self.stderr = open(self.stderr_path, "w")
-        self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=self.stderr, text=True)
+        self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=self.stderr)
         self.port = None
         self.http_port = None
         deadline = time.monotonic() + START_TIMEOUT
-        lines = []
+        # Raw reads: a buffered readline() would hide the second line from select().
+        fd = self.proc.stdout.fileno()
+        out = b""
         while self.port is None or self.http_port is None:
             left = deadline - time.monotonic()
             if left <= 0 or self.proc.poll() is not None:
+                stderr = self.stderr_path.read_text()[-2000:]
                 self.stop()
-                raise RuntimeError(f"finsd did not start: {' '.join(cmd)}\nstdout: {lines}\n"
-                                   f"stderr: {self.stderr_path.read_text()[-2000:]}")
-            ready, _, _ = select.select([self.proc.stdout], [], [], min(left, 0.5))
-            if not ready:
-                continue
-            line = self.proc.stdout.readline()
-            if not line:
-                continue
-            lines.append(line.strip())
-            m = re.match(r"listening (\d+)", line)
+                raise RuntimeError(f"finsd did not start: {' '.join(cmd)}\nstdout: {out!r}\n"
+                                   f"stderr: {stderr}")
+            ready, _, _ = select.select([fd], [], [], min(left, 0.5))
+            if ready:
+                out += os.read(fd, 4096)
+            text = out.decode(errors="replace")
+            m = re.search(r"^listening (\d+)$", text, re.M)
             if m:
                 self.port = int(m.group(1))
-            m = re.search(r"\bhttp\b.*?(\d+)\s*$", line)
+            m = re.search(r"^http\b.*?(\d+)$", text, re.M)
             if m:
                 self.http_port = int(m.group(1))
         self.url = f"http://127.0.0.1:{self.http_port}/"
@@ -202,3 +202,12 @@ def cell_text(driver, word):
 
 def severe_console_errors(driver):
     return [e for e in driver.get_log("browser") if e.get("level") == "SEVERE"]
+
+
+def go_to(driver, address):
+    """Types an address into the address box, as a user does after pressing g."""
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.common.keys import Keys
+    box = driver.find_element(By.ID, "goto")
+    box.clear()
+    box.send_keys(address, Keys.ENTER)

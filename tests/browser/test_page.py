@@ -7,7 +7,7 @@ import urllib.request
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
 
-from conftest import (cell_text, open_page, screenshot, severe_console_errors, wait_for,
+from conftest import (cell_text, go_to, open_page, screenshot, severe_console_errors, wait_for,
                       _chrome)
 
 
@@ -71,7 +71,7 @@ def test_value_written_over_fins_appears_within_1_s(finsd_factory, page):
     wait_for(lambda: cell_text(page, 3) == "12345", 1.0, "D3 = 12345 on the page")
     # Far down the area too: going there subscribes those rows.
     finsd.fins("write", "D32000", 777)
-    page.find_element(By.ID, "goto").send_keys("D32000", Keys.ENTER)
+    go_to(page, "D32000")
     wait_for(lambda: cell_text(page, 32000) == "777", 5, "D32000 = 777 on the page")
 
 

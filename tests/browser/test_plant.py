@@ -1,7 +1,7 @@
 """A plant in the browser: the list of CPU Units by network opens each one's own view."""
 from selenium.webdriver.common.by import By
 
-from conftest import cell_text, open_page, screenshot, wait_for
+from conftest import cell_text, go_to, open_page, screenshot, wait_for
 
 PLANT = """
 [[plc]]
@@ -36,7 +36,7 @@ def test_plant_list_opens_a_cpu_unit(finsd_factory, page):
     assert [u.get_attribute("data-plc") for u in units] == ["press1", "oven"]
     assert "Network 1" in page.find_element(By.ID, "plant-list").text
     # The first CPU Unit is open; its D100 is its own.
-    page.find_element(By.ID, "goto").send_keys("D100\n")
+    go_to(page, "D100")
     wait_for(lambda: cell_text(page, 100) == "1111", 5, "press1's D100")
     page.find_element(By.CSS_SELECTOR, "#plant-list .unit[data-plc='oven']").click()
     wait_for(lambda: page.find_element(By.ID, "unit-title").text == "oven", 5, "oven's view")

@@ -82,6 +82,7 @@ app.live = new Live(onMessage, (s) => {
 
 const grid = new Grid($('grid'), app);
 const trend = new Trend($('trend-canvas'), $('trend-tags'), app);
+window.finsd = {state, grid, trend, live: app.live};  // for the console and the tests
 
 function onMessage(msg) {
   if (grid.onMessage(msg)) return;

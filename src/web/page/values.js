@@ -52,9 +52,9 @@ export function toNumber(viewId, words) {
   const w = words[0];
   switch (viewId) {
     case 'int16': return (w << 16) >> 16;
-    case 'uint32': join(words, 2); return buffer.getUint32(4);
-    case 'int32': join(words, 2); return buffer.getInt32(4);
-    case 'float': join(words, 2); return buffer.getFloat32(4);
+    case 'uint32': join(words, 2); return buffer.getUint32(0);
+    case 'int32': join(words, 2); return buffer.getInt32(0);
+    case 'float': join(words, 2); return buffer.getFloat32(0);
     case 'double': join(words, 4); return buffer.getFloat64(0);
     case 'bcd': { const t = bcdText(w); return t === null ? null : Number(t); }
     default: return w;
