@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <chrono>
 #include <exception>
 #include <string>
 
@@ -16,6 +17,7 @@
 #include "server/control/control_dispatch.hpp"
 #include "server/control/control_requests.hpp"
 #include "web/assets.hpp"
+#include "web/cpu_facts.hpp"
 #include "web/memory_values.hpp"
 
 namespace fins::web {
@@ -131,7 +133,8 @@ Json plc_entry(const WebContext& context, const server::ControlTarget& t) {
                {"net", t.addresses.empty() ? 0 : t.addresses.front().first},
                {"node", t.addresses.empty() ? 0 : t.addresses.front().second},
                {"unit", 0},
-               {"em_banks", t.plc->profile().em_banks}};
+               {"em_banks", t.plc->profile().em_banks},
+               {"areas", memory_areas(t.plc->profile())}};
     if (context.describe) context.describe(t, entry);
     return entry;
 }
@@ -279,6 +282,7 @@ Json status_object(const WebContext& context, const server::ControlTarget& targe
     status["access_log"] = events_object(target)["access_log"];
     status["connections"] = Json::array();
     status["udp_peers"] = Json::array();
+    add_cpu_facts(*target.plc, status, std::chrono::system_clock::now());
     if (context.network_status) context.network_status(target, status);
     return status;
 }

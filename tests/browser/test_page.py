@@ -1,6 +1,7 @@
 """finsd's page in a real browser (issue 16 "Tested in a real browser"): it loads, shows
 what FINS writes, writes what is edited, and its buttons and switches change what FINS
 answers. Each test starts its own finsd; screenshots go to the build's artifacts."""
+import re
 import time
 import urllib.request
 
@@ -40,6 +41,15 @@ def test_page_loads(finsd_factory, page):
     wait_for(lambda: page.find_element(By.ID, "cpu-model").text.startswith("CJ2H"), 5, "the model")
     wait_for(lambda: cell_text(page, 0) == "0", 5, "D0's value")
     assert page.find_element(By.ID, "mode-badge").text == "RUN"
+    # The clock ticks (the CPU Unit's, as 07 01 reads it) and the cycle time is shown.
+    clock = wait_for(lambda: re.fullmatch(r"\d{4}-\d\d-\d\d \d\d:\d\d:\d\d",
+                                          page.find_element(By.ID, "cpu-clock").text), 5, "the clock")
+    assert clock.group(0)[:10] == finsd.fins("clock")[1]["time"][:10]  # unless run at midnight
+    assert "ms" in page.find_element(By.ID, "cpu-cycle").text
+    # The areas are the model's: a CJ2H has H0-H511 (its profile), 25 EM banks.
+    h = page.find_element(By.CSS_SELECTOR, "#area-list button[data-prefix='H']")
+    assert h.get_attribute("title") == "H0 - H511"
+    assert len(page.find_elements(By.CSS_SELECTOR, "#bank-list button")) == 25
     assert page.find_element(By.ID, "control-badge").text == "read only"
     # The script and stylesheet came from finsd itself (CSP) and nothing failed.
     assert severe_console_errors(page) == []

@@ -99,13 +99,12 @@ function onMessage(msg) {
 
 // ---- areas and views ---------------------------------------------------------------
 
-// The CPU Unit's memory areas as /api/plcs gives them ("areas": [{"prefix","words"}]).
-// An older finsd without them: the CS/CJ areas every CPU Unit has, by name only (the
-// server answers an address past an area's end with its error, shown above the grid).
+// The CPU Unit's memory areas as /api/plcs gives them ("areas": [{"prefix","words"}],
+// from the model's profile). A finsd without them: the CS/CJ areas at their largest
+// sizes (the server answers a word past a smaller model's end with its error).
 function areasOf(p) {
   if (p && Array.isArray(p.areas) && p.areas.length) {
-    return p.areas.map((a) => ({prefix: a.prefix ?? a.name, words: a.words ?? a.size ?? 32768,
-                                label: a.label ?? a.name ?? a.prefix}));
+    return p.areas.map((a) => ({prefix: a.prefix, words: a.words, label: a.prefix}));
   }
   const list = [['CIO', 6144], ['W', 512], ['H', 1536], ['A', 1472], ['T', 4096], ['C', 4096],
                 ['D', 32768]].map(([prefix, words]) => ({prefix, words, label: prefix}));
@@ -215,7 +214,7 @@ function selectPlc(p, address) {
   const changed = plcKey(p) !== plcKey(state.plc);
   state.plc = p;
   $('unit-title').textContent = p ? (p.name || p.model || 'CPU Unit') : '—';
-  $('unit-address').textContent = p ? `${p.net}.${p.node}.${p.unit ?? 0}${p.model && p.name ? ' · ' + p.model : ''}` : '';
+  $('unit-address').textContent = p ? `FINS ${p.net}.${p.node}.${p.unit ?? 0}${p.model && p.name ? ' · ' + p.model : ''}` : '';
   document.title = p && p.name ? `${p.name} · finsd` : 'finsd';
   panels.renderPlant(state.plcs, p, (q) => selectPlc(q));
   panels.renderRouting(p);

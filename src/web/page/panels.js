@@ -19,18 +19,36 @@ function fmtMs(v) {
 
 // ---- CPU Unit -------------------------------------------------------------------------
 
+// The CPU Unit clock: the page's own clock plus the offset finsd reports (it changes
+// only when 07 02 sets the clock), so the clock ticks here with no message from finsd.
+let clockOffset = null;
+function two(n) {
+  return String(n).padStart(2, '0');
+}
+function tickClock() {
+  const el = $('cpu-clock');
+  if (clockOffset === null) {
+    el.textContent = '—';
+    return;
+  }
+  const t = new Date(Date.now() + clockOffset * 1000);
+  el.textContent = `${t.getUTCFullYear()}-${two(t.getUTCMonth() + 1)}-${two(t.getUTCDate())} ` +
+                   `${two(t.getUTCHours())}:${two(t.getUTCMinutes())}:${two(t.getUTCSeconds())}`;
+}
+setInterval(() => { if (!document.hidden) tickClock(); }, 1000);
+
 export function renderCpu(s, plc) {
   $('cpu-model').textContent = s.model ?? plc?.model ?? '—';
   const ct = s.cycle_time;
   if (ct && typeof ct === 'object') {
-    const avg = ct.average_ms ?? ct.average ?? ct.avg;
-    const max = ct.max_ms ?? ct.max;
-    const min = ct.min_ms ?? ct.min;
-    $('cpu-cycle').textContent = `${fmtMs(avg)}  (min ${fmtMs(min)}, max ${fmtMs(max)})`;
+    $('cpu-cycle').textContent = ct.max_ms
+      ? `${fmtMs(ct.base_ms)}  (min ${fmtMs(ct.min_ms)}, max ${fmtMs(ct.max_ms)})`
+      : `${fmtMs(ct.base_ms)}  (stopped)`;
   } else {
-    $('cpu-cycle').textContent = ct === undefined ? '—' : fmtMs(ct);
+    $('cpu-cycle').textContent = '—';
   }
-  $('cpu-clock').textContent = s.clock ? String(s.clock).replace('T', ' ') : '—';
+  clockOffset = typeof s.clock_offset_s === 'number' ? s.clock_offset_s : null;
+  tickClock();
   const battery = $('cpu-battery');
   battery.textContent = s.battery_low ? 'low (battery error)' : 'normal';
   battery.className = s.battery_low ? 'warn' : '';
