@@ -31,16 +31,17 @@ ROOT = Path(__file__).resolve().parents[1]
 def start_finsd(bin_dir, workdir):
     cmd = [str(bin_dir / "finsd"), "--port", "0", "--http", "127.0.0.1:0",
            "--control", str(Path(workdir) / "finsd.sock"), "--log-level", "warn"]
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE)
     http = None
+    out = b""
     deadline = time.monotonic() + 20
-    while http is None and time.monotonic() < deadline:
-        ready, _, _ = select.select([proc.stdout], [], [], 0.5)
+    while http is None and time.monotonic() < deadline and proc.poll() is None:
+        ready, _, _ = select.select([proc.stdout.fileno()], [], [], 0.5)
         if ready:
-            line = proc.stdout.readline()
-            m = re.search(r"\bhttp\b.*?(\d+)\s*$", line)
-            if m:
-                http = int(m.group(1))
+            out += os.read(proc.stdout.fileno(), 4096)  # raw: readline() would buffer
+        m = re.search(r"^http\b.*?(\d+)$", out.decode(errors="replace"), re.M)
+        if m:
+            http = int(m.group(1))
     if http is None:
         proc.kill()
         sys.exit("finsd printed no http port")
@@ -65,8 +66,10 @@ def chrome():
 TIMING = """
 const n = performance.getEntriesByType('navigation')[0];
 const m = performance.getEntriesByName('finsd-first-values')[0];
+const h = performance.getEntriesByName('finsd-hello')[0];
 return m ? {response: n.responseEnd, interactive: n.domInteractive,
-            dcl: n.domContentLoadedEventEnd, load: n.loadEventEnd, values: m.startTime} : null;
+            dcl: n.domContentLoadedEventEnd, load: n.loadEventEnd, hello: h ? h.startTime : 0,
+            values: m.startTime} : null;
 """
 
 
@@ -99,6 +102,7 @@ def main():
                   f"(DOM interactive {cold['interactive']:.1f}, load {cold['load']:.1f})")
             for key, name in [("response", "HTML received"), ("interactive", "DOM interactive"),
                               ("dcl", "DOMContentLoaded end"), ("load", "load end"),
+                              ("hello", "WebSocket hello"),
                               ("values", "first values in the grid")]:
                 xs = sorted(t[key] for t in warm)
                 print(f"{args.runs} reloads, {name:26}: median {statistics.median(xs):6.1f} ms, "

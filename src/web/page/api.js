@@ -97,6 +97,7 @@ export class Live {
   receive(msg) {
     switch (msg.type) {
       case 'hello':
+        if (!this.fresh) performance.mark('finsd-hello');  // bench/web_page.py
         this.fresh = {session: msg.session, seq: msg.seq ?? 0};
         if (this.session) {
           this.raw({op: 'resume', session: this.session, seq: this.seq});
