@@ -14,6 +14,7 @@
 #include <boost/url/url_view.hpp>
 
 #include "plc/plc.hpp"
+#include "plc/routing_tables.hpp"
 #include "server/control/control_dispatch.hpp"
 #include "server/control/control_requests.hpp"
 #include "web/assets.hpp"
@@ -135,6 +136,27 @@ Json plc_entry(const WebContext& context, const server::ControlTarget& t) {
                {"unit", 0},
                {"em_banks", t.plc->profile().em_banks},
                {"areas", memory_areas(t.plc->profile())}};
+    // The CPU Unit's routing tables (parameter area 8013, W342 5-3-8): what the router uses.
+    const auto decoded =
+        plc::decode_routing_tables(t.plc->parameters().words(plc::routing_table_area));
+    Json routes = Json::array();
+    if (decoded.state == plc::RoutingTablesState::valid) {
+        const auto& tables = decoded.tables;
+        for (std::size_t i = 0; i < tables.local_count; ++i)
+            routes.push_back({{"network", tables.local[i].network},
+                              {"local", true},
+                              {"unit", tables.local[i].unit}});
+        for (std::size_t i = 0; i < tables.relay_count; ++i)
+            routes.push_back({{"network", tables.relay[i].network},
+                              {"local", false},
+                              {"relay_network", tables.relay[i].relay_network},
+                              {"relay_node", tables.relay[i].relay_node}});
+    }
+    entry["routing_tables"] = decoded.state == plc::RoutingTablesState::valid  ? "valid"
+                              : decoded.state == plc::RoutingTablesState::none ? "none"
+                                                                               : "broken";
+    entry["routes"] = std::move(routes);
+    entry["relays"] = Json::object();
     if (context.describe) context.describe(t, entry);
     return entry;
 }

@@ -177,6 +177,8 @@ int configure(int argc, char** argv, Settings& settings) {
     app.add_option("--serial", o.serial,
                    "Serial port NAME=DEVICE[,baud=9600,parity=even,data=7,stop=2,unit=0,mode=..."
                    ",timeout=1]; NAME cpu, scuN.P or board.P (repeatable; README Host Link)");
+    fins::cli::finsd::HttpFlags http;
+    fins::cli::finsd::add_http_flags(app, http);
     app.add_flag("--reset-state", o.reset_state,
                  "Move a refused state file aside (never deleted) and start with a new one");
     try {
@@ -214,6 +216,10 @@ int configure(int argc, char** argv, Settings& settings) {
     take(o_durability, durability, o.durability);
     if (auto r = apply_overrides(o, settings); !r) return fail(2, r.error());
     if (auto r = validate(settings); !r) return fail(2, r.error());
+    fins::cli::finsd::apply_http_flags(http, settings.http);
+    if (auto r = check_http(settings.http); !r) return fail(2, r.error());
+    if (settings.http.listen)  // until finsd's io_context is Boost.Asio's (the move on main)
+        return fail(2, "--http: this build does not serve HTTP yet");
     // A node list protects nothing unless the mode reads it: refuse the flag rather than
     // let someone believe those nodes are refused (or, under "all", the only ones).
     const auto write_mode = settings.network_write_protection.mode;
