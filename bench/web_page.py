@@ -8,12 +8,11 @@ Interactive = the moment the grid holds the first values from the WebSocket (the
 performance mark "finsd-first-values"), measured from the start of the navigation; the
 Navigation Timing points before it are printed too. Idle cost = finsd's CPU time
 (/proc/PID/stat utime + stime) over --idle seconds with no page, then with the page open
-and nothing changing in the PLC.
+and nothing changing in the PLC, and the WebSocket messages the idle page received.
 """
 import argparse
 import os
 import re
-import select
 import signal
 import statistics
 import subprocess
@@ -30,21 +29,21 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def start_finsd(bin_dir, workdir):
     cmd = [str(bin_dir / "finsd"), "--port", "0", "--http", "127.0.0.1:0",
-           "--control", str(Path(workdir) / "finsd.sock"), "--log-level", "warn"]
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE)
+           "--control", str(Path(workdir) / "finsd.sock")]
+    log = Path(workdir) / "stderr.txt"
+    with open(log, "w") as err:
+        proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=err)
     http = None
-    out = b""
     deadline = time.monotonic() + 20
     while http is None and time.monotonic() < deadline and proc.poll() is None:
-        ready, _, _ = select.select([proc.stdout.fileno()], [], [], 0.5)
-        if ready:
-            out += os.read(proc.stdout.fileno(), 4096)  # raw: readline() would buffer
-        m = re.search(r"^http\b.*?(\d+)$", out.decode(errors="replace"), re.M)
+        # finsd logs "finsd: HTTP on ADDRESS port N" (docs/web.md "Starting it").
+        m = re.search(r"HTTP on \S+ port (\d+)", log.read_text(errors="replace"))
         if m:
             http = int(m.group(1))
+        time.sleep(0.05)
     if http is None:
         proc.kill()
-        sys.exit("finsd printed no http port")
+        sys.exit(f"finsd logged no HTTP port: {log.read_text()[-2000:]}")
     return proc, f"http://127.0.0.1:{http}/"
 
 
@@ -114,12 +113,15 @@ def main():
             alone = cpu_seconds(proc.pid) - before
             driver.get(url)
             time.sleep(3)
+            seq = driver.execute_script("return window.finsd.live.seq")
             before = cpu_seconds(proc.pid)
             time.sleep(args.idle)
             with_page = cpu_seconds(proc.pid) - before
+            messages = driver.execute_script("return window.finsd.live.seq") - seq
             print(f"finsd CPU over {args.idle:.0f} s: no page {alone * 1000:.0f} ms "
                   f"({alone / args.idle * 100:.2f} %), idle page open {with_page * 1000:.0f} ms "
-                  f"({with_page / args.idle * 100:.2f} %)")
+                  f"({with_page / args.idle * 100:.2f} %); WebSocket messages to the idle page: "
+                  f"{messages}")
         finally:
             driver.quit()
             proc.send_signal(signal.SIGTERM)

@@ -63,11 +63,11 @@ class Finsd:
             ready, _, _ = select.select([fd], [], [], min(left, 0.5))
             if ready:
                 out += os.read(fd, 4096)
-            text = out.decode(errors="replace")
-            m = re.search(r"^listening (\d+)$", text, re.M)
+            m = re.search(r"^listening (\d+)$", out.decode(errors="replace"), re.M)
             if m:
                 self.port = int(m.group(1))
-            m = re.search(r"^http\b.*?(\d+)$", text, re.M)
+            # finsd logs "finsd: HTTP on ADDRESS port N" (docs/web.md "Starting it").
+            m = re.search(r"HTTP on \S+ port (\d+)", self.stderr_path.read_text(errors="replace"))
             if m:
                 self.http_port = int(m.group(1))
         self.url = f"http://127.0.0.1:{self.http_port}/"
