@@ -42,7 +42,7 @@ export function renderCpu(s, plc) {
   const ct = s.cycle_time;
   if (ct && typeof ct === 'object') {
     $('cpu-cycle').textContent = ct.max_ms
-      ? `${fmtMs(ct.base_ms)}  (min ${fmtMs(ct.min_ms)}, max ${fmtMs(ct.max_ms)})`
+      ? `${fmtMs(ct.base_ms)} · min ${Number(ct.min_ms).toFixed(1)} · max ${Number(ct.max_ms).toFixed(1)}`
       : `${fmtMs(ct.base_ms)}  (stopped)`;
   } else {
     $('cpu-cycle').textContent = '—';
