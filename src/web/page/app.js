@@ -77,6 +77,7 @@ const app = {
 
 app.live = new Live(onMessage, (s) => {
   $('link').dataset.state = s;
+  document.body.dataset.link = s;  // stale values are dimmed while offline
   $('link-text').textContent = s;
 });
 
@@ -293,6 +294,9 @@ function wire() {
       $('goto').blur();
       $('grid').focus({preventScroll: true});
     }
+  });
+  $('goto').addEventListener('keydown', (e) => {
+    if (e.key === 'Escape') $('grid').focus({preventScroll: true});
   });
   $('grid').addEventListener('selectionchange', () => {
     if (document.activeElement !== $('goto')) $('goto').value = grid.address(grid.selected);
