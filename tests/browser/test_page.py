@@ -111,11 +111,18 @@ def test_value_edited_on_the_page_is_read_back_over_fins(finsd_factory, page):
     page.find_element(By.CSS_SELECTOR, "#views button[data-view='float']").click()
     edit_cell(page, 20, "-3.25")
     wait_for(lambda: finsd.read("D20", as_="float") == [-3.25], 5, "D20 = -3.25 over FINS")
+    # The bits view: a click on bit 3 of D40 sets it.
+    page.find_element(By.CSS_SELECTOR, "#views button[data-view='bits']").click()
+    bit = wait_for(lambda: page.find_element(By.CSS_SELECTOR, "#grid-rows .cell[data-word='40'] i[data-bit='3']"),
+                   5, "bit 3 of D40")
+    bit.click()
+    wait_for(lambda: finsd.read("D40") == [8], 5, "D40 = 8 over FINS")
+    wait_for(lambda: "on" in bit.get_attribute("class"), 5, "the bit lit")
     # A value the view cannot hold is refused with the server's message; nothing written.
     page.find_element(By.CSS_SELECTOR, "#views button[data-view='uint16']").click()
     edit_cell(page, 30, "70000")
     toast = wait_for(lambda: page.find_element(By.ID, "toast").text, 5, "an error message")
-    assert toast
+    assert "70000" in toast
     assert finsd.read("D30") == [0]
     screenshot(page, "page-edited")
 
