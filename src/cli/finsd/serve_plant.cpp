@@ -10,13 +10,14 @@
 #include <vector>
 
 #include <spdlog/spdlog.h>
-#include <asio/io_context.hpp>
-#include <asio/signal_set.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/signal_set.hpp>
 
 #include "cli/finsd/config_plant.hpp"
 #include "cli/finsd/control_setup.hpp"
 #include "cli/finsd/serial_gateway_setup.hpp"
 #include "cli/finsd/serial_ports.hpp"
+#include "cli/finsd/web_setup.hpp"
 #include "plc/injections.hpp"
 #include "plc/profile.hpp"
 #include "server/control/control.hpp"
@@ -24,6 +25,7 @@
 #include "server/routing/router.hpp"
 #include "server/serial/serial_ports.hpp"
 #include "server/sessions/server.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::cli::finsd {
 
@@ -192,6 +194,16 @@ int serve_plant(const Settings& s) {
         const auto& p = (*plant)->router().port(i);
         targets[p.cpu].addresses.emplace_back(p.address.network, p.address.node);
     }
+    // --http (docs/web.md): every CPU Unit, each with its first unit's server.
+    std::vector<const server::Server*> first_units;
+    for (std::size_t i = 0; i < targets.size(); ++i)
+        first_units.push_back(&(*plant)->server(i, 0));
+    auto web = start_web(io, s.http, targets, first_units, plant->get());
+    if (web.exit_code >= 0) {
+        extras.stop();
+        std::fprintf(stderr, "finsd: %s\n", web.error.c_str());
+        return web.exit_code;
+    }
     auto control_start = start_control(io, std::move(targets), s.control_socket);
     if (control_start.exit_code >= 0) {
         extras.stop();
@@ -221,6 +233,7 @@ int serve_plant(const Settings& s) {
         extras.stop();
         (*plant)->stop();
         if (control) control->stop();
+        if (web.server) web.server->stop();
         io.stop();
     });
     io.run();
