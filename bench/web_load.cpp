@@ -31,11 +31,11 @@
 #include <boost/beast/websocket.hpp>
 
 #include "plc/plc.hpp"
+#include "transport/asio.hpp"
 #include "web/http_server.hpp"
 
 namespace {
 
-namespace asio = boost::asio;
 namespace beast = boost::beast;
 namespace websocket = beast::websocket;
 using Clock = std::chrono::steady_clock;

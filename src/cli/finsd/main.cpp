@@ -37,6 +37,7 @@
 #include "cli/finsd/ctl.hpp"
 #include "cli/finsd/serial_gateway_setup.hpp"
 #include "cli/finsd/serial_ports.hpp"
+#include "cli/finsd/web_setup.hpp"
 #include "plc/plc.hpp"
 #include "plc/profile.hpp"
 #include "plc/storage.hpp"
@@ -219,8 +220,6 @@ int configure(int argc, char** argv, Settings& settings) {
     if (auto r = validate(settings); !r) return fail(2, r.error());
     fins::cli::finsd::apply_http_flags(http, settings.http);
     if (auto r = check_http(settings.http); !r) return fail(2, r.error());
-    if (settings.http.listen)  // until finsd's io_context is Boost.Asio's (the move on main)
-        return fail(2, "--http: this build does not serve HTTP yet");
     // A node list protects nothing unless the mode reads it: refuse the flag rather than
     // let someone believe those nodes are refused (or, under "all", the only ones).
     const auto write_mode = settings.network_write_protection.mode;
@@ -333,6 +332,9 @@ int serve(const Settings& s) {
     target.addresses = {{(*server)->address().network, (*server)->address().node}};
     target.instructions = &(*server)->instructions();
     target.schedule = &schedule;
+    // --http (docs/web.md): the same CPU Unit, on this io_context.
+    auto web = fins::cli::finsd::start_web(io, s.http, {target}, {server->get()});
+    if (web.exit_code >= 0) return fail(web.exit_code, web.error);
     auto control_start = fins::cli::start_control(io, {std::move(target)}, s.control_socket);
     if (control_start.exit_code >= 0) return fail(control_start.exit_code, control_start.error);
     auto& control = control_start.server;
@@ -356,6 +358,7 @@ int serve(const Settings& s) {
         (*server)->stop();
         gateway_ports.close_all();
         if (control) control->stop();
+        if (web.server) web.server->stop();
         serial.stop();
         plc.storage().flush();
         io.stop();
