@@ -14,9 +14,19 @@
 
 #include "fins/client.hpp"
 
-#include "cli/fins/value_format.hpp"
+#include "typed/value_format.hpp"
 
 namespace fins::cli {
+
+using typed::Format;
+using typed::format_name;
+using typed::parse_bit;
+using typed::parse_format;
+using typed::parse_words;
+using typed::ParseError;
+using typed::print_words;
+using typed::Printed;
+using typed::words_per_value;
 
 inline constexpr int exit_ok = 0;
 inline constexpr int exit_usage = 2;

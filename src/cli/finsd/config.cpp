@@ -62,6 +62,8 @@ class Loader {
                 r = load_remotes(key, node, source_, s_);
             else if (k == "schedule")
                 r = load_schedule(key, node, source_, s_);
+            else if (k == "http")
+                r = load_http_table(node, source_, s_.http);
             else
                 r = fail(key, k, "unknown key");
             if (!r) return r;

@@ -17,6 +17,7 @@
 
 #include <tl/expected.hpp>
 
+#include "cli/finsd/config_http.hpp"
 #include "cli/finsd/config_schedule.hpp"
 #include "cli/finsd/config_serial.hpp"
 #include "fins/address.hpp"
@@ -94,6 +95,8 @@ struct Settings : CpuUnitOptions, server::FileMemoryOptions {
     // PLC-initiated messages (config_schedule.hpp).
     std::vector<server::RemoteNode> remotes;  // [[remote]]
     std::vector<ScheduleEntry> schedule;      // [[schedule]]
+
+    HttpSettings http;  // [http], --http (config_http.hpp, docs/web.md)
 };
 
 // Command-line values; a set optional overrides the file.

@@ -37,6 +37,7 @@
 #include "cli/finsd/ctl.hpp"
 #include "cli/finsd/serial_gateway_setup.hpp"
 #include "cli/finsd/serial_ports.hpp"
+#include "cli/finsd/web_setup.hpp"
 #include "plc/plc.hpp"
 #include "plc/profile.hpp"
 #include "plc/storage.hpp"
@@ -178,6 +179,8 @@ int configure(int argc, char** argv, Settings& settings) {
     app.add_option("--serial", o.serial,
                    "Serial port NAME=DEVICE[,baud=9600,parity=even,data=7,stop=2,unit=0,mode=..."
                    ",timeout=1]; NAME cpu, scuN.P or board.P (repeatable; README Host Link)");
+    fins::cli::finsd::HttpFlags http;
+    fins::cli::finsd::add_http_flags(app, http);
     app.add_flag("--reset-state", o.reset_state,
                  "Move a refused state file aside (never deleted) and start with a new one");
     try {
@@ -215,6 +218,8 @@ int configure(int argc, char** argv, Settings& settings) {
     take(o_durability, durability, o.durability);
     if (auto r = apply_overrides(o, settings); !r) return fail(2, r.error());
     if (auto r = validate(settings); !r) return fail(2, r.error());
+    fins::cli::finsd::apply_http_flags(http, settings.http);
+    if (auto r = check_http(settings.http); !r) return fail(2, r.error());
     // A node list protects nothing unless the mode reads it: refuse the flag rather than
     // let someone believe those nodes are refused (or, under "all", the only ones).
     const auto write_mode = settings.network_write_protection.mode;
@@ -327,6 +332,9 @@ int serve(const Settings& s) {
     target.addresses = {{(*server)->address().network, (*server)->address().node}};
     target.instructions = &(*server)->instructions();
     target.schedule = &schedule;
+    // --http (docs/web.md): the same CPU Unit, on this io_context.
+    auto web = fins::cli::finsd::start_web(io, s.http, {target}, {server->get()});
+    if (web.exit_code >= 0) return fail(web.exit_code, web.error);
     auto control_start = fins::cli::start_control(io, {std::move(target)}, s.control_socket);
     if (control_start.exit_code >= 0) return fail(control_start.exit_code, control_start.error);
     auto& control = control_start.server;
@@ -350,6 +358,7 @@ int serve(const Settings& s) {
         (*server)->stop();
         gateway_ports.close_all();
         if (control) control->stop();
+        if (web.server) web.server->stop();
         serial.stop();
         plc.storage().flush();
         io.stop();

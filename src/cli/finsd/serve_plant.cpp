@@ -19,6 +19,7 @@
 #include "cli/finsd/control_setup.hpp"
 #include "cli/finsd/serial_gateway_setup.hpp"
 #include "cli/finsd/serial_ports.hpp"
+#include "cli/finsd/web_setup.hpp"
 #include "plc/injections.hpp"
 #include "plc/profile.hpp"
 #include "server/control/control.hpp"
@@ -218,6 +219,16 @@ int serve_plant(const Settings& s) {
         const auto& p = (*plant)->router().port(i);
         targets[p.cpu].addresses.emplace_back(p.address.network, p.address.node);
     }
+    // --http (docs/web.md): every CPU Unit, each with its first unit's server.
+    std::vector<const server::Server*> first_units;
+    for (std::size_t i = 0; i < targets.size(); ++i)
+        first_units.push_back(&(*plant)->server(i, 0));
+    auto web = start_web(io, s.http, targets, first_units, plant->get());
+    if (web.exit_code >= 0) {
+        extras.stop();
+        std::fprintf(stderr, "finsd: %s\n", web.error.c_str());
+        return web.exit_code;
+    }
     auto control_start = start_control(io, std::move(targets), s.control_socket);
     if (control_start.exit_code >= 0) {
         extras.stop();
@@ -253,6 +264,7 @@ int serve_plant(const Settings& s) {
         extras.stop();
         (*plant)->stop();
         if (control) control->stop();
+        if (web.server) web.server->stop();
         io.stop();
     });
     io.run();

@@ -12,7 +12,6 @@
 #include <sys/stat.h>
 
 #include <algorithm>
-#include <charconv>
 #include <chrono>
 #include <string>
 #include <utility>
@@ -26,7 +25,7 @@
 #include <boost/asio/write.hpp>
 #include <nlohmann/json.hpp>
 
-#include "server/control/control_instructions.hpp"
+#include "server/control/control_dispatch.hpp"
 #include "server/control/control_requests.hpp"
 #include "transport/asio.hpp"
 
@@ -46,46 +45,6 @@ struct Shared {
     ControlOptions options;
     bool stopped = false;
 };
-
-// "NET.NODE" -> (network, node).
-std::optional<std::pair<std::uint8_t, std::uint8_t>> parse_net_node(const std::string& text) {
-    const auto dot = text.find('.');
-    if (dot == std::string::npos) return std::nullopt;
-    unsigned net = 0;
-    unsigned node = 0;
-    const char* b = text.data();
-    const char* e = text.data() + text.size();
-    const auto r1 = std::from_chars(b, b + dot, net);
-    const auto r2 = std::from_chars(b + dot + 1, e, node);
-    if (r1.ec != std::errc{} || r1.ptr != b + dot || r2.ec != std::errc{} || r2.ptr != e ||
-        dot == 0 || net > 0xFF || node > 0xFF)
-        return std::nullopt;
-    return std::pair{static_cast<std::uint8_t>(net), static_cast<std::uint8_t>(node)};
-}
-
-// The CPU Unit a request names with "plc" (the first without it), or nullptr with `why`.
-const ControlTarget* select_target(const Shared& shared, const Json& j, std::string& why) {
-    const auto it = j.find("plc");
-    if (it == j.end() || it->is_null()) return &shared.targets.front();
-    if (!it->is_string()) {
-        why = "\"plc\" must be a CPU Unit's name or its FINS address NET.NODE";
-        return nullptr;
-    }
-    const std::string wanted = it->get<std::string>();
-    for (const auto& t : shared.targets)
-        if (!t.name.empty() && t.name == wanted) return &t;
-    if (const auto address = parse_net_node(wanted))
-        for (const auto& t : shared.targets)
-            if (std::find(t.addresses.begin(), t.addresses.end(), *address) != t.addresses.end())
-                return &t;
-    std::string known;
-    for (const auto& t : shared.targets)
-        if (!t.name.empty()) known += (known.empty() ? "" : ", ") + t.name;
-    why = fmt::format("no CPU Unit \"{}\" here{}", wanted,
-                      known.empty() ? std::string(" (a single node: leave \"plc\" out)")
-                                    : " (CPU Units: " + known + ")");
-    return nullptr;
-}
 
 class Session : public std::enable_shared_from_this<Session> {
   public:
@@ -151,29 +110,13 @@ class Session : public std::enable_shared_from_this<Session> {
     void serve(const std::string& line) {
         const Json j = Json::parse(line, nullptr, false);
         if (j.is_discarded()) return write(control_error("not JSON"), false);
-        if (!j.is_object() || !j.contains("cmd") || !j["cmd"].is_string())
-            return write(control_error("expected an object with a string \"cmd\""), false);
-        std::string why;
-        const ControlTarget* target = select_target(*shared_, j, why);
-        if (target == nullptr) return write(control_error(why), false);
-        try {
-            waiting_ = true;
-            const bool instruction = handle_instruction_request(
-                target->instructions, target->schedule, j, [self = shared_from_this()](Json reply) {
-                    self->waiting_ = false;
-                    if (self->shared_->stopped || !self->open_) return;
-                    self->write(std::move(reply), false);
-                });
-            if (instruction) return;
-            waiting_ = false;
-            Json reply = handle_control_request(*target->plc, j);
-            if (!target->name.empty() && reply.contains("status"))
-                reply["status"]["plc"] = target->name;
-            write(std::move(reply), false);
-        } catch (const std::exception& e) {
-            waiting_ = false;
-            write(control_error(std::string("bad request: ") + e.what()), false);
-        }
+        // Set before: an answer given at once clears it inside the call.
+        waiting_ = true;
+        dispatch_control_request(shared_->targets, j, [self = shared_from_this()](Json reply) {
+            self->waiting_ = false;
+            if (self->shared_->stopped || !self->open_) return;
+            self->write(std::move(reply), false);
+        });
     }
 
     void write(const Json& reply, bool close_after) {

@@ -8,6 +8,7 @@
 #include "plc/plc.hpp"
 #include "server/dispatch/relay_error.hpp"
 #include "server/handlers/handlers.hpp"
+#include "server/metrics/metrics.hpp"
 #include "server/routing/router.hpp"
 #include "server/serial/serial_ports.hpp"
 
@@ -86,6 +87,7 @@ Dispatcher::Destination Dispatcher::find_destination(const Header& header) const
 std::size_t Dispatcher::handle(Bytes request, MutableBytes out, const RequestContext& context) {
     // Without a header and command code there is no SID to answer.
     if (request.size() < header_size + command_code_size) return 0;
+    metrics::start_request();
     ByteReader reader(request);
     const Header header = read_header(reader);
     const CommandCode command{reader.u8(), reader.u8()};
@@ -146,6 +148,7 @@ Dispatcher::Reply::Reply(plc::Plc& cpu_unit, const Header& request, CommandCode 
 }
 
 std::size_t Dispatcher::Reply::answer(EndCode code) const noexcept {
+    metrics::note_request(command, code);
     if (!wanted) return 0;
     // Bits 6/7 of every end code report the CPU Unit's non-fatal/fatal errors (W342
     // 5-1-3): 0040 is a normal completion on a CPU Unit with a battery error. Read when

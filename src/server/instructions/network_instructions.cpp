@@ -10,6 +10,7 @@
 
 #include "fins/commands/memory_area.hpp"
 #include "plc/plc.hpp"
+#include "server/metrics/metrics.hpp"
 #include "transport/asio.hpp"
 
 namespace fins::server {
@@ -310,6 +311,7 @@ void NetworkInstructions::finish(std::size_t index, InstructionResult result) {
     ++(result.done() ? counters_.done : counters_.errors);
     // CS/CJ completion code: the end code (0000 normal), or the local error's code.
     const std::uint16_t completion = result.done() ? std::uint16_t{0} : result.error_id_ex;
+    metrics::note_instruction(static_cast<std::uint8_t>(p.request.kind), completion);
     show_port(index, false,
               result.error_id == instruction_parameter_error
                   ? std::optional<std::uint16_t>{}

@@ -11,6 +11,7 @@
 #include "plc/plc.hpp"
 #include "plc/routing_tables.hpp"
 #include "server/dispatch/relay_error.hpp"
+#include "server/metrics/metrics.hpp"
 
 namespace fins::server {
 
@@ -135,6 +136,7 @@ std::uint8_t Router::network_for_local(std::size_t cpu) const noexcept {
 
 std::size_t Router::relay_error(const Header& request, CommandCode command, const Port& arrival,
                                 EndCode code, MutableBytes out) const noexcept {
+    metrics::note_relay_error(code);
     return write_relay_error(request, command, arrival.address, code, out);
 }
 
@@ -142,6 +144,7 @@ std::size_t Router::forward(std::size_t port, Bytes frame, MutableBytes out,
                             const RequestContext& context) {
     // Without a header and command code there is no SID to answer (as the dispatcher).
     if (frame.size() < header_size + command_code_size) return 0;
+    metrics::note_relay();
     ByteReader reader(frame);
     const Header header = read_header(reader);
     const CommandCode command{reader.u8(), reader.u8()};

@@ -271,6 +271,14 @@ std::size_t Server::tcp_connections() const noexcept {
     return impl_->nodes.in_use();
 }
 
+std::vector<TcpConnectionInfo> Server::tcp_connection_list() const {
+    std::vector<TcpConnectionInfo> out;
+    for (const auto& weak : impl_->sessions)
+        if (const auto s = weak.lock(); s != nullptr && s->open())
+            out.push_back({s->peer_address().to_string(), !s->pending()});
+    return out;
+}
+
 NetworkInstructions& Server::instructions() noexcept {
     return *impl_->instructions;
 }

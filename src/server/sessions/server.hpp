@@ -65,6 +65,12 @@ struct ServerOptions {
     TcpClientTiming tcp_client_timing;
 };
 
+// One FINS/TCP client connection as finsd's web page lists it.
+struct TcpConnectionInfo {
+    std::string address;       // the peer's IP address
+    bool established = false;  // false: in the handshake (or closing after a refusal)
+};
+
 // The node number finsd takes when none is given (see ServerOptions::node).
 std::uint8_t derive_node(const std::string& bind_address) noexcept;
 
@@ -81,6 +87,8 @@ class Server {
     [[nodiscard]] std::uint16_t tcp_port() const noexcept;
     [[nodiscard]] NodeAddress address() const noexcept;
     [[nodiscard]] std::size_t tcp_connections() const noexcept;
+    // The FINS/TCP client connections open now, in accept order (allocates: for the page).
+    [[nodiscard]] std::vector<TcpConnectionInfo> tcp_connection_list() const;
     // The one dispatcher every session uses (serial sessions attach to it too).
     [[nodiscard]] Dispatcher& dispatcher() noexcept;
     // Sends `frame` as a datagram from the FINS/UDP socket (false: no UDP, or not sent).

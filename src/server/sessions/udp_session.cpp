@@ -11,6 +11,7 @@
 #include <boost/asio/post.hpp>
 
 #include "server/dispatch/dispatcher.hpp"
+#include "server/metrics/metrics.hpp"
 #include "transport/asio.hpp"
 
 namespace fins::server {
@@ -249,6 +250,7 @@ void UdpSession::send_late(Bytes frame, const sockaddr_storage& peer, socklen_t 
 
 void UdpSession::note_dropped(std::uint64_t count) {
     counters_.dropped += count;
+    metrics::note_datagrams_dropped(count);
     if (const auto n = drops_logged_.note(count))
         spdlog::warn("fins/udp: send buffer full, {} replies dropped (clients resend on timeout)",
                      n);

@@ -1,5 +1,7 @@
-// Value formats of the `fins` CLI (--as): how words read from the PLC are printed and
-// how command-line values become words. Word order is Omron's (fins/values.hpp).
+// Value formats (`fins --as`, the HTTP API's `as`, the WebSocket's subscriptions): how
+// words read from the PLC are printed and how text values become words. One table for
+// every front end, so `fins read D100 --as int32` and `GET /api/read?...&as=int32` agree.
+// Word order is Omron's (fins/values.hpp).
 #pragma once
 
 #include <cstddef>
@@ -14,10 +16,11 @@
 
 #include "fins/error.hpp"
 
-namespace fins::cli {
+namespace fins::typed {
 
 enum class Format { int16, uint16, int32, uint32, float32, float64, bcd, string, bits, hex };
 
+// Also takes "float32", "float64", "ascii" (string) and "bool" (bits).
 std::optional<Format> parse_format(std::string_view name);
 std::string_view format_name(Format f);
 // Words per value; 0 for bits (one element per value).
@@ -41,4 +44,4 @@ std::variant<std::vector<std::uint16_t>, ParseError> parse_words(
 // "1", "0", "on", "off", "true", "false" -> bit.
 std::optional<bool> parse_bit(std::string_view s);
 
-}  // namespace fins::cli
+}  // namespace fins::typed

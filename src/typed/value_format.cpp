@@ -1,4 +1,4 @@
-#include "cli/fins/value_format.hpp"
+#include "typed/value_format.hpp"
 
 #include <charconv>
 #include <cmath>
@@ -8,7 +8,7 @@
 
 #include "fins/values.hpp"
 
-namespace fins::cli {
+namespace fins::typed {
 
 namespace {
 
@@ -78,6 +78,8 @@ std::optional<Format> parse_format(std::string_view name) {
         if (f.name == name) return f.format;
     if (name == "float32") return Format::float32;
     if (name == "float64") return Format::float64;
+    if (name == "ascii") return Format::string;
+    if (name == "bool") return Format::bits;
     return std::nullopt;
 }
 
@@ -220,4 +222,4 @@ std::variant<std::vector<std::uint16_t>, ParseError> parse_words(
     return out;
 }
 
-}  // namespace fins::cli
+}  // namespace fins::typed

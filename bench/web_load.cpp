@@ -1,0 +1,195 @@
+// fins_web_load: what finsd's web front costs the thread that also serves FINS. The
+// virtual PLC and the HTTP/WebSocket server run on one io_context thread, as in finsd,
+// with a tick on that thread that changes `words` words every --tick-ms. Measured: the
+// CPU time that thread spends (CLOCK_THREAD_CPUTIME_ID) per second of wall time, with
+// no client, with --clients clients each watching the `words` changing words, and with
+// as many idle clients (connected, subscribed to nothing: the cost of an idle page).
+// FINS shares that thread, so at saturation its request rate loses that fraction
+// (docs/benchmarks.md). The WebSocket clients run on a second thread and count what
+// they receive. Output: one line per case, or JSON lines with --json.
+// Timing lives here, never in pass/fail tests.
+#include <time.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <functional>
+#include <future>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <fmt/core.h>
+#include <spdlog/spdlog.h>
+#include <CLI/CLI.hpp>
+#include <boost/asio/post.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <boost/beast/core/flat_buffer.hpp>
+#include <boost/beast/core/tcp_stream.hpp>
+#include <boost/beast/websocket.hpp>
+
+#include "plc/plc.hpp"
+#include "transport/asio.hpp"
+#include "web/http_server.hpp"
+
+namespace {
+
+namespace beast = boost::beast;
+namespace websocket = beast::websocket;
+using Clock = std::chrono::steady_clock;
+
+double thread_cpu_seconds() {
+    timespec t{};
+    ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_nsec) * 1e-9;
+}
+
+// WebSocket clients on their own thread: each subscribes (or not) and counts messages.
+class Clients {
+  public:
+    Clients(std::uint16_t port, unsigned count, unsigned words, bool subscribe) {
+        for (unsigned i = 0; i < count; ++i) {
+            auto c = std::make_unique<Client>(io_);
+            auto& s = beast::get_lowest_layer(c->ws);
+            s.connect(asio::ip::tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
+            c->ws.handshake("127.0.0.1", "/ws");
+            if (subscribe)
+                c->ws.write(asio::buffer(fmt::format(
+                    R"({{"op":"subscribe","id":"s","address":"D0","count":{}}})", words)));
+            clients_.push_back(std::move(c));
+        }
+        for (auto& c : clients_)
+            read(*c);
+        thread_ = std::thread([this] { io_.run(); });
+    }
+    ~Clients() {
+        asio::post(io_, [this] {
+            for (auto& c : clients_)
+                beast::get_lowest_layer(c->ws).close();
+        });
+        io_.stop();
+        thread_.join();
+    }
+    std::uint64_t messages() const { return messages_.load(); }
+    std::uint64_t bytes() const { return bytes_.load(); }
+
+  private:
+    struct Client {
+        explicit Client(asio::io_context& io) : ws(io) {}
+        websocket::stream<beast::tcp_stream> ws;
+        beast::flat_buffer buffer;
+    };
+    void read(Client& c) {
+        c.ws.async_read(c.buffer, [this, &c](beast::error_code ec, std::size_t n) {
+            if (ec) return;
+            ++messages_;
+            bytes_ += n;
+            c.buffer.consume(c.buffer.size());
+            read(c);
+        });
+    }
+    asio::io_context io_{1};
+    std::vector<std::unique_ptr<Client>> clients_;
+    std::atomic<std::uint64_t> messages_{0};
+    std::atomic<std::uint64_t> bytes_{0};
+    std::thread thread_;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"fins_web_load: the CPU finsd's web front takes from the FINS thread"};
+    double seconds = 3.0;
+    unsigned clients = 50, words = 1000, tick_ms = 10;
+    bool json = false;
+    app.add_option("--seconds", seconds, "Duration of each case")->capture_default_str();
+    app.add_option("--clients", clients, "WebSocket clients")->capture_default_str();
+    app.add_option("--words", words, "Words each client watches (all change every tick)")
+        ->capture_default_str()
+        ->check(CLI::Range(1u, 4096u));
+    app.add_option("--tick-ms", tick_ms, "Milliseconds between changes")->capture_default_str();
+    app.add_flag("--json", json, "Print JSON lines");
+    CLI11_PARSE(app, argc, argv);
+    spdlog::set_level(spdlog::level::warn);
+
+    fins::plc::Plc plc{fins::plc::cj2h()};
+    asio::io_context io{1};
+    fins::web::WebContext context;
+    fins::server::ControlTarget target;
+    target.plc = &plc;
+    context.targets.push_back(target);
+    context.options.max_connections = clients * 2 + 8;
+    auto web = fins::web::HttpServer::start(io, std::move(context));
+    if (!web) {
+        std::fprintf(stderr, "fins_web_load: cannot start the server\n");
+        return 1;
+    }
+    // The tick: every watched word changes (a counter, as a scenario would move them).
+    asio::steady_timer tick(io);
+    std::uint16_t value = 0;
+    std::function<void()> arm = [&] {
+        tick.expires_after(std::chrono::milliseconds(tick_ms));
+        tick.async_wait([&](boost::system::error_code ec) {
+            if (ec) return;
+            ++value;
+            auto dm = plc.memory().words(fins::Region::dm);
+            std::fill_n(dm.begin(), words, value);
+            arm();
+        });
+    };
+    arm();
+    std::thread server_thread([&] { io.run(); });
+    // The server thread's CPU seconds, read on that thread.
+    const auto server_cpu = [&] {
+        std::promise<double> p;
+        auto f = p.get_future();
+        asio::post(io, [&] { p.set_value(thread_cpu_seconds()); });
+        return f.get();
+    };
+    const auto measure =
+        [&](const char* name,
+            const std::function<std::pair<std::uint64_t, std::uint64_t>()>& counts) {
+            const double c0 = server_cpu();
+            const auto w0 = Clock::now();
+            const auto [m0, b0] = counts();
+            std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
+            const auto [m1, b1] = counts();
+            const double wall = std::chrono::duration<double>(Clock::now() - w0).count();
+            const double share = (server_cpu() - c0) / wall * 100.0;
+            const double msgs = static_cast<double>(m1 - m0) / wall;
+            const double mbytes = static_cast<double>(b1 - b0) / wall / 1e6;
+            if (json)
+                std::printf(
+                    "{\"case\":\"%s\",\"thread_cpu_percent\":%.2f,\"ws_messages_per_s\":%.1f,"
+                    "\"ws_mbytes_per_s\":%.2f}\n",
+                    name, share, msgs, mbytes);
+            else
+                std::printf("%-26s server thread CPU %6.2f %%  WebSocket %7.1f msg/s %6.2f MB/s\n",
+                            name, share, msgs, mbytes);
+            std::fflush(stdout);
+        };
+    measure("no WebSocket client", [] { return std::pair<std::uint64_t, std::uint64_t>{0, 0}; });
+    {
+        Clients watching((*web)->port(), clients, words, true);
+        std::this_thread::sleep_for(std::chrono::milliseconds(500));  // snapshots out
+        measure(fmt::format("{} clients x {} words", clients, words).c_str(), [&] {
+            return std::pair{watching.messages(), watching.bytes()};
+        });
+    }
+    {
+        Clients idle((*web)->port(), clients, words, false);
+        std::this_thread::sleep_for(std::chrono::milliseconds(500));
+        measure(fmt::format("{} idle clients", clients).c_str(), [&] {
+            return std::pair{idle.messages(), idle.bytes()};
+        });
+    }
+    asio::post(io, [&] {
+        tick.cancel();
+        (*web)->stop();
+        io.stop();
+    });
+    server_thread.join();
+    return 0;
+}

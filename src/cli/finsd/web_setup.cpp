@@ -1,0 +1,117 @@
+// finsd's HTTP front at start-up (contract in web_setup.hpp).
+#include "cli/finsd/web_setup.hpp"
+
+#include <fstream>
+#include <sstream>
+#include <utility>
+
+#include <fmt/core.h>
+#include <spdlog/spdlog.h>
+
+#include "server/metrics/metrics.hpp"
+#include "server/sessions/server.hpp"
+
+namespace fins::cli::finsd {
+
+namespace {
+
+using Json = nlohmann::json;
+
+// The token: the file's first line, without surrounding white space.
+std::optional<std::string> read_token(const std::filesystem::path& file, std::string& why) {
+    std::ifstream in(file);
+    if (!in) {
+        why = fmt::format("--http-token-file {}: cannot read it", file.string());
+        return std::nullopt;
+    }
+    std::string line;
+    std::getline(in, line);
+    const auto first = line.find_first_not_of(" \t\r\n");
+    const auto last = line.find_last_not_of(" \t\r\n");
+    if (first == std::string::npos) {
+        why = fmt::format("--http-token-file {}: the first line is empty", file.string());
+        return std::nullopt;
+    }
+    return line.substr(first, last - first + 1);
+}
+
+}  // namespace
+
+WebStart start_web(boost::asio::io_context& io, const HttpSettings& http,
+                   std::vector<server::ControlTarget> targets,
+                   std::vector<const server::Server*> servers, server::Plant* plant) {
+    (void)plant;
+    WebStart out;
+    if (!http.listen) return out;
+    const auto listen = parse_http_listen(*http.listen);
+    if (!listen) {
+        out.exit_code = 2;
+        out.error = listen.error();
+        return out;
+    }
+    web::WebContext context;
+    context.options.bind_address = listen->first;
+    context.options.port = listen->second;
+    context.options.control = http.control;
+    context.options.allowed_hosts = http.allowed_hosts;
+    context.options.max_connections = http.max_connections;
+    if (http.token_file) {
+        std::string why;
+        const auto token = read_token(*http.token_file, why);
+        if (!token) {
+            out.exit_code = 2;
+            out.error = why;
+            return out;
+        }
+        context.options.token = *token;
+    }
+    context.targets = std::move(targets);
+    const auto server_of = [context_targets = context.targets,
+                            servers](const server::ControlTarget& t) -> const server::Server* {
+        for (std::size_t i = 0; i < context_targets.size() && i < servers.size(); ++i)
+            if (context_targets[i].plc == t.plc) return servers[i];
+        return nullptr;
+    };
+    context.network_status = [server_of](const server::ControlTarget& t, Json& status) {
+        const auto* s = server_of(t);
+        if (s == nullptr) return;
+        Json list = Json::array();
+        for (const auto& c : s->tcp_connection_list())
+            list.push_back(
+                {{"address", c.address}, {"state", c.established ? "established" : "handshake"}});
+        status["connections"] = std::move(list);
+    };
+    context.describe = [server_of](const server::ControlTarget& t, Json& entry) {
+        const auto* s = server_of(t);
+        if (s == nullptr) return;
+        entry["udp_port"] = s->udp_port();
+        entry["tcp_port"] = s->tcp_port();
+        entry["tcp_connections"] = s->tcp_connections();
+    };
+    context.metrics = [servers]() {
+        using server::metrics::Family;
+        Family tcp{"fins_tcp_connections", "FINS/TCP client connections by state", "gauge", {}};
+        std::size_t established = 0;
+        std::size_t handshake = 0;
+        for (const auto* s : servers)
+            for (const auto& c : s->tcp_connection_list())
+                ++(c.established ? established : handshake);
+        tcp.samples = {{"state=\"established\"", static_cast<double>(established)},
+                       {"state=\"handshake\"", static_cast<double>(handshake)}};
+        const std::vector<Family> extra{tcp};
+        return server::metrics::expose(server::metrics::process_metrics(), extra);
+    };
+    auto started = web::HttpServer::start(io, std::move(context));
+    if (!started) {
+        out.exit_code = 3;
+        out.error = fmt::format("cannot listen for HTTP on {}: {}", *http.listen,
+                                started.error().message());
+        return out;
+    }
+    out.server = std::move(*started);
+    spdlog::info("finsd: HTTP on {} port {} (control {})", listen->first, out.server->port(),
+                 http.control ? "on" : "off");
+    return out;
+}
+
+}  // namespace fins::cli::finsd

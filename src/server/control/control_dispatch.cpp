@@ -1,0 +1,78 @@
+// The control verbs' one dispatcher (contract in control_dispatch.hpp).
+#include "server/control/control_dispatch.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <exception>
+
+#include <fmt/core.h>
+
+#include "server/control/control_requests.hpp"
+
+namespace fins::server {
+
+using Json = nlohmann::json;
+
+std::optional<std::pair<std::uint8_t, std::uint8_t>> parse_net_node(std::string_view text) {
+    const auto dot = text.find('.');
+    if (dot == std::string_view::npos) return std::nullopt;
+    unsigned net = 0;
+    unsigned node = 0;
+    const char* b = text.data();
+    const char* e = text.data() + text.size();
+    const auto r1 = std::from_chars(b, b + dot, net);
+    const auto r2 = std::from_chars(b + dot + 1, e, node);
+    if (r1.ec != std::errc{} || r1.ptr != b + dot || r2.ec != std::errc{} || r2.ptr != e ||
+        dot == 0 || net > 0xFF || node > 0xFF)
+        return std::nullopt;
+    return std::pair{static_cast<std::uint8_t>(net), static_cast<std::uint8_t>(node)};
+}
+
+const ControlTarget* find_control_target(std::span<const ControlTarget> targets,
+                                         std::optional<std::string_view> wanted, std::string& why) {
+    if (targets.empty()) {
+        why = "no CPU Unit";
+        return nullptr;
+    }
+    if (!wanted) return &targets.front();
+    for (const auto& t : targets)
+        if (!t.name.empty() && t.name == *wanted) return &t;
+    if (const auto address = parse_net_node(*wanted))
+        for (const auto& t : targets)
+            if (std::find(t.addresses.begin(), t.addresses.end(), *address) != t.addresses.end())
+                return &t;
+    std::string known;
+    for (const auto& t : targets)
+        if (!t.name.empty()) known += (known.empty() ? "" : ", ") + t.name;
+    why = fmt::format("no CPU Unit \"{}\" here{}", *wanted,
+                      known.empty() ? std::string(" (a single node: leave \"plc\" out)")
+                                    : " (CPU Units: " + known + ")");
+    return nullptr;
+}
+
+void dispatch_control_request(std::span<const ControlTarget> targets, const Json& j,
+                              const ControlReply& reply) {
+    if (!j.is_object() || !j.contains("cmd") || !j["cmd"].is_string())
+        return reply(control_error("expected an object with a string \"cmd\""));
+    std::optional<std::string_view> wanted;
+    if (const auto it = j.find("plc"); it != j.end() && !it->is_null()) {
+        if (!it->is_string())
+            return reply(
+                control_error("\"plc\" must be a CPU Unit's name or its FINS address NET.NODE"));
+        wanted = it->get_ref<const std::string&>();
+    }
+    std::string why;
+    const ControlTarget* target = find_control_target(targets, wanted, why);
+    if (target == nullptr) return reply(control_error(why));
+    Json answer;
+    try {
+        if (handle_instruction_request(target->instructions, target->schedule, j, reply)) return;
+        answer = handle_control_request(*target->plc, j);
+    } catch (const std::exception& e) {
+        answer = control_error(std::string("bad request: ") + e.what());
+    }
+    if (!target->name.empty() && answer.contains("status")) answer["status"]["plc"] = target->name;
+    reply(std::move(answer));
+}
+
+}  // namespace fins::server

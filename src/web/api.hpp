@@ -1,0 +1,63 @@
+// finsd's HTTP API as a plain function of (request, state): no sockets, so the unit
+// tests and fuzz/fuzz_http.cpp call it directly and the Beast session (http_session.cpp)
+// only reads, calls and writes. Routes and bodies: docs/web.md, docs/api/openapi.yaml.
+//
+//   GET  /  /<file>              the embedded page, /openapi.yaml, /chart.js
+//   GET  /api/plcs               the CPU Units served
+//   GET  /api/read               ?address=D100&count=3&as=uint16[&plc=NAME|NET.NODE]
+//   POST /api/write              {"address","values","as"[,"plc"]}       (control on)
+//   GET  /api/status             the control channel's status plus network, logs
+//   POST /api/control            any control channel request object     (control on)
+//   GET  /metrics                Prometheus text format
+// Every error is {"error":"..."} with 400, 403, 404, 405, 413 or 431.
+#pragma once
+
+#include <chrono>
+#include <functional>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include <nlohmann/json.hpp>
+
+#include "web/web_context.hpp"
+
+namespace fins::web {
+
+struct HttpAnswer {
+    unsigned status = 200;
+    std::string content_type = "application/json";
+    std::string body;
+};
+
+HttpAnswer json_answer(unsigned status, const nlohmann::json& body);
+HttpAnswer error_answer(unsigned status, std::string_view message);
+
+// The request fields the security rules read.
+struct RequestMeta {
+    std::string_view method;  // "GET", "POST", ...
+    std::string_view target;  // origin-form: "/api/read?address=D0"
+    std::optional<std::string_view> host;
+    std::optional<std::string_view> origin;
+    std::optional<std::string_view> authorization;
+    bool websocket_upgrade = false;
+};
+
+// The rules every request passes before its route (nullopt: go on):
+//   403 a Host header naming a host other than loopback, the bound address or an allowed
+//       host (DNS rebinding); an Origin other than http://<such a host> on a POST or a
+//       WebSocket upgrade; a POST without "Authorization: Bearer <token>" when a token is set.
+std::optional<HttpAnswer> check_request(const WebOptions& options, const RequestMeta& meta);
+
+// Answers one request; `done` is called exactly once: at once, or later on the io_context
+// for a control request that runs a PLC-initiated instruction (send / recv / sendcmd).
+void handle_request(WebContext& context, std::string_view method, std::string_view target,
+                    std::string_view body, const std::function<void(HttpAnswer)>& done);
+
+// GET /api/status's object for `target` (also the WebSocket "status" topic).
+nlohmann::json status_object(const WebContext& context, const server::ControlTarget& target);
+// The "errors" and "events" topics: active errors and the error log; the write access log.
+nlohmann::json errors_object(const server::ControlTarget& target);
+nlohmann::json events_object(const server::ControlTarget& target);
+
+}  // namespace fins::web

@@ -1,0 +1,61 @@
+// The state an HTTP server's sessions share, and the two session kinds (http_server.hpp).
+// Internal to src/web/.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <list>
+#include <memory>
+
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/beast/core/tcp_stream.hpp>
+#include <boost/beast/http/message.hpp>
+#include <boost/beast/http/string_body.hpp>
+
+#include "web/subscriptions.hpp"
+#include "web/web_context.hpp"
+
+namespace fins::web {
+
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace http = beast::http;
+
+class Connection {
+  public:
+    virtual ~Connection() = default;
+    virtual void close() = 0;
+};
+
+struct ServerShared {
+    explicit ServerShared(asio::io_context& io, WebContext c)
+        : context(std::move(c)), acceptor(io), resumable(context.options) {}
+    WebContext context;
+    asio::ip::tcp::acceptor acceptor;
+    ResumeStore resumable;
+    std::list<std::weak_ptr<Connection>> connections;
+    std::size_t websockets = 0;
+    bool stopped = false;
+
+    [[nodiscard]] std::size_t open_connections() {
+        connections.remove_if([](const auto& w) { return w.expired(); });
+        return connections.size();
+    }
+};
+
+// Serves HTTP requests on `socket` until it closes or upgrades to a WebSocket.
+void run_http_session(asio::ip::tcp::socket socket, std::shared_ptr<ServerShared> shared);
+// Takes over `stream` after the upgrade request `request` passed the checks.
+void run_websocket_session(beast::tcp_stream stream, http::request<http::string_body> request,
+                           std::shared_ptr<ServerShared> shared);
+
+// Content-Security-Policy and the other headers every answer carries.
+template <class Message>
+void set_common_headers(Message& m) {
+    m.set(http::field::server, "finsd");
+    m.set("Content-Security-Policy", "default-src 'self'");
+    m.set("X-Content-Type-Options", "nosniff");
+    m.set(http::field::cache_control, "no-store");
+}
+
+}  // namespace fins::web

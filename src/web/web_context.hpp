@@ -1,0 +1,59 @@
+// What finsd's HTTP/WebSocket front (src/web/) serves and under which rules. Built by
+// finsd (cli/finsd/web_setup) for a single node or a plant; read by the pure request
+// handler (api.hpp), the WebSocket subscriptions (subscriptions.hpp) and the sessions.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "server/control/control.hpp"
+
+namespace fins::web {
+
+struct WebOptions {
+    std::string bind_address = "127.0.0.1";
+    std::uint16_t port = 0;  // the port actually bound (Host and Origin checks use it)
+    // POST /api/write and /api/control; off: 403 and nothing reaches the PLC.
+    bool control = false;
+    // Non-empty: POST requests must carry "Authorization: Bearer <token>" (required
+    // when bound beyond loopback with control on).
+    std::string token;
+    // Host names besides the loopback ones and the bound address that the Host header
+    // (and so a browser's Origin) may name: DNS rebinding protection.
+    std::vector<std::string> allowed_hosts;
+
+    std::size_t max_body_bytes = 64 * 1024;   // 413 beyond
+    std::size_t max_header_bytes = 8 * 1024;  // 431 beyond (request line + fields)
+    std::size_t max_header_fields = 64;       // 431 beyond
+    std::size_t max_connections = 64;         // HTTP + WebSocket; the oldest idle one goes
+    std::chrono::milliseconds idle_timeout{std::chrono::seconds(30)};     // HTTP keep-alive
+    std::chrono::milliseconds request_timeout{std::chrono::seconds(10)};  // a begun request
+
+    // WebSocket.
+    std::size_t max_ws_message_bytes = 4 * 1024;
+    std::size_t max_subscriptions = 64;           // per connection
+    std::size_t max_queued_messages = 32;         // per connection; beyond: drop to snapshots
+    std::chrono::milliseconds min_interval{100};  // per subscription: at most 10 updates/s
+    std::size_t history_messages = 256;           // kept per connection for "resume"
+    std::chrono::milliseconds resume_window{std::chrono::seconds(30)};  // a closed one kept
+    std::size_t max_resumable = 16;  // closed connections kept for "resume"
+};
+
+struct WebContext {
+    std::vector<server::ControlTarget> targets;  // the first is the default CPU Unit
+    WebOptions options;
+    // Adds what the server around a CPU Unit knows (its network, routes, relays, FINS/TCP
+    // connections, UDP peers) to its /api/plcs entry and its /api/status object. Optional.
+    std::function<void(const server::ControlTarget&, nlohmann::json& plc)> describe;
+    std::function<void(const server::ControlTarget&, nlohmann::json& status)> network_status;
+    // The Prometheus text of GET /metrics; absent: 404.
+    std::function<std::string()> metrics;
+};
+
+}  // namespace fins::web

@@ -1,0 +1,81 @@
+// finsd --http as users run it: a finsd process, FINS clients and an HTTP client side by
+// side. A value written over FINS is read over HTTP, one written over HTTP is read over
+// FINS, the mode set over HTTP is what 06 01 answers, and the start-up refusals.
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <string>
+
+#include "integration/finsd_run.hpp"
+#include "web_server.hpp"
+
+namespace fins::test {
+namespace {
+
+using Json = nlohmann::json;
+
+// A port free now (the kernel's choice), for --http ADDRESS:PORT.
+std::uint16_t free_port() {
+    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    socklen_t n = sizeof a;
+    ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
+    ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &n);
+    ::close(fd);
+    return ntohs(a.sin_port);
+}
+
+TEST(FinsdHttp, FinsAndHttpSeeTheSamePlc) {
+    ScratchDir dir("http");
+    const auto port = free_port();
+    Finsd finsd({"--http", "127.0.0.1:" + std::to_string(port), "--http-control", "--control",
+                 (dir.path() / "ctl.sock").string()});
+    ASSERT_TRUE(finsd.started()) << finsd.result().err;
+    auto fins = finsd.client();
+    ASSERT_NE(fins, nullptr);
+    ASSERT_TRUE(fins->write_words(addr("D100"), std::vector<std::uint16_t>{1234}));
+    HttpClient http(port);
+    EXPECT_EQ(body_json(http.request(http::verb::get, "/api/read?address=D100"))["values"],
+              Json::array({1234}));
+    auto w = http.request(http::verb::post, "/api/write",
+                          R"({"address":"D200","values":[-2],"as":"int16"})");
+    EXPECT_EQ(w.result_int(), 200u) << w.body();
+    EXPECT_EQ(words_of(*fins, "D200", 1), std::vector<std::uint16_t>{0xFFFE});
+    auto mode =
+        http.request(http::verb::post, "/api/control", R"({"cmd":"mode","mode":"program"})");
+    EXPECT_EQ(mode.result_int(), 200u) << mode.body();
+    auto status = fins->send_raw(CommandCode{0x06, 0x01}, {});
+    ASSERT_TRUE(status);
+    ASSERT_GE(status->data.size(), 2u);
+    EXPECT_EQ(status->data[1], 0x00);  // 06 01 mode: PROGRAM
+    auto plcs = body_json(http.request(http::verb::get, "/api/plcs"));
+    EXPECT_EQ(plcs["plcs"][0]["udp_port"], finsd.port());
+    EXPECT_EQ(finsd.stop().exit_code, 0);
+}
+
+TEST(FinsdHttp, ReadOnlyByDefault) {
+    const auto port = free_port();
+    Finsd finsd({"--http", "127.0.0.1:" + std::to_string(port)});
+    ASSERT_TRUE(finsd.started()) << finsd.result().err;
+    HttpClient http(port);
+    EXPECT_EQ(http.request(http::verb::post, "/api/write", R"({"address":"D100","values":[1]})")
+                  .result_int(),
+              403u);
+    auto fins = finsd.client();
+    EXPECT_EQ(words_of(*fins, "D100", 1), std::vector<std::uint16_t>{0});
+}
+
+TEST(FinsdHttp, ControlBeyondLoopbackWithoutATokenDoesNotStart) {
+    Finsd finsd({"--http", "0.0.0.0:0", "--http-control"});
+    ASSERT_FALSE(finsd.started());
+    EXPECT_EQ(finsd.result().exit_code, 2);
+    EXPECT_NE(finsd.result().err.find("--http-token-file"), std::string::npos)
+        << finsd.result().err;
+}
+
+}  // namespace
+}  // namespace fins::test
