@@ -107,7 +107,7 @@ Plan plan_group(std::span<const Tag> tags, std::size_t gap_words) {
     return plan;
 }
 
-std::string describe(const Plan& plan, std::span<const Tag> tags) {
+std::string describe_plan(const Plan& plan, std::span<const Tag> tags) {
     std::string out;
     auto it = std::back_inserter(out);
     for (const auto& f : plan.frames) {

@@ -47,6 +47,6 @@ Plan plan_group(std::span<const Tag> tags, std::size_t gap_words);
 // One line per frame, as `fins-bridge --plan` prints it:
 //   01 01 D100 x 12 words: speed temp
 //   01 04 3 elements: run T5 D900
-std::string describe(const Plan& plan, std::span<const Tag> tags);
+std::string describe_plan(const Plan& plan, std::span<const Tag> tags);
 
 }  // namespace fins::bridge

@@ -112,7 +112,7 @@ TEST(Plan, DescribeNamesEveryFrameAndTag) {
                       tag("c", "D9000", "int16") + tag("d", "T5", "bool");
     auto c = parse_ok(one_group(tags));
     const auto& g = c.plcs[0].groups[0];
-    EXPECT_EQ(describe(plan_group(g.tags, g.gap_words), g.tags),
+    EXPECT_EQ(describe_plan(plan_group(g.tags, g.gap_words), g.tags),
               "01 01 D100 x 2 words (82 0064): a=D100 b=D101\n"
               "01 04 2 elements: c=D9000 d=T5\n");
 }

@@ -42,7 +42,7 @@ int main(int argc, char** argv) {
                 const auto pl = fins::bridge::plan_group(g.tags, g.gap_words);
                 fmt::print("{}/{}: {} tags, {} frames every {} ms\n", p.name, g.name, g.tags.size(),
                            pl.frames.size(), g.interval.count());
-                std::string text = fins::bridge::describe(pl, g.tags);
+                std::string text = fins::bridge::describe_plan(pl, g.tags);
                 std::size_t at = 0;
                 while (at < text.size()) {
                     const auto nl = text.find('\n', at);
