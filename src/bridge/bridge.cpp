@@ -59,6 +59,8 @@ bool Bridge::start(std::string& error) {
             format_->connected(sink_);
             for (const auto& [name, st] : statuses_)
                 format_->status(st, sink_);
+            for (auto& [name, p] : pollers_)
+                p->request_full();
         });
     };
     h.message = [this](std::string topic, std::string payload, bool retained) {

@@ -148,6 +148,11 @@ void PlcPoller::start() {
     open();
 }
 
+void PlcPoller::request_full() noexcept {
+    for (auto& gs : groups_)
+        gs->need_full = true;
+}
+
 void PlcPoller::stop() {
     if (!running_) return;
     running_ = false;
@@ -487,9 +492,8 @@ void PlcPoller::on_timeout() {
             ++i;
         }
     }
-    const auto gen = generation_;
-    for (auto& r : expired) {
-        if (gen != generation_) return;
+    for (std::size_t k = 0; k < expired.size(); ++k) {
+        Request& r = expired[k];
         if (r.attempts < plc_.retries) {
             ++r.attempts;
             ++stats_.resends;
@@ -498,10 +502,13 @@ void PlcPoller::on_timeout() {
             continue;
         }
         ++stats_.timeouts;
-        complete(r, nullptr, make_error_code(ClientError::timeout));
+        // The PLC is offline: this frame and every other one waiting fail with it.
+        in_flight_.insert(in_flight_.end(), expired.begin() + static_cast<std::ptrdiff_t>(k),
+                          expired.end());
         go_offline(make_error_code(ClientError::timeout));
+        return;
     }
-    if (gen == generation_) arm_timeout();
+    arm_timeout();
 }
 
 void PlcPoller::on_frame(Bytes frame) {

@@ -79,6 +79,9 @@ class PlcPoller {
     [[nodiscard]] bool online() const noexcept { return state_ == State::online; }
     [[nodiscard]] const Plc& plc() const noexcept { return plc_; }
     [[nodiscard]] const PollerStats& stats() const noexcept { return stats_; }
+    // The next cycle of every group publishes all its tags (after an MQTT reconnect: what
+    // was published while disconnected was dropped).
+    void request_full() noexcept;
 
     // Queues a write of `value` (already type- and range-checked) to `tag`, then a read
     // back. The answer comes through PollerEvents::write_done. Returns an error text

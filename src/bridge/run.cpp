@@ -17,8 +17,9 @@ std::unique_ptr<PayloadFormat> make_format(const BridgeConfig& config) {
     return std::make_unique<JsonPayload>(config.mqtt.topic_prefix, config.instance);
 }
 
-int run(const BridgeConfig& config) {
+int run(const BridgeConfig& config, const std::string& log_level) {
     spdlog::set_default_logger(spdlog::stderr_color_mt("fins-bridge"));
+    spdlog::set_level(spdlog::level::from_str(log_level));
     net::io_context io(1);
     Bridge bridge(io, config, make_format(config), std::make_unique<SingleInstance>());
     std::string error;

@@ -21,9 +21,12 @@ int main(int argc, char** argv) {
     std::string config;
     std::string instance;
     bool plan = false;
+    std::string log_level = "info";
     app.add_option("--config", config, "TOML configuration file")->required();
     app.add_option("--instance", instance, "instance name (default: [bridge] instance, host name)");
     app.add_flag("--plan", plan, "print the frames each group is read with, then exit");
+    app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off")
+        ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
     app.set_version_flag("--version", std::string("fins-bridge ") + FINSKIT_VERSION);
     try {
         app.parse(argc, argv);
@@ -52,5 +55,5 @@ int main(int argc, char** argv) {
             }
         return 0;
     }
-    return fins::bridge::run(*c);
+    return fins::bridge::run(*c, log_level);
 }
