@@ -389,3 +389,72 @@ TEST(BridgeRun, BadConfigStopsAtStartWithItsPosition) {
 
 }  // namespace
 }  // namespace fins::bridge::test
+
+namespace fins::bridge::test {
+namespace {
+
+// A PLC behind a router: the bridge talks to router-a (network 1) and addresses line-2
+// (network 2, node 5) with dest = "2.5.0"; router-a relays over its second unit.
+TEST(BridgeRun, PlcBehindARouter) {
+    fins::test::FixedPorts lock;
+    ScratchDir dir{"bridge"};
+    const auto plant = dir.write("plant.toml", R"(log_level = "warn"
+[[plc]]
+name = "router-a"
+  [[plc.ethernet]]
+  unit = 0
+  network = 1
+  bind = "127.0.61.1"
+  port = 9611
+  [[plc.ethernet]]
+  unit = 1
+  network = 2
+  bind = "127.0.62.1"
+  port = 9611
+[[plc]]
+name = "line-2"
+  [[plc.ethernet]]
+  unit = 0
+  network = 2
+  bind = "127.0.62.5"
+  port = 9611
+  [[plc.relay]]
+  network = 1
+  via_network = 2
+  via_node = 1
+)");
+    Finsd finsd{{"--config", plant}};
+    Mosquitto broker{dir};
+    Subscriber sub(broker.port(), "t/#");
+    ASSERT_TRUE(finsd.started() && broker.started() && sub.connected()) << finsd.result().err;
+    BridgeProcess bridge(dir, mqtt_section(broker.port()) +
+                                  "[[plc]]\nname = \"line2\"\nhost = \"127.0.61.1\"\nport = 9611\n"
+                                  "dest = \"2.5.0\"\ntimeout_ms = 500\n" +
+                                  tags);
+    auto full =
+        sub.wait_topic("t/line2/fast", [](const json& j) { return j.value("full", false); });
+    ASSERT_TRUE(full) << bridge.stop().err;
+    EXPECT_EQ(full->json()["values"]["speed"], 0) << full->payload;
+    sub.publish("t/line2/write", R"({"id":"r1","tag":"temp","value":12.25})");
+    auto r =
+        sub.wait_topic("t/line2/write/response", [](const json& j) { return j["id"] == "r1"; });
+    ASSERT_TRUE(r);
+    EXPECT_EQ(r->json()["value"], 12.25) << r->payload;
+    // The value is in line-2, not in router-a.
+    ClientOptions o;  // through router-a, as the bridge does
+    o.host = "127.0.61.1";
+    o.port = 9611;
+    o.destination = {2, 5, 0};
+    auto line = Client::connect(o);
+    ASSERT_TRUE(line);
+    EXPECT_EQ((*line)->read_float(fins::test::addr("D200")).value_or(0), 12.25f);
+    ClientOptions a;
+    a.host = "127.0.61.1";
+    a.port = 9611;
+    auto router = Client::connect(a);
+    ASSERT_TRUE(router);
+    EXPECT_EQ((*router)->read_float(fins::test::addr("D200")).value_or(-1), 0.0f);
+}
+
+}  // namespace
+}  // namespace fins::bridge::test
