@@ -26,8 +26,6 @@ const Tag* find_tag(const Plc& plc, std::string_view name) {
     return nullptr;
 }
 
-constexpr auto report_every = std::chrono::seconds(10);
-
 }  // namespace
 
 Bridge::Bridge(net::io_context& io, const BridgeConfig& config,
@@ -208,7 +206,7 @@ void Bridge::command(const std::string& topic, const std::string& payload, bool 
 }
 
 void Bridge::report() {
-    report_timer_.expires_after(report_every);
+    report_timer_.expires_after(config_.stats);
     report_timer_.async_wait([this](boost::system::error_code ec) {
         if (ec || stopped_) return;
         PollerStats t{};

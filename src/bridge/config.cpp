@@ -112,11 +112,12 @@ class Loader {
         c.source = source_;
         if (const auto* n = root.get("bridge")) {
             const auto& t = table(*n, "[bridge]");
-            only(t, "[bridge]", {"instance", "failover_s", "payload"});
+            only(t, "[bridge]", {"instance", "failover_s", "payload", "stats_s"});
             c.instance = text_or(t, "instance", "");
             if (!c.instance.empty() && !valid_name(c.instance))
                 fail(*t.get("instance"), "instance must be [A-Za-z0-9_-]+");
             duration(t, "failover_s", 1, 3600, c.failover);
+            duration(t, "stats_s", 1, 3600, c.stats);
             c.payload = text_or(t, "payload", "json");
             if (c.payload != "json" && c.payload != "sparkplug")
                 fail(*t.get("payload"), "payload must be \"json\" or \"sparkplug\"");

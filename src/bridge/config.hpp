@@ -106,7 +106,8 @@ struct BridgeConfig {
     std::string source;  // the file name, for messages
     std::string instance;
     std::chrono::seconds failover{10};
-    std::string payload = "json";  // "json" | "sparkplug" (PayloadFormat, payload.hpp)
+    std::chrono::seconds stats{10};  // {prefix}/$bridge/{instance}/stats every this often
+    std::string payload = "json";    // "json" | "sparkplug" (PayloadFormat, payload.hpp)
     Mqtt mqtt;
     WriteRules write;
     std::vector<Plc> plcs;
