@@ -28,7 +28,7 @@ const Tag* find_tag(const Plc& plc, std::string_view name) {
 
 }  // namespace
 
-Bridge::Bridge(net::io_context& io, const BridgeConfig& config,
+Bridge::Bridge(asio::io_context& io, const BridgeConfig& config,
                std::unique_ptr<PayloadFormat> format, std::unique_ptr<Ownership> ownership)
     : io_(io),
       config_(config),
@@ -52,7 +52,7 @@ Bridge::~Bridge() = default;
 bool Bridge::start(std::string& error) {
     MqttClient::Handlers h;
     h.connected = [this] {
-        net::post(io_, [this] {
+        asio::post(io_, [this] {
             if (stopped_) return;
             format_->connected(sink_);
             for (const auto& [name, st] : statuses_)
@@ -148,8 +148,8 @@ void Bridge::incoming(std::string topic, std::string payload, bool retained) {
         ++dropped_commands_;
         return;
     }
-    net::post(io_, [this, topic = std::move(topic), payload = std::move(payload), retained,
-                    arrival = Clock::now()] {
+    asio::post(io_, [this, topic = std::move(topic), payload = std::move(payload), retained,
+                     arrival = Clock::now()] {
         pending_commands_.fetch_sub(1);
         if (!stopped_) command(topic, payload, retained, arrival);
     });

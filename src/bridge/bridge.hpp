@@ -41,7 +41,7 @@ inline constexpr std::size_t max_pending_commands = 1024;
 
 class Bridge final : public PollerEvents {
   public:
-    Bridge(net::io_context& io, const BridgeConfig& config, std::unique_ptr<PayloadFormat> format,
+    Bridge(asio::io_context& io, const BridgeConfig& config, std::unique_ptr<PayloadFormat> format,
            std::unique_ptr<Ownership> ownership);
     ~Bridge() override;
 
@@ -59,7 +59,7 @@ class Bridge final : public PollerEvents {
     [[nodiscard]] PayloadFormat& format() noexcept { return *format_; }
     [[nodiscard]] Ownership& ownership() noexcept { return *ownership_; }
     [[nodiscard]] MqttClient* mqtt() noexcept { return mqtt_.get(); }
-    [[nodiscard]] net::io_context& io() noexcept { return io_; }
+    [[nodiscard]] asio::io_context& io() noexcept { return io_; }
 
     void group_done(const GroupSample& sample) override;
     void status_changed(const PlcStatus& status) override;
@@ -82,7 +82,7 @@ class Bridge final : public PollerEvents {
     void publish(Message&& m);
     void report();
 
-    net::io_context& io_;
+    asio::io_context& io_;
     const BridgeConfig& config_;
     std::unique_ptr<PayloadFormat> format_;
     std::unique_ptr<Ownership> ownership_;
@@ -93,7 +93,7 @@ class Bridge final : public PollerEvents {
     std::map<std::string, IdMemory, std::less<>> ids_;
     std::atomic<std::size_t> pending_commands_{0};
     std::atomic<std::uint64_t> dropped_commands_{0};
-    net::steady_timer report_timer_;
+    asio::steady_timer report_timer_;
     std::chrono::steady_clock::time_point last_report_;
     PollerStats last_totals_{};
     bool stopped_ = false;

@@ -19,7 +19,7 @@ namespace fins::bridge {
 using Clock = std::chrono::steady_clock;
 
 struct PlcPoller::GroupState {
-    GroupState(net::io_context& io, const Group& g) : cfg(g), timer(io) {}
+    GroupState(asio::io_context& io, const Group& g) : cfg(g), timer(io) {}
     const Group& cfg;
     Plan plan;
     std::vector<std::vector<std::uint8_t>> parameters;     // encoded once per frame
@@ -28,7 +28,7 @@ struct PlcPoller::GroupState {
     std::vector<TagSample> samples;
     std::vector<TagSample> published;
     std::vector<bool> have_published;
-    net::steady_timer timer;
+    asio::steady_timer timer;
     Clock::time_point next;
     std::size_t outstanding = 0;
     bool in_cycle = false;
@@ -79,7 +79,7 @@ bool is_end_code(std::error_code ec) {
 
 }  // namespace
 
-PlcPoller::PlcPoller(net::io_context& io, const Plc& plc, double phase, PollerEvents& events,
+PlcPoller::PlcPoller(asio::io_context& io, const Plc& plc, double phase, PollerEvents& events,
                      std::uint64_t seed)
     : io_(io),
       plc_(plc),
@@ -194,7 +194,7 @@ void PlcPoller::open() {
     boost::system::error_code ec;
     if (plc_.transport == Transport::udp) {
         if (!udp_peer_) {
-            net::ip::udp::resolver resolver(io_);
+            asio::ip::udp::resolver resolver(io_);
             auto r = resolver.resolve(plc_.host, std::to_string(plc_.port), ec);
             if (ec || r.empty()) {
                 go_offline(std::make_error_code(std::errc::host_unreachable));
@@ -214,7 +214,7 @@ void PlcPoller::open() {
             }
             const auto local = udp_.local_endpoint(ec).address();
             const auto peer = udp_peer_->address();
-            const auto bytes = [](const net::ip::address& a) {
+            const auto bytes = [](const asio::ip::address& a) {
                 std::vector<std::uint8_t> b;
                 if (a.is_v4()) {
                     auto x = a.to_v4().to_bytes();
@@ -236,9 +236,9 @@ void PlcPoller::open() {
 }
 
 void PlcPoller::udp_read() {
-    udp_.async_receive(net::buffer(rx_), [this, gen = socket_generation_](
-                                             boost::system::error_code ec, std::size_t n) {
-        if (gen != socket_generation_ || ec == net::error::operation_aborted) return;
+    udp_.async_receive(asio::buffer(rx_), [this, gen = socket_generation_](
+                                              boost::system::error_code ec, std::size_t n) {
+        if (gen != socket_generation_ || ec == asio::error::operation_aborted) return;
         // connection_refused: an ICMP port unreachable for an earlier datagram (a stopped
         // PLC). The frame's timeout takes the PLC offline; keep listening.
         if (!ec) on_frame(Bytes(rx_.data(), n));
@@ -250,7 +250,7 @@ void PlcPoller::tcp_connect() {
     close_socket();
     state_ = state_ == State::online ? State::offline : state_;
     const auto gen = generation_;
-    net::ip::tcp::resolver resolver(io_);
+    asio::ip::tcp::resolver resolver(io_);
     boost::system::error_code ec;
     auto r = resolver.resolve(plc_.host, std::to_string(plc_.port), ec);
     if (ec || r.empty()) {
@@ -259,13 +259,13 @@ void PlcPoller::tcp_connect() {
     }
     tcp_peer_ = r.begin()->endpoint();
     tcp_.async_connect(*tcp_peer_, [this, gen](boost::system::error_code e) {
-        if (gen != generation_ || e == net::error::operation_aborted) return;
+        if (gen != generation_ || e == asio::error::operation_aborted) return;
         if (e) {
             go_offline(std::make_error_code(std::errc::connection_refused));
             return;
         }
         boost::system::error_code ignored;
-        tcp_.set_option(net::ip::tcp::no_delay(true), ignored);
+        tcp_.set_option(asio::ip::tcp::no_delay(true), ignored);
         std::array<std::uint8_t, 20> hello{};
         ByteWriter w(hello);
         write_node_address_request(w, 0);  // 0: the server allocates our node
@@ -284,9 +284,9 @@ void PlcPoller::tcp_connect() {
 
 void PlcPoller::tcp_read() {
     tcp_.async_read_some(
-        net::buffer(rx_.data() + rx_used_, rx_.size() - rx_used_),
+        asio::buffer(rx_.data() + rx_used_, rx_.size() - rx_used_),
         [this, gen = generation_](boost::system::error_code ec, std::size_t n) {
-            if (gen != generation_ || ec == net::error::operation_aborted) return;
+            if (gen != generation_ || ec == asio::error::operation_aborted) return;
             if (ec) {
                 go_offline(make_error_code(ClientError::connection_closed));
                 return;
@@ -334,17 +334,17 @@ void PlcPoller::tcp_flush() {
     std::swap(tx_, tx_busy_);
     tx_.clear();
     writing_ = true;
-    net::async_write(tcp_, net::buffer(tx_busy_),
-                     [this, gen = generation_](boost::system::error_code ec, std::size_t) {
-                         if (gen != generation_ || ec == net::error::operation_aborted) return;
-                         writing_ = false;
-                         tx_busy_.clear();
-                         if (ec) {
-                             go_offline(make_error_code(ClientError::connection_closed));
-                             return;
-                         }
-                         tcp_flush();
-                     });
+    asio::async_write(tcp_, asio::buffer(tx_busy_),
+                      [this, gen = generation_](boost::system::error_code ec, std::size_t) {
+                          if (gen != generation_ || ec == asio::error::operation_aborted) return;
+                          writing_ = false;
+                          tx_busy_.clear();
+                          if (ec) {
+                              go_offline(make_error_code(ClientError::connection_closed));
+                              return;
+                          }
+                          tcp_flush();
+                      });
 }
 
 void PlcPoller::schedule(std::size_t g) {
@@ -452,7 +452,7 @@ bool PlcPoller::send(Request& r) {
     r.deadline = Clock::now() + plc_.timeout;
     if (plc_.transport == Transport::udp) {
         boost::system::error_code ec;
-        udp_.send(net::buffer(scratch_.data(), *n), 0, ec);
+        udp_.send(asio::buffer(scratch_.data(), *n), 0, ec);
         // A refused or full send is a lost datagram: the timeout handles it.
     } else {
         ByteWriter w(MutableBytes(scratch_).first(tcp_header_size));

@@ -36,10 +36,9 @@
 #include "bridge/payload.hpp"
 #include "bridge/plan.hpp"
 #include "fins/frame.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::bridge {
-
-namespace net = boost::asio;
 
 inline constexpr std::size_t max_pending_writes = 16;  // per PLC; more are refused at once
 
@@ -66,7 +65,7 @@ class PollerEvents {
 class PlcPoller {
   public:
     // `phase` in [0, 1): where in its interval each group's first tick falls.
-    PlcPoller(net::io_context& io, const Plc& plc, double phase, PollerEvents& events,
+    PlcPoller(asio::io_context& io, const Plc& plc, double phase, PollerEvents& events,
               std::uint64_t seed);
     ~PlcPoller();
     PlcPoller(const PlcPoller&) = delete;
@@ -125,7 +124,7 @@ class PlcPoller {
     void backoff();
     std::int64_t now_ms() const;
 
-    net::io_context& io_;
+    asio::io_context& io_;
     const Plc& plc_;
     double phase_;
     PollerEvents& events_;
@@ -136,10 +135,10 @@ class PlcPoller {
     std::uint64_t socket_generation_ = 0;  // bumped when the socket closes
     std::optional<std::chrono::steady_clock::time_point> armed_;  // the timeout timer's wait
 
-    net::ip::udp::socket udp_;
-    net::ip::tcp::socket tcp_;
-    std::optional<net::ip::udp::endpoint> udp_peer_;
-    std::optional<net::ip::tcp::endpoint> tcp_peer_;
+    asio::ip::udp::socket udp_;
+    asio::ip::tcp::socket tcp_;
+    std::optional<asio::ip::udp::endpoint> udp_peer_;
+    std::optional<asio::ip::tcp::endpoint> tcp_peer_;
     NodeAddress destination_;
     NodeAddress source_;
     std::array<std::uint8_t, 2048 + 16> rx_{};
@@ -154,8 +153,8 @@ class PlcPoller {
     std::vector<Request> in_flight_;
     std::deque<std::unique_ptr<WriteOp>> writes_;
     std::uint8_t next_service_id_ = 0;
-    net::steady_timer timeout_timer_;
-    net::steady_timer backoff_timer_;
+    asio::steady_timer timeout_timer_;
+    asio::steady_timer backoff_timer_;
     unsigned backoff_attempt_ = 0;
     std::string last_error_;
     PollerStats stats_;

@@ -20,14 +20,14 @@ std::unique_ptr<PayloadFormat> make_format(const BridgeConfig& config) {
 int run(const BridgeConfig& config, const std::string& log_level) {
     spdlog::set_default_logger(spdlog::stderr_color_mt("fins-bridge"));
     spdlog::set_level(spdlog::level::from_str(log_level));
-    net::io_context io(1);
+    asio::io_context io(1);
     Bridge bridge(io, config, make_format(config), std::make_unique<SingleInstance>());
     std::string error;
     if (!bridge.start(error)) {
         spdlog::error("{}", error);
         return 3;
     }
-    net::signal_set signals(io, SIGINT, SIGTERM);
+    asio::signal_set signals(io, SIGINT, SIGTERM);
     signals.async_wait([&](boost::system::error_code ec, int) {
         if (ec) return;
         bridge.stop();
