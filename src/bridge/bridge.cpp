@@ -50,8 +50,9 @@ Bridge::Bridge(asio::io_context& io, const BridgeConfig& config,
 Bridge::~Bridge() = default;
 
 bool Bridge::start(std::string& error) {
-    MqttClient::Handlers h;
-    h.connected = [this] {
+    const bool session = format_->own_session();
+    // The format's births and statuses follow the connection that carries them.
+    auto births = [this] {
         asio::post(io_, [this] {
             if (stopped_) return;
             format_->connected(sink_);
@@ -61,13 +62,38 @@ bool Bridge::start(std::string& error) {
                 p->request_full();
         });
     };
-    h.message = [this](std::string topic, std::string payload, bool retained) {
+    auto message = [this](std::string topic, std::string payload, bool retained) {
         incoming(std::move(topic), std::move(payload), retained);
     };
+    MqttClient::Handlers h;
+    if (!session) h.connected = births;
+    h.message = message;
+    h.disconnected = [this] {
+        asio::post(io_, [this] {
+            if (!stopped_) ownership_->connection_lost();
+        });
+    };
+    auto subscriptions = ownership_->subscriptions();
+    if (!session) {
+        const auto more = format_->subscriptions();
+        subscriptions.insert(subscriptions.end(), more.begin(), more.end());
+    }
     mqtt_ = std::make_unique<MqttClient>(config_.mqtt, format_->bridge_status(false),
-                                         format_->bridge_status(true), format_->subscriptions(),
+                                         format_->bridge_status(true), std::move(subscriptions),
                                          std::move(h));
     if (!mqtt_->start(error)) return false;
+    if (session) {
+        // Sparkplug's Edge Node session: its own client id, its NDEATH as the Will.
+        Mqtt sc = config_.mqtt;
+        sc.client_id += "-session";
+        MqttClient::Handlers sh;
+        sh.connected = births;
+        sh.message = message;
+        sh.will = [this] { return format_->session_will(); };
+        session_ = std::make_unique<MqttClient>(sc, Message{}, Message{}, format_->subscriptions(),
+                                                std::move(sh));
+        if (!session_->start(error)) return false;
+    }
     reconcile();
     last_report_ = Clock::now();
     report();
@@ -80,6 +106,7 @@ void Bridge::stop() {
     report_timer_.cancel();
     for (auto& [name, p] : pollers_)
         p->stop();
+    if (session_) session_->stop(format_->session_goodbye());
     if (mqtt_) mqtt_->stop(format_->bridge_status(false));
 }
 
@@ -92,12 +119,16 @@ void Bridge::reconcile() {
         } else if (!mine && p->running()) {
             p->stop();
             statuses_.erase(name);
+            format_->released(p->plc(), sink_);
         }
     }
 }
 
 void Bridge::publish(Message&& m) {
-    if (mqtt_) mqtt_->publish(m);
+    if (session_)
+        session_->publish(m);
+    else if (mqtt_)
+        mqtt_->publish(m);
 }
 
 void Bridge::group_done(const GroupSample& sample) {
@@ -157,14 +188,26 @@ void Bridge::incoming(std::string topic, std::string payload, bool retained) {
 
 void Bridge::command(const std::string& topic, const std::string& payload, bool retained,
                      Clock::time_point arrival) {
+    if (ownership_->on_message(topic, payload)) return;  // membership
     auto parsed = format_->parse(topic, payload, retained);
     if (!parsed) return;
-    if (!parsed->rebirth && !ownership_->owns(parsed->plc)) return;  // its owner answers
+    // Its owner answers. A retained command arrives as this instance subscribes, before it
+    // has joined; it is refused, never executed, by the instance that owns the PLC once
+    // joined (docs/bridge.md "Several instances").
+    if (!parsed->rebirth && !ownership_->owns(parsed->plc) &&
+        !(retained && parsed->refuse && ownership_->owns_once_joined(parsed->plc)))
+        return;
     auto it = pollers_.find(parsed->plc);
     Plc unknown;
     unknown.name = parsed->plc;
     const Plc& plc = it != pollers_.end() ? it->second->plc() : unknown;
-    if (parsed->rebirth) return;  // formats handle their own control commands
+    if (parsed->rebirth) {
+        // A host application asks for the whole birth sequence again (Sparkplug NCMD).
+        format_->connected(sink_);
+        for (const auto& [name, st] : statuses_)
+            format_->status(st, sink_);
+        return;
+    }
     if (parsed->refuse) {
         // A repeated id is answered as the first time, even when refused.
         if (!parsed->refuse->id.empty()) {

@@ -87,6 +87,7 @@ class Bridge final : public PollerEvents {
     std::unique_ptr<PayloadFormat> format_;
     std::unique_ptr<Ownership> ownership_;
     std::unique_ptr<MqttClient> mqtt_;
+    std::unique_ptr<MqttClient> session_;  // the format's own connection (own_session())
     Sink sink_;
     std::map<std::string, std::unique_ptr<PlcPoller>, std::less<>> pollers_;
     std::map<std::string, PlcStatus, std::less<>> statuses_;

@@ -112,7 +112,11 @@ class Loader {
         c.source = source_;
         if (const auto* n = root.get("bridge")) {
             const auto& t = table(*n, "[bridge]");
-            only(t, "[bridge]", {"instance", "failover_s", "payload", "stats_s"});
+            only(t, "[bridge]",
+                 {"instance", "failover_s", "payload", "stats_s", "sparkplug_group"});
+            c.sparkplug_group = text_or(t, "sparkplug_group", "");
+            if (!c.sparkplug_group.empty() && !valid_name(c.sparkplug_group))
+                fail(*t.get("sparkplug_group"), "sparkplug_group must be [A-Za-z0-9_-]+");
             c.instance = text_or(t, "instance", "");
             if (!c.instance.empty() && !valid_name(c.instance))
                 fail(*t.get("instance"), "instance must be [A-Za-z0-9_-]+");
@@ -134,6 +138,14 @@ class Loader {
         if (const auto* n = root.get("mqtt")) mqtt(table(*n, "[mqtt]"), c.mqtt);
         if (c.mqtt.brokers.empty()) c.mqtt.brokers.push_back({"127.0.0.1", 1883});
         if (c.mqtt.client_id.empty()) c.mqtt.client_id = "fins-bridge-" + c.instance;
+        if (c.sparkplug_group.empty()) {
+            // Sparkplug's group_id: the topic prefix, with what a Sparkplug ID may not hold
+            // ('/', '+', '#') made '-'.
+            c.sparkplug_group = c.mqtt.topic_prefix;
+            std::replace_if(
+                c.sparkplug_group.begin(), c.sparkplug_group.end(),
+                [](char ch) { return !valid_name(std::string_view(&ch, 1)); }, '-');
+        }
         if (const auto* n = root.get("write")) {
             const auto& t = table(*n, "[write]");
             only(t, "[write]", {"ttl_s", "id_memory"});

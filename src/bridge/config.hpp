@@ -108,6 +108,7 @@ struct BridgeConfig {
     std::chrono::seconds failover{10};
     std::chrono::seconds stats{10};  // {prefix}/$bridge/{instance}/stats every this often
     std::string payload = "json";    // "json" | "sparkplug" (PayloadFormat, payload.hpp)
+    std::string sparkplug_group;     // Sparkplug group_id; default: topic_prefix
     Mqtt mqtt;
     WriteRules write;
     std::vector<Plc> plcs;

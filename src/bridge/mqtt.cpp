@@ -95,6 +95,11 @@ void MqttClient::loop() {
     while (!closing()) {
         const Broker& b = config_.brokers[broker % config_.brokers.size()];
         accepted_ = false;
+        if (handlers_.will) {
+            will_ = handlers_.will();
+            mosquitto_will_set(mosq_, will_.topic.c_str(), static_cast<int>(will_.payload.size()),
+                               will_.payload.data(), will_.qos, will_.retain);
+        }
         int rc = mosquitto_connect(mosq_, b.host.c_str(), b.port,
                                    static_cast<int>(config_.keepalive.count()));
         if (rc == MOSQ_ERR_SUCCESS) {
@@ -121,6 +126,7 @@ void MqttClient::loop() {
         }
         connected_ = false;
         queued_ = 0;  // what libmosquitto held for the lost connection is gone
+        if (accepted_ && handlers_.disconnected) handlers_.disconnected();
         if (closing()) return;
         if (accepted_) {
             attempt = 0;  // a lost session: the same broker first
@@ -149,8 +155,9 @@ void MqttClient::on_connect(mosquitto* m, void* p, int rc) {
     for (const auto& s : self->subscriptions_)
         mosquitto_subscribe(m, nullptr, s.c_str(), 1);
     const auto& o = self->online_;
-    mosquitto_publish(m, nullptr, o.topic.c_str(), static_cast<int>(o.payload.size()),
-                      o.payload.data(), o.qos, o.retain);
+    if (!o.topic.empty())  // a connection with no status of its own (Sparkplug's session)
+        mosquitto_publish(m, nullptr, o.topic.c_str(), static_cast<int>(o.payload.size()),
+                          o.payload.data(), o.qos, o.retain);
     spdlog::info("MQTT connected");
     if (self->handlers_.connected) self->handlers_.connected();
 }

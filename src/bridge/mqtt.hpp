@@ -46,6 +46,12 @@ class MqttClient {
     struct Handlers {
         std::function<void()> connected;  // on the MQTT thread, after subscribing
         std::function<void(std::string topic, std::string payload, bool retained)> message;
+        // On the MQTT thread when an accepted connection is lost (not after stop()).
+        std::function<void()> disconnected;
+        // When set, the Will for each CONNECT, asked for before every attempt (Sparkplug's
+        // NDEATH carries a bdSeq that changes per CONNECT); the constructor's `will` is then
+        // only the default.
+        std::function<Message()> will;
     };
     MqttClient(const Mqtt& config, Message will, Message online,
                std::vector<std::string> subscriptions, Handlers handlers);

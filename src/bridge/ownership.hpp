@@ -11,7 +11,9 @@
 #pragma once
 
 #include <functional>
+#include <string>
 #include <string_view>
+#include <vector>
 
 namespace fins::bridge {
 
@@ -20,6 +22,19 @@ class Ownership {
     virtual ~Ownership() = default;
     // Called on the bridge's io_context thread.
     [[nodiscard]] virtual bool owns(std::string_view plc) const = 0;
+    // Membership travels on the bridge's MQTT connection (bridge/cluster): the topic filters
+    // to subscribe to, every message received (true: it was membership, consumed), and the
+    // loss of the connection. All on the io_context thread.
+    [[nodiscard]] virtual std::vector<std::string> subscriptions() const { return {}; }
+    virtual bool on_message(std::string_view topic, std::string_view payload) {
+        (void)topic;
+        (void)payload;
+        return false;
+    }
+    virtual void connection_lost() {}
+    // Whether this instance owns plc once it has joined (counted as a member even before
+    // that): who answers a retained command, which is refused and never executed.
+    [[nodiscard]] virtual bool owns_once_joined(std::string_view plc) const { return owns(plc); }
     // The handler runs on the bridge's io_context thread (post to it from elsewhere).
     void on_change(std::function<void()> handler) { changed_ = std::move(handler); }
 

@@ -93,6 +93,20 @@ class PayloadFormat {
     virtual void values(const GroupSample& sample, const Sink& out) = 0;
     virtual void status(const PlcStatus& status, const Sink& out) = 0;
     virtual void write_response(const Plc& plc, const WriteResponse& r, const Sink& out) = 0;
+    // The PLC is no longer polled here (another instance owns it now).
+    virtual void released(const Plc& plc, const Sink& out) {
+        (void)plc;
+        (void)out;
+    }
+    // A format whose session rules need an MQTT connection of its own (Sparkplug B: the
+    // Edge Node's NDEATH must be the connection's Will, with a bdSeq that changes on every
+    // CONNECT) says so here. Its subscriptions and messages then travel on that second
+    // connection, and the bridge's status and membership stay on the first.
+    [[nodiscard]] virtual bool own_session() const { return false; }
+    // The Will for the session's next CONNECT (called on the MQTT thread before each one).
+    virtual Message session_will() { return {}; }
+    // Published on the session before a clean disconnect.
+    [[nodiscard]] virtual Message session_goodbye() const { return {}; }
     // Parses a message on one of subscriptions(); nullopt when it is not for this format.
     virtual std::optional<ParsedCommand> parse(std::string_view topic, std::string_view payload,
                                                bool retained) = 0;
