@@ -19,7 +19,7 @@ Message JsonPayload::bridge_status(bool online) const {
 }
 
 nlohmann::json error_json(std::error_code ec) {
-    nlohmann::json j{{"error", describe(ec)}};
+    nlohmann::json j{{"error", error_text(ec)}};
     if (ec.category() == end_code_category()) j["end_code"] = fmt::format("{:04X}", ec.value());
     return j;
 }

@@ -20,8 +20,20 @@
 
 #include "bridge/config.hpp"
 #include "bridge/tag_type.hpp"
+#include "fins/error.hpp"
 
 namespace fins::bridge {
+
+// An error as users read it: for a FINS end code its code, name and probable cause from
+// libfins' end-code table (W342 5-1-3): "1103 address range error: the start address is
+// beyond the accessible area"; otherwise the error's message ("no response within the
+// timeout").
+inline std::string error_text(std::error_code ec) {
+    if (ec.category() == end_code_category())
+        if (const auto* info = find_end_code(static_cast<std::uint16_t>(ec.value())))
+            return describe(ec) + ": " + std::string(info->message);
+    return describe(ec);
+}
 
 struct Message {
     std::string topic;

@@ -669,7 +669,7 @@ void PlcPoller::finish_write(WriteOp& op, std::error_code error, const ResponseV
     r.id = op.id;
     if (error) {
         r.ok = false;
-        r.error = describe(error);
+        r.error = error_text(error);
         if (is_end_code(error))
             r.end_code = static_cast<std::uint16_t>(error.value());
         else if (op.end_code != 0 || response != nullptr)
@@ -708,7 +708,7 @@ void PlcPoller::go_online() {
 
 void PlcPoller::go_offline(std::error_code why) {
     if (!running_) return;
-    last_error_ = describe(why);
+    last_error_ = error_text(why);
     const bool was = state_ == State::offline;
     state_ = State::offline;
     ++generation_;  // handlers of this connection and pending timers return early
