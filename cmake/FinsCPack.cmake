@@ -1,6 +1,7 @@
 # The Debian 12 packages (cpack -G DEB in a tree configured with
 # -DCMAKE_INSTALL_PREFIX=/usr; scripts/package.sh), split as Debian splits a library:
-#   finskit          finsd (+ systemd unit, /etc/finskit/finsd.toml), fins, docs, man
+#   finskit          finsd (+ systemd unit, /etc/finskit/finsd.toml), fins, fins-bridge
+#                    (+ unit, /etc/finskit/fins-bridge.toml), docs, man
 #                    pages, bash completions
 # Each carries /usr/share/doc/PKG/copyright and changelog.gz (FinsDebian.cmake).
 #   libfins0.1       libfins.so.0.1 (the SONAME while 0.x; see FinsPackage.cmake)
@@ -8,6 +9,11 @@
 #                    reference, examples
 #   python3-finskit  the finskit module and its pytest plugin (when FINS_PYTHON)
 install(FILES ${PROJECT_SOURCE_DIR}/packaging/finsd.service
+  DESTINATION lib/systemd/system COMPONENT runtime)
+# fins-bridge (docs/bridge.md): the program, its unit (not enabled by postinst: it needs
+# a configured PLC list and broker) and /etc/finskit/fins-bridge.toml (a conffile).
+install(TARGETS fins-bridge RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
+install(FILES ${PROJECT_SOURCE_DIR}/packaging/fins-bridge.service
   DESTINATION lib/systemd/system COMPONENT runtime)
 # /etc/finskit/finsd.toml (file(INSTALL) adds DESTDIR) when the prefix (at install time: cpack, --prefix) is /usr,
 # as GNUInstallDirs does; <prefix>/etc/finskit otherwise, never the host's /etc.
@@ -18,6 +24,7 @@ install(CODE "
     set(fins_etc \"\${CMAKE_INSTALL_PREFIX}/etc\")
   endif()
   file(INSTALL \"${PROJECT_SOURCE_DIR}/packaging/finsd.toml\"
+       \"${PROJECT_SOURCE_DIR}/packaging/fins-bridge.toml\"
        DESTINATION \"\${fins_etc}/finskit\")" COMPONENT runtime)
 
 set(CPACK_GENERATOR DEB)

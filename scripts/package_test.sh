@@ -51,6 +51,13 @@ grep '^bind = "127.0.0.1"' /etc/finskit/finsd.toml >/dev/null || fail "config bi
 check "config binds 127.0.0.1"
 dpkg-query -W -f='${Conffiles}' finskit | grep /etc/finskit/finsd.toml >/dev/null || fail "config is a conffile"
 check "config is a conffile"
+# fins-bridge: program, unit (not enabled by the package), example config as a conffile.
+dpkg -L finskit | grep '^/usr/bin/fins-bridge$' >/dev/null || fail "fins-bridge installed"
+bridge_unit=$(dpkg -L finskit | grep "/systemd/system/fins-bridge.service$")
+systemd-analyze verify "$bridge_unit" || fail "systemd-analyze verify $bridge_unit"
+dpkg-query -W -f='${Conffiles}' finskit | grep /etc/finskit/fins-bridge.toml >/dev/null || fail "bridge config is a conffile"
+/usr/bin/fins-bridge --config /etc/finskit/fins-bridge.toml --plan | grep '^press1/fast: ' >/dev/null || fail "fins-bridge --plan of the installed config"
+check "fins-bridge installed, its unit verifies, its config is a conffile and plans"
 
 # Where systemd is PID 1 the postinst has started the service: it runs and answers on
 # its control socket inside the sandbox. Elsewhere (containers, CI) that is skipped.

@@ -1,0 +1,299 @@
+#include "bridge/bridge.hpp"
+
+#include <cmath>
+#include <random>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+#include <boost/asio/post.hpp>
+
+namespace fins::bridge {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::int64_t epoch_ms() {
+    return std::chrono::duration_cast<std::chrono::milliseconds>(
+               std::chrono::system_clock::now().time_since_epoch())
+        .count();
+}
+
+const Tag* find_tag(const Plc& plc, std::string_view name) {
+    for (const auto& g : plc.groups)
+        for (const auto& t : g.tags)
+            if (t.name == name) return &t;
+    return nullptr;
+}
+
+}  // namespace
+
+Bridge::Bridge(asio::io_context& io, const BridgeConfig& config,
+               std::unique_ptr<PayloadFormat> format, std::unique_ptr<Ownership> ownership)
+    : io_(io),
+      config_(config),
+      format_(std::move(format)),
+      ownership_(std::move(ownership)),
+      report_timer_(io) {
+    sink_ = [this](Message&& m) { publish(std::move(m)); };
+    std::random_device seed;
+    std::size_t index = 0;
+    for (const auto& p : config_.plcs) {
+        // Golden-ratio phases: any number of PLCs spreads evenly over the interval.
+        const double phase = std::fmod(static_cast<double>(index++) * 0.6180339887498949, 1.0);
+        pollers_.emplace(p.name, std::make_unique<PlcPoller>(
+                                     io_, p, phase, *this, (std::uint64_t{seed()} << 32) | seed()));
+    }
+    ownership_->on_change([this] { reconcile(); });
+}
+
+Bridge::~Bridge() = default;
+
+bool Bridge::start(std::string& error) {
+    const bool session = format_->own_session();
+    // The format's births and statuses follow the connection that carries them.
+    auto births = [this] {
+        asio::post(io_, [this] {
+            if (stopped_) return;
+            format_->connected(sink_);
+            for (const auto& [name, st] : statuses_)
+                format_->status(st, sink_);
+            for (auto& [name, p] : pollers_)
+                p->request_full();
+        });
+    };
+    auto message = [this](std::string topic, std::string payload, bool retained) {
+        incoming(std::move(topic), std::move(payload), retained);
+    };
+    MqttClient::Handlers h;
+    if (!session) h.connected = births;
+    h.message = message;
+    h.disconnected = [this] {
+        asio::post(io_, [this] {
+            if (!stopped_) ownership_->connection_lost();
+        });
+    };
+    auto subscriptions = ownership_->subscriptions();
+    if (!session) {
+        const auto more = format_->subscriptions();
+        subscriptions.insert(subscriptions.end(), more.begin(), more.end());
+    }
+    mqtt_ = std::make_unique<MqttClient>(config_.mqtt, format_->bridge_status(false),
+                                         format_->bridge_status(true), std::move(subscriptions),
+                                         std::move(h));
+    if (!mqtt_->start(error)) return false;
+    if (session) {
+        // Sparkplug's Edge Node session: its own client id, its NDEATH as the Will.
+        Mqtt sc = config_.mqtt;
+        sc.client_id += "-session";
+        MqttClient::Handlers sh;
+        sh.connected = births;
+        sh.message = message;
+        sh.will = [this] { return format_->session_will(); };
+        session_ = std::make_unique<MqttClient>(sc, Message{}, Message{}, format_->subscriptions(),
+                                                std::move(sh));
+        if (!session_->start(error)) return false;
+    }
+    reconcile();
+    last_report_ = Clock::now();
+    report();
+    return true;
+}
+
+void Bridge::stop() {
+    if (stopped_) return;
+    stopped_ = true;
+    report_timer_.cancel();
+    for (auto& [name, p] : pollers_)
+        p->stop();
+    if (session_) session_->stop(format_->session_goodbye());
+    if (mqtt_) mqtt_->stop(format_->bridge_status(false));
+}
+
+void Bridge::reconcile() {
+    if (stopped_) return;
+    for (auto& [name, p] : pollers_) {
+        const bool mine = ownership_->owns(name);
+        if (mine && !p->running()) {
+            p->start();
+        } else if (!mine && p->running()) {
+            p->stop();
+            statuses_.erase(name);
+            format_->released(p->plc(), sink_);
+        }
+    }
+}
+
+void Bridge::publish(Message&& m) {
+    if (session_)
+        session_->publish(m);
+    else if (mqtt_)
+        mqtt_->publish(m);
+}
+
+void Bridge::group_done(const GroupSample& sample) {
+    format_->values(sample, sink_);
+}
+
+void Bridge::status_changed(const PlcStatus& status) {
+    statuses_[status.plc->name] = status;
+    if (status.online)
+        spdlog::info("PLC {} online", status.plc->name);
+    else
+        spdlog::warn("PLC {} offline: {}", status.plc->name, status.last_error);
+    format_->status(status, sink_);
+}
+
+void Bridge::write_done(const Plc& plc, const WriteResponse& response) {
+    auto& e = remember(plc.name, response.id);
+    e.done = true;
+    e.response = response;
+    format_->write_response(plc, response, sink_);
+}
+
+void Bridge::answer(const Plc& plc, const WriteResponse& r) {
+    if (!r.id.empty()) {
+        auto& e = remember(plc.name, r.id);
+        e.done = true;
+        e.response = r;
+    }
+    format_->write_response(plc, r, sink_);
+}
+
+Bridge::IdMemory::Entry& Bridge::remember(const std::string& plc, const std::string& id) {
+    auto& m = ids_[plc];
+    auto [it, fresh] = m.entries.try_emplace(id);
+    if (fresh) {
+        m.order.push_back(id);
+        while (m.order.size() > config_.write.id_memory) {
+            if (m.order.front() != id) m.entries.erase(m.order.front());
+            m.order.pop_front();
+        }
+    }
+    return m.entries.find(id)->second;
+}
+
+void Bridge::incoming(std::string topic, std::string payload, bool retained) {
+    if (pending_commands_.fetch_add(1) >= max_pending_commands) {
+        pending_commands_.fetch_sub(1);
+        ++dropped_commands_;
+        return;
+    }
+    asio::post(io_, [this, topic = std::move(topic), payload = std::move(payload), retained,
+                     arrival = Clock::now()] {
+        pending_commands_.fetch_sub(1);
+        if (!stopped_) command(topic, payload, retained, arrival);
+    });
+}
+
+void Bridge::command(const std::string& topic, const std::string& payload, bool retained,
+                     Clock::time_point arrival) {
+    if (ownership_->on_message(topic, payload)) return;  // membership
+    auto parsed = format_->parse(topic, payload, retained);
+    if (!parsed) return;
+    // Its owner answers. A retained command arrives as this instance subscribes, before it
+    // has joined; it is refused, never executed, by the instance that owns the PLC once
+    // joined (docs/bridge.md "Several instances").
+    if (!parsed->rebirth && !ownership_->owns(parsed->plc) &&
+        !(retained && parsed->refuse && ownership_->owns_once_joined(parsed->plc)))
+        return;
+    auto it = pollers_.find(parsed->plc);
+    Plc unknown;
+    unknown.name = parsed->plc;
+    const Plc& plc = it != pollers_.end() ? it->second->plc() : unknown;
+    if (parsed->rebirth) {
+        // A host application asks for the whole birth sequence again (Sparkplug NCMD).
+        format_->connected(sink_);
+        for (const auto& [name, st] : statuses_)
+            format_->status(st, sink_);
+        return;
+    }
+    if (parsed->refuse) {
+        // A repeated id is answered as the first time, even when refused.
+        if (!parsed->refuse->id.empty()) {
+            auto& m = ids_[plc.name];
+            if (auto e = m.entries.find(parsed->refuse->id);
+                e != m.entries.end() && e->second.done) {
+                format_->write_response(plc, e->second.response, sink_);
+                return;
+            }
+        }
+        answer(plc, *parsed->refuse);
+        return;
+    }
+    const WriteCommand& w = *parsed->write;
+    {
+        auto& m = ids_[plc.name];
+        if (auto e = m.entries.find(w.id); e != m.entries.end()) {
+            if (e->second.done) format_->write_response(plc, e->second.response, sink_);
+            return;  // running: its answer is on its way
+        }
+    }
+    const auto refuse = [&](std::string error) {
+        answer(plc, WriteResponse{w.id, false, std::nullopt, std::nullopt, std::move(error)});
+    };
+    if (it == pollers_.end()) return refuse(fmt::format("no PLC named '{}'", w.plc));
+    const auto ttl = config_.write.ttl;
+    if (w.ts_ms && epoch_ms() - *w.ts_ms > ttl.count())
+        return refuse(fmt::format("command older than the TTL ({} ms)", ttl.count()));
+    if (Clock::now() - arrival > ttl)
+        return refuse(fmt::format("command waited longer than the TTL ({} ms)", ttl.count()));
+    const Tag* tag = find_tag(plc, w.tag);
+    if (tag == nullptr) return refuse(fmt::format("no tag '{}' on PLC '{}'", w.tag, plc.name));
+    if (!tag->writable) return refuse(fmt::format("tag '{}' is not writable", w.tag));
+    Encoded value;
+    if (auto e = encode_value(tag->type, tag->length, tag->range, w.value, value))
+        return refuse(*e);
+    if (auto e = it->second->write(*tag, value, w.id)) return refuse(*e);
+    remember(plc.name, w.id);  // running
+}
+
+void Bridge::report() {
+    report_timer_.expires_after(config_.stats);
+    report_timer_.async_wait([this](boost::system::error_code ec) {
+        if (ec || stopped_) return;
+        PollerStats t{};
+        std::size_t online = 0;
+        std::size_t polled = 0;
+        for (const auto& [name, p] : pollers_) {
+            const auto& s = p->stats();
+            t.cycles += s.cycles;
+            t.values += s.values;
+            t.frames += s.frames;
+            t.overruns += s.overruns;
+            t.timeouts += s.timeouts;
+            t.resends += s.resends;
+            t.end_codes += s.end_codes;
+            online += p->online() ? 1u : 0u;
+            polled += p->running() ? 1u : 0u;
+        }
+        const auto now = Clock::now();
+        const double seconds = std::chrono::duration<double>(now - last_report_).count();
+        const auto m = mqtt_ ? mqtt_->stats() : MqttStats{};
+        nlohmann::json j{
+            {"instance", config_.instance},
+            {"ts", epoch_ms()},
+            {"plcs_polled", polled},
+            {"plcs_online", online},
+            {"values_per_s", static_cast<double>(t.values - last_totals_.values) / seconds},
+            {"values", t.values},
+            {"cycles", t.cycles},
+            {"frames", t.frames},
+            {"overruns", t.overruns},
+            {"timeouts", t.timeouts},
+            {"resends", t.resends},
+            {"end_codes", t.end_codes},
+            {"published", m.published},
+            {"dropped", m.dropped},
+            {"connects", m.connects},
+            {"commands_dropped", dropped_commands_.load()}};
+        last_totals_ = t;
+        last_report_ = now;
+        spdlog::info("stats {}", j.dump());
+        publish({fmt::format("{}/$bridge/{}/stats", config_.mqtt.topic_prefix, config_.instance),
+                 j.dump(), 0, false});
+        report();
+    });
+}
+
+}  // namespace fins::bridge

@@ -1,0 +1,103 @@
+// The bridge: one PlcPoller per configured PLC on one io_context, a PayloadFormat that
+// turns their results into messages, an MqttClient that carries them, and the write path.
+//
+//   PLC --FINS--> PlcPoller (plan, window, timeouts) --GroupSample--> PayloadFormat
+//       --Message--> MqttClient --> broker
+//   broker --> MqttClient --(bounded post)--> Bridge::command --> PlcPoller::write
+//
+// Ownership (ownership.hpp) decides which PLCs this instance polls: reconcile() starts
+// and stops pollers when it changes, and a write is executed only for an owned PLC.
+//
+// Writes (docs/bridge.md "Writes"): a command is refused, with an answer and without
+// touching the PLC, when it is retained, not JSON, names an unknown or read-only tag,
+// has a value of the wrong type or out of range, is older than [write] ttl_s (its "ts",
+// or the time it waited here), or the PLC is offline. Its id is remembered (the last
+// [write] id_memory ids per PLC): a repeated id is answered again with the first answer,
+// never executed again; while the first is still running the repeat gets no answer of
+// its own (the first one's answer is on the same topic).
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <deque>
+#include <map>
+#include <memory>
+#include <string>
+#include <unordered_map>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/steady_timer.hpp>
+
+#include "bridge/config.hpp"
+#include "bridge/mqtt.hpp"
+#include "bridge/ownership.hpp"
+#include "bridge/payload.hpp"
+#include "bridge/poller.hpp"
+
+namespace fins::bridge {
+
+// Commands received and not yet taken by the io_context; more are dropped (and counted).
+inline constexpr std::size_t max_pending_commands = 1024;
+
+class Bridge final : public PollerEvents {
+  public:
+    Bridge(asio::io_context& io, const BridgeConfig& config, std::unique_ptr<PayloadFormat> format,
+           std::unique_ptr<Ownership> ownership);
+    ~Bridge() override;
+
+    // Connects MQTT and starts polling the owned PLCs. False with the reason on a
+    // start-up failure.
+    bool start(std::string& error);
+    // Stops polling, publishes the offline status and disconnects.
+    void stop();
+    // Starts polling owned PLCs that are not polled and stops the others.
+    void reconcile();
+
+    // Incoming MQTT message (any thread): posted to the io_context, bounded.
+    void incoming(std::string topic, std::string payload, bool retained);
+
+    [[nodiscard]] PayloadFormat& format() noexcept { return *format_; }
+    [[nodiscard]] Ownership& ownership() noexcept { return *ownership_; }
+    [[nodiscard]] MqttClient* mqtt() noexcept { return mqtt_.get(); }
+    [[nodiscard]] asio::io_context& io() noexcept { return io_; }
+
+    void group_done(const GroupSample& sample) override;
+    void status_changed(const PlcStatus& status) override;
+    void write_done(const Plc& plc, const WriteResponse& response) override;
+
+  private:
+    struct IdMemory {
+        struct Entry {
+            bool done = false;
+            WriteResponse response;
+        };
+        std::unordered_map<std::string, Entry> entries;
+        std::deque<std::string> order;  // oldest first
+    };
+
+    void command(const std::string& topic, const std::string& payload, bool retained,
+                 std::chrono::steady_clock::time_point arrival);
+    void answer(const Plc& plc, const WriteResponse& r);
+    IdMemory::Entry& remember(const std::string& plc, const std::string& id);
+    void publish(Message&& m);
+    void report();
+
+    asio::io_context& io_;
+    const BridgeConfig& config_;
+    std::unique_ptr<PayloadFormat> format_;
+    std::unique_ptr<Ownership> ownership_;
+    std::unique_ptr<MqttClient> mqtt_;
+    std::unique_ptr<MqttClient> session_;  // the format's own connection (own_session())
+    Sink sink_;
+    std::map<std::string, std::unique_ptr<PlcPoller>, std::less<>> pollers_;
+    std::map<std::string, PlcStatus, std::less<>> statuses_;
+    std::map<std::string, IdMemory, std::less<>> ids_;
+    std::atomic<std::size_t> pending_commands_{0};
+    std::atomic<std::uint64_t> dropped_commands_{0};
+    asio::steady_timer report_timer_;
+    std::chrono::steady_clock::time_point last_report_;
+    PollerStats last_totals_{};
+    bool stopped_ = false;
+};
+
+}  // namespace fins::bridge

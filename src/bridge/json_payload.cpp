@@ -1,0 +1,117 @@
+#include "bridge/json_payload.hpp"
+
+#include <fmt/format.h>
+
+#include "fins/error.hpp"
+
+namespace fins::bridge {
+
+JsonPayload::JsonPayload(std::string prefix, std::string instance)
+    : prefix_(std::move(prefix)), instance_(std::move(instance)) {}
+
+std::vector<std::string> JsonPayload::subscriptions() const {
+    return {prefix_ + "/+/write"};
+}
+
+Message JsonPayload::bridge_status(bool online) const {
+    nlohmann::json j{{"state", online ? "online" : "offline"}, {"instance", instance_}};
+    return {fmt::format("{}/$bridge/{}/status", prefix_, instance_), j.dump(), 1, true};
+}
+
+nlohmann::json error_json(std::error_code ec) {
+    nlohmann::json j{{"error", error_text(ec)}};
+    if (ec.category() == end_code_category()) j["end_code"] = fmt::format("{:04X}", ec.value());
+    return j;
+}
+
+void JsonPayload::values(const GroupSample& s, const Sink& out) {
+    std::string& b = buffer_;
+    b.clear();
+    auto it = std::back_inserter(b);
+    fmt::format_to(it, "{{\"ts\":{},\"values\":{{", s.ts_ms);
+    bool first = true;
+    for (std::size_t i = 0; i < s.tags.size(); ++i) {
+        const TagSample& t = s.tags[i];
+        if (!s.full && !t.changed) continue;
+        const Tag& tag = s.group->tags[i];
+        if (!first) b += ',';
+        first = false;
+        b += '"';
+        b += tag.name;  // [A-Za-z0-9_-]: nothing to escape
+        b += "\":";
+        if (t.error)
+            b += error_json(t.error).dump();
+        else
+            append_json(b, tag.type, t.value);
+    }
+    if (first && !s.full) return;  // nothing changed: no message
+    b += s.full ? "},\"full\":true}" : "}}";
+    out({fmt::format("{}/{}/{}", prefix_, s.plc->name, s.group->name), b, 0, false});
+}
+
+void JsonPayload::status(const PlcStatus& st, const Sink& out) {
+    nlohmann::json j{{"state", st.online ? "online" : "offline"}, {"ts", st.ts_ms}};
+    if (!st.last_error.empty()) j["error"] = st.last_error;
+    out({fmt::format("{}/{}/status", prefix_, st.plc->name), j.dump(), 1, true});
+}
+
+void JsonPayload::write_response(const Plc& plc, const WriteResponse& r, const Sink& out) {
+    nlohmann::json j{{"id", r.id}, {"ok", r.ok}};
+    j["end_code"] = r.end_code ? nlohmann::json(fmt::format("{:04X}", *r.end_code)) : nullptr;
+    j["value"] = r.value ? *r.value : nlohmann::json(nullptr);
+    j["error"] = r.error.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.error);
+    out({fmt::format("{}/{}/write/response", prefix_, plc.name), j.dump(), 1, false});
+}
+
+std::optional<ParsedCommand> JsonPayload::parse(std::string_view topic, std::string_view payload,
+                                                bool retained) {
+    // {prefix}/{plc}/write
+    constexpr std::string_view suffix = "/write";
+    if (topic.size() <= prefix_.size() + 1 + suffix.size() || !topic.starts_with(prefix_) ||
+        topic[prefix_.size()] != '/' || !topic.ends_with(suffix))
+        return std::nullopt;
+    ParsedCommand c;
+    c.plc = std::string(
+        topic.substr(prefix_.size() + 1, topic.size() - prefix_.size() - 1 - suffix.size()));
+    const auto refuse = [&](std::string id, std::string error) {
+        c.refuse =
+            WriteResponse{std::move(id), false, std::nullopt, std::nullopt, std::move(error)};
+        return c;
+    };
+    auto j = nlohmann::json::parse(payload, nullptr, false);
+    if (j.is_discarded() || !j.is_object()) return refuse("", "the command is not a JSON object");
+    std::string id;
+    if (auto f = j.find("id"); f != j.end()) {
+        if (f->is_string())
+            id = f->get<std::string>();
+        else if (f->is_number_integer())
+            id = f->dump();
+        else
+            return refuse("", "id must be a string or an integer");
+    }
+    if (id.empty()) return refuse("", "the command has no id");
+    if (id.size() > 128) return refuse(id.substr(0, 128), "id longer than 128 characters");
+    if (retained)
+        return refuse(id, "retained command refused (a command is executed once, when sent)");
+    for (auto& [k, v] : j.items())
+        if (k != "id" && k != "tag" && k != "value" && k != "ts")
+            return refuse(id, fmt::format("unknown key '{}'", k));
+    auto tag = j.find("tag");
+    if (tag == j.end() || !tag->is_string()) return refuse(id, "tag must be a string");
+    auto value = j.find("value");
+    if (value == j.end()) return refuse(id, "the command has no value");
+    WriteCommand w;
+    w.plc = c.plc;
+    w.id = id;
+    w.tag = tag->get<std::string>();
+    w.value = *value;
+    if (auto ts = j.find("ts"); ts != j.end()) {
+        if (!ts->is_number_integer())
+            return refuse(id, "ts must be an integer (ms since the epoch)");
+        w.ts_ms = ts->get<std::int64_t>();
+    }
+    c.write = std::move(w);
+    return c;
+}
+
+}  // namespace fins::bridge

@@ -1,0 +1,38 @@
+// The JSON payload format (docs/bridge.md "Topics and payloads"):
+//   {prefix}/{plc}/{group}            {"ts":1700000000000,"values":{"speed":12,"run":true,
+//                                      "temp":{"error":"timeout"}}[,"full":true]}
+//   {prefix}/{plc}/status             retained {"state":"online"|"offline","ts":..,"error":..}
+//   {prefix}/$bridge/{instance}/status retained {"state":"online"|"offline","instance":..}
+//   {prefix}/{plc}/write              in:  {"id":"..","tag":"temp","value":1.5[,"ts":ms]}
+//   {prefix}/{plc}/write/response     out: {"id":..,"ok":..,"end_code":..,"value":..,"error":..}
+// A tag that could not be read is {"error":"<text>","end_code":"1103"} (end_code only when
+// the PLC answered one), never a value.
+#pragma once
+
+#include <string>
+
+#include "bridge/payload.hpp"
+
+namespace fins::bridge {
+
+class JsonPayload final : public PayloadFormat {
+  public:
+    JsonPayload(std::string prefix, std::string instance);
+    [[nodiscard]] std::vector<std::string> subscriptions() const override;
+    [[nodiscard]] Message bridge_status(bool online) const override;
+    void values(const GroupSample& sample, const Sink& out) override;
+    void status(const PlcStatus& status, const Sink& out) override;
+    void write_response(const Plc& plc, const WriteResponse& r, const Sink& out) override;
+    std::optional<ParsedCommand> parse(std::string_view topic, std::string_view payload,
+                                       bool retained) override;
+
+  private:
+    std::string prefix_;
+    std::string instance_;
+    std::string buffer_;  // reused for every data message
+};
+
+// The JSON text of an error: {"error":"...","end_code":"1103"}.
+nlohmann::json error_json(std::error_code ec);
+
+}  // namespace fins::bridge

@@ -1,0 +1,388 @@
+// Real parts for the Sparkplug and multi-instance tests: a mosquitto broker on a free loopback
+// port, fins-bridge processes (logs to a file, so a chatty child never blocks on a full pipe),
+// an MQTT recorder (libmosquitto) and a UDP relay in front of finsd that counts the requests
+// of each sender (which instance polls which PLC). Every wait is bounded; children die with
+// the test (PR_SET_PDEATHSIG) and are killed by their destructor.
+#pragma once
+
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <mosquitto.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <mutex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace fins::test::bridge {
+
+using namespace std::chrono_literals;
+
+inline const std::string bridge_path = std::string(FINS_BIN_DIR) + "/fins-bridge";
+inline const std::string finsd_exe = std::string(FINS_BIN_DIR) + "/finsd";
+
+inline bool have_program(const std::string& path) {
+    return ::access(path.c_str(), X_OK) == 0;
+}
+inline std::string mosquitto_path() {
+    for (const char* p : {"/usr/sbin/mosquitto", "/usr/bin/mosquitto"})
+        if (have_program(p)) return p;
+    return {};
+}
+
+// A loopback port that was free a moment ago (the kernel's choice).
+inline std::uint16_t free_tcp_port() {
+    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    a.sin_port = 0;
+    socklen_t len = sizeof a;
+    if (::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0 ||
+        ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) != 0) {
+        ::close(fd);
+        return 0;
+    }
+    ::close(fd);
+    return ntohs(a.sin_port);
+}
+
+inline bool tcp_connectable(std::uint16_t port) {
+    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    a.sin_port = htons(port);
+    const bool ok = ::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+    ::close(fd);
+    return ok;
+}
+
+// A child process whose stdout and stderr go to `log`.
+class Proc {
+  public:
+    Proc(const std::vector<std::string>& argv, const std::filesystem::path& log) : log_(log) {
+        const pid_t parent = ::getpid();
+        pid_ = ::fork();
+        if (pid_ == 0) {
+            if (::prctl(PR_SET_PDEATHSIG, SIGKILL) != 0 || ::getppid() != parent) ::_exit(127);
+            const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+            if (fd >= 0) {
+                ::dup2(fd, 1);
+                ::dup2(fd, 2);
+                ::close(fd);
+            }
+            std::vector<char*> args;
+            for (const auto& a : argv)
+                args.push_back(const_cast<char*>(a.c_str()));
+            args.push_back(nullptr);
+            ::execv(args[0], args.data());
+            ::_exit(127);
+        }
+    }
+    ~Proc() { kill(SIGKILL); }
+    Proc(const Proc&) = delete;
+    Proc& operator=(const Proc&) = delete;
+
+    // Sends `sig` and reaps the child (bounded: SIGKILL after `timeout`). The exit status.
+    int kill(int sig, std::chrono::milliseconds timeout = 10s) {
+        if (pid_ <= 0 || reaped_) return status_;
+        ::kill(pid_, sig);
+        const auto deadline = std::chrono::steady_clock::now() + timeout;
+        int st = 0;
+        while (::waitpid(pid_, &st, WNOHANG) == 0) {
+            if (std::chrono::steady_clock::now() > deadline) {
+                ::kill(pid_, SIGKILL);
+                ::waitpid(pid_, &st, 0);
+                break;
+            }
+            std::this_thread::sleep_for(10ms);
+        }
+        reaped_ = true;
+        status_ = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+        return status_;
+    }
+    [[nodiscard]] pid_t pid() const { return pid_; }
+    bool running() {
+        if (pid_ <= 0 || reaped_) return false;
+        int st = 0;
+        if (::waitpid(pid_, &st, WNOHANG) == pid_) {
+            reaped_ = true;
+            status_ = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+            return false;
+        }
+        return true;
+    }
+    std::string log() const {
+        std::ifstream in(log_);
+        std::stringstream s;
+        s << in.rdbuf();
+        return s.str();
+    }
+
+  private:
+    std::filesystem::path log_;
+    pid_t pid_ = -1;
+    bool reaped_ = false;
+    int status_ = -1;
+};
+
+// mosquitto on 127.0.0.1:<free port>, anonymous, no persistence.
+class Mosquitto {
+  public:
+    explicit Mosquitto(const std::filesystem::path& dir) {
+        const auto exe = mosquitto_path();
+        if (exe.empty()) return;
+        for (int attempt = 0; attempt < 5 && !up_; ++attempt) {
+            port_ = free_tcp_port();
+            const auto conf = dir / ("mosquitto-" + std::to_string(port_) + ".conf");
+            std::ofstream(conf) << "listener " << port_ << " 127.0.0.1\nallow_anonymous true\n"
+                                << "persistence false\n";
+            proc_ = std::make_unique<Proc>(std::vector<std::string>{exe, "-c", conf.string()},
+                                           dir / ("mosquitto-" + std::to_string(port_) + ".log"));
+            const auto deadline = std::chrono::steady_clock::now() + 10s;
+            while (std::chrono::steady_clock::now() < deadline && proc_->running()) {
+                if (tcp_connectable(port_)) {
+                    up_ = true;
+                    break;
+                }
+                std::this_thread::sleep_for(20ms);
+            }
+        }
+    }
+    [[nodiscard]] bool up() const { return up_; }
+    [[nodiscard]] std::uint16_t port() const { return port_; }
+
+  private:
+    std::unique_ptr<Proc> proc_;
+    std::uint16_t port_ = 0;
+    bool up_ = false;
+};
+
+struct Received {
+    std::string topic;
+    std::string payload;
+    bool retain = false;
+    std::chrono::steady_clock::time_point at;
+};
+
+// An MQTT client that records everything on its subscriptions and can publish.
+class Recorder {
+  public:
+    Recorder(std::uint16_t port, const std::vector<std::string>& filters, std::string id = {}) {
+        static std::once_flag once;
+        std::call_once(once, [] { mosquitto_lib_init(); });
+        static std::atomic<int> n{0};
+        if (id.empty()) id = "recorder-" + std::to_string(::getpid()) + "-" + std::to_string(n++);
+        m_ = mosquitto_new(id.c_str(), true, this);
+        mosquitto_connect_callback_set(m_, [](mosquitto* m, void* self, int rc) {
+            auto* r = static_cast<Recorder*>(self);
+            if (rc != 0) return;
+            for (const auto& f : r->filters_)
+                mosquitto_subscribe(m, nullptr, f.c_str(), 1);
+        });
+        mosquitto_subscribe_callback_set(m_, [](mosquitto*, void* self, int, int, const int*) {
+            auto* r = static_cast<Recorder*>(self);
+            std::lock_guard lock(r->mu_);
+            ++r->subacks_;
+            r->cv_.notify_all();
+        });
+        mosquitto_message_callback_set(
+            m_, [](mosquitto*, void* self, const mosquitto_message* msg) {
+                auto* r = static_cast<Recorder*>(self);
+                Received rec{msg->topic,
+                             std::string(static_cast<const char*>(msg->payload),
+                                         static_cast<std::size_t>(msg->payloadlen)),
+                             msg->retain, std::chrono::steady_clock::now()};
+                std::lock_guard lock(r->mu_);
+                r->messages_.push_back(std::move(rec));
+                r->cv_.notify_all();
+            });
+        filters_ = filters;
+        mosquitto_connect(m_, "127.0.0.1", port, 10);
+        mosquitto_loop_start(m_);
+        std::unique_lock lock(mu_);
+        cv_.wait_for(lock, 10s, [&] { return subacks_ >= filters_.size(); });
+    }
+    ~Recorder() {
+        mosquitto_disconnect(m_);
+        mosquitto_loop_stop(m_, false);
+        mosquitto_destroy(m_);
+    }
+    Recorder(const Recorder&) = delete;
+    Recorder& operator=(const Recorder&) = delete;
+
+    void publish(const std::string& topic, const std::string& payload, int qos = 1,
+                 bool retain = false) {
+        mosquitto_publish(m_, nullptr, topic.c_str(), static_cast<int>(payload.size()),
+                          payload.data(), qos, retain);
+    }
+
+    // Waits until pred(messages) holds (at most timeout); the last answer of pred. pred runs
+    // with the recorder locked: it must use its argument, not messages() or count().
+    bool wait(const std::function<bool(const std::vector<Received>&)>& pred,
+              std::chrono::milliseconds timeout) {
+        std::unique_lock lock(mu_);
+        return cv_.wait_for(lock, timeout, [&] { return pred(messages_); });
+    }
+    std::vector<Received> messages() const {
+        std::lock_guard lock(mu_);
+        return messages_;
+    }
+    std::size_t count() const {
+        std::lock_guard lock(mu_);
+        return messages_.size();
+    }
+
+  private:
+    mosquitto* m_ = nullptr;
+    std::vector<std::string> filters_;
+    mutable std::mutex mu_;
+    std::condition_variable cv_;
+    std::size_t subacks_ = 0;
+    std::vector<Received> messages_;
+};
+
+// UDP relays in front of one finsd: relay i listens on its own loopback port (a PLC of the
+// bridge's config) and forwards to finsd's port, each sender through its own upstream socket
+// so answers go back to it. It counts the requests of every sender per relay: two senders
+// on one relay in a stable period means two instances polled that PLC.
+class CountingRelay {
+  public:
+    CountingRelay(std::size_t relays, std::uint16_t finsd_port) : finsd_port_(finsd_port) {
+        for (std::size_t i = 0; i < relays; ++i) {
+            const int fd = udp_socket(0);
+            listen_.push_back(fd);
+            sockaddr_in a{};
+            socklen_t len = sizeof a;
+            ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
+            ports_.push_back(ntohs(a.sin_port));
+        }
+        thread_ = std::thread([this] { loop(); });
+    }
+    ~CountingRelay() {
+        stop_ = true;
+        thread_.join();
+        for (int fd : listen_)
+            ::close(fd);
+        for (auto& [k, fd] : upstream_)
+            ::close(fd);
+    }
+    CountingRelay(const CountingRelay&) = delete;
+    CountingRelay& operator=(const CountingRelay&) = delete;
+
+    [[nodiscard]] std::uint16_t port(std::size_t relay) const { return ports_[relay]; }
+
+    // Requests per sender ("port") seen by relay i since the last reset.
+    std::map<std::uint16_t, std::uint64_t> senders(std::size_t relay) const {
+        std::lock_guard lock(mu_);
+        std::map<std::uint16_t, std::uint64_t> out;
+        for (const auto& [key, n] : counts_)
+            if (key.first == relay) out[key.second] = n;
+        return out;
+    }
+    // MEMORY AREA WRITE (01 02) frames relay i passed on, since the start.
+    std::uint64_t writes(std::size_t relay) const {
+        std::lock_guard lock(mu_);
+        const auto it = writes_.find(relay);
+        return it == writes_.end() ? 0 : it->second;
+    }
+    void reset() {
+        std::lock_guard lock(mu_);
+        counts_.clear();
+    }
+
+  private:
+    static int udp_socket(std::uint16_t port) {
+        const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK, 0);
+        sockaddr_in a{};
+        a.sin_family = AF_INET;
+        a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+        a.sin_port = htons(port);
+        ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
+        return fd;
+    }
+
+    void loop() {
+        char buf[4096];
+        while (!stop_) {
+            std::vector<pollfd> fds;
+            for (int fd : listen_)
+                fds.push_back({fd, POLLIN, 0});
+            std::vector<std::pair<std::size_t, sockaddr_in>> owners;  // upstream fd order
+            std::vector<int> ups;
+            {
+                for (const auto& [key, fd] : upstream_) {
+                    fds.push_back({fd, POLLIN, 0});
+                    ups.push_back(fd);
+                    owners.push_back({key.first, client_[key]});
+                }
+            }
+            if (::poll(fds.data(), fds.size(), 50) <= 0) continue;
+            for (std::size_t i = 0; i < listen_.size(); ++i) {
+                if (!(fds[i].revents & POLLIN)) continue;
+                sockaddr_in from{};
+                socklen_t len = sizeof from;
+                const auto n = ::recvfrom(listen_[i], buf, sizeof buf, 0,
+                                          reinterpret_cast<sockaddr*>(&from), &len);
+                if (n <= 0) continue;
+                const std::pair<std::size_t, std::uint16_t> key{i, ntohs(from.sin_port)};
+                auto it = upstream_.find(key);
+                if (it == upstream_.end()) {
+                    it = upstream_.emplace(key, udp_socket(0)).first;
+                    client_[key] = from;
+                }
+                {
+                    std::lock_guard lock(mu_);
+                    ++counts_[key];
+                    // FINS header (10 bytes) then the command code: 01 02 MEMORY AREA WRITE.
+                    if (n >= 12 && buf[10] == 0x01 && buf[11] == 0x02) ++writes_[i];
+                }
+                sockaddr_in to{};
+                to.sin_family = AF_INET;
+                to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+                to.sin_port = htons(finsd_port_);
+                ::sendto(it->second, buf, static_cast<std::size_t>(n), 0,
+                         reinterpret_cast<sockaddr*>(&to), sizeof to);
+            }
+            for (std::size_t j = 0; j < ups.size(); ++j) {
+                if (!(fds[listen_.size() + j].revents & POLLIN)) continue;
+                const auto n = ::recv(ups[j], buf, sizeof buf, 0);
+                if (n <= 0) continue;
+                const auto& [relay, client] = owners[j];
+                ::sendto(listen_[relay], buf, static_cast<std::size_t>(n), 0,
+                         reinterpret_cast<const sockaddr*>(&client), sizeof client);
+            }
+        }
+    }
+
+    std::uint16_t finsd_port_;
+    std::vector<int> listen_;
+    std::vector<std::uint16_t> ports_;
+    std::map<std::pair<std::size_t, std::uint16_t>, int> upstream_;
+    std::map<std::pair<std::size_t, std::uint16_t>, sockaddr_in> client_;
+    mutable std::mutex mu_;
+    std::map<std::pair<std::size_t, std::uint16_t>, std::uint64_t> counts_;
+    std::map<std::size_t, std::uint64_t> writes_;
+    std::atomic<bool> stop_{false};
+    std::thread thread_;
+};
+
+}  // namespace fins::test::bridge
