@@ -13,10 +13,12 @@
 
 namespace fins::scenario {
 
-// A 1-based position in the scenario's source file; line 0 = unknown.
+// A 1-based position in one of the scenario's source files (`source`: an index the
+// loader keeps; a [scenario] table may include a file); line 0 = unknown.
 struct SourcePos {
     std::uint32_t line = 0;
     std::uint32_t column = 0;
+    std::uint32_t source = 0;
 };
 
 // The value types of `fins --as`: how a tag's value sits in PLC words (fins/values.hpp).

@@ -21,9 +21,9 @@ tl::unexpected<CompileError> error(SourcePos pos, std::string message) {
 // The position of column `column` of line `line` of a string value starting at `pos`
 // (the opening quote).
 SourcePos inside(SourcePos pos, std::uint32_t line, std::uint32_t column) {
-    if (pos.line == 0) return {line, column};
-    if (line == 1) return {pos.line, pos.column + column};
-    return {pos.line + line - 1, column};
+    if (pos.line == 0) return {line, column, pos.source};
+    if (line == 1) return {pos.line, pos.column + column, pos.source};
+    return {pos.line + line - 1, column, pos.source};
 }
 
 // Why IoMemory::locate refused an address, in words.

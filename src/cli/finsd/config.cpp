@@ -62,6 +62,8 @@ class Loader {
                 r = load_remotes(key, node, source_, s_);
             else if (k == "schedule")
                 r = load_schedule(key, node, source_, s_);
+            else if (k == "scenario")
+                r = scenario(node);
             else
                 r = fail(key, k, "unknown key");
             if (!r) return r;
@@ -127,6 +129,13 @@ class Loader {
         if (v->get() < lo || v->get() > hi)
             return fail(key, path, fmt::format("{} is not {}-{}", v->get(), lo, hi));
         return v->get();
+    }
+
+    Expected<void> scenario(const toml::node& node) {
+        auto config = load_scenario_table(node, source_, "scenario");
+        if (!config) return tl::unexpected(config.error());
+        s_.scenario = std::move(*config);
+        return {};
     }
 
     Expected<void> mode(const toml::key& key, const toml::node& node) {

@@ -17,6 +17,7 @@
 
 #include <tl/expected.hpp>
 
+#include "cli/finsd/config_scenario.hpp"
 #include "cli/finsd/config_schedule.hpp"
 #include "cli/finsd/config_serial.hpp"
 #include "fins/address.hpp"
@@ -85,6 +86,8 @@ struct Settings : CpuUnitOptions, server::FileMemoryOptions {
         std::vector<MemoryInit> memory;         // [plc.memory]
         std::vector<SerialPortConfig> serial;   // [plc.serial]
         std::vector<ScheduleEntry> schedule;    // [[plc.schedule]]
+        // [plc.scenario] (config_scenario.hpp)
+        std::optional<ScenarioConfig> scenario;
         // Per [[plc.ethernet]]: true when it sets `port`; the others take `port` above
         // (--port, [network] port).
         std::vector<bool> port_given;
@@ -94,6 +97,8 @@ struct Settings : CpuUnitOptions, server::FileMemoryOptions {
     // PLC-initiated messages (config_schedule.hpp).
     std::vector<server::RemoteNode> remotes;  // [[remote]]
     std::vector<ScheduleEntry> schedule;      // [[schedule]]
+    // [scenario], --scenario (config_scenario.hpp)
+    std::optional<ScenarioConfig> scenario;
 };
 
 // Command-line values; a set optional overrides the file.

@@ -42,6 +42,7 @@
 #include "plc/storage.hpp"
 #include "plc/storage_format.hpp"
 #include "plc/storage_guard.hpp"
+#include "scenario/scenario.hpp"
 #include "server/control/control.hpp"
 #include "server/instructions/instruction_schedule.hpp"
 #include "server/serial/serial_ports.hpp"
@@ -177,6 +178,11 @@ int configure(int argc, char** argv, Settings& settings) {
     app.add_option("--serial", o.serial,
                    "Serial port NAME=DEVICE[,baud=9600,parity=even,data=7,stop=2,unit=0,mode=..."
                    ",timeout=1]; NAME cpu, scuN.P or board.P (repeatable; README Host Link)");
+    std::string scenario_file;
+    auto* o_scenario = app.add_option(
+        "--scenario", scenario_file,
+        "A file with a [scenario] table: signals, links and events that make memory move "
+        "(docs/scenarios.md); replaces the configuration's [scenario]");
     app.add_flag("--reset-state", o.reset_state,
                  "Move a refused state file aside (never deleted) and start with a new one");
     try {
@@ -191,6 +197,15 @@ int configure(int argc, char** argv, Settings& settings) {
     }
     if (!config.empty())
         if (auto r = load_config_file(config, settings); !r) return fail(2, r.error());
+    if (o_scenario->count() > 0) {
+        if (!settings.plant.cpus.empty())
+            return fail(2,
+                        "--scenario is for a single node: give each [[plc]] its own "
+                        "[plc.scenario] (docs/scenarios.md)");
+        auto loaded = fins::cli::finsd::load_scenario_file(scenario_file);
+        if (!loaded) return fail(2, loaded.error());
+        settings.scenario = std::move(*loaded);
+    }
     take(o_profile, profile, o.profile);
     take(o_mode, mode, o.mode);
     take(o_data, data_dir, o.data_dir);
@@ -296,6 +311,13 @@ int serve(const Settings& s) {
     if (!s.memory.empty()) spdlog::info("finsd: {} [memory] entries written", written);
     plc.change_mode(s.mode, std::chrono::system_clock::now());
     fins::cli::finsd::apply_cpu_options(s, plc);
+    // [scenario], --scenario: compiled against this CPU Unit; every error is a start error.
+    std::unique_ptr<fins::scenario::Scenario> scenario;
+    if (s.scenario) {
+        auto compiled = fins::cli::finsd::compile_scenario(*s.scenario, plc);
+        if (!compiled) return fail(2, compiled.error());
+        scenario = std::move(*compiled);
+    }
     // File memory (22 xx): <data_dir>/card and <data_dir>/em; else a temp dir removed at exit.
     if (const auto refused = fins::server::set_up_file_memory(plc, s, s.data_dir, ""))
         return fail(3, refused->message);

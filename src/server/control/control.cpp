@@ -28,6 +28,7 @@
 
 #include "server/control/control_instructions.hpp"
 #include "server/control/control_requests.hpp"
+#include "server/control/control_scenario.hpp"
 
 namespace fins::server {
 
@@ -164,7 +165,8 @@ class Session : public std::enable_shared_from_this<Session> {
                 });
             if (instruction) return;
             waiting_ = false;
-            Json reply = handle_control_request(*target->plc, j);
+            Json reply = j["cmd"] == "scenario" ? handle_scenario_request(target->scenario, j)
+                                                : handle_control_request(*target->plc, j);
             if (!target->name.empty() && reply.contains("status"))
                 reply["status"]["plc"] = target->name;
             write(std::move(reply), false);
