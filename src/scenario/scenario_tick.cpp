@@ -411,6 +411,11 @@ void Scenario::Impl::step() noexcept {
         plc->write_access_log().record(NodeAddress{0, 0, 0}, CommandCode{0x01, 0x02},
                                        EndCode::normal_completion, host_now);
     ++tick_count;
+    // Events whose duration runs out at the new time end now: after advance(5) an event
+    // of 0-5 s is over (a unit fault is cleared before the next request is served).
+    now_s = static_cast<double>(tick_count) * def.tick_s;
+    for (auto& event : events)
+        if (event.active && event.end >= 0 && now_s >= event.end - epsilon) end_event(event);
 }
 
 void Scenario::tick(plc::TimePoint now) noexcept {

@@ -35,6 +35,7 @@
 #include "cli/finsd/config_plant.hpp"
 #include "cli/finsd/control_setup.hpp"
 #include "cli/finsd/ctl.hpp"
+#include "cli/finsd/scenario_setup.hpp"
 #include "cli/finsd/serial_gateway_setup.hpp"
 #include "cli/finsd/serial_ports.hpp"
 #include "plc/plc.hpp"
@@ -342,8 +343,12 @@ int serve(const Settings& s) {
     fins::server::SerialPorts gateway_ports;
     fins::cli::finsd::open_gateway_ports(io, s.serial, gateway_ports);
     (*server)->attach_serial_ports(&gateway_ports);
+    // The scenario ticks on this io_context; its unit faults reach the dispatcher.
+    auto runner = fins::cli::finsd::run_scenario(io, s.scenario, std::move(scenario), plc);
+    if (runner) (*server)->dispatcher().attach_faults(runner.get());
     // --control, FINSD_SOCKET or the default path (control_setup.hpp).
     fins::server::ControlTarget target;
+    target.scenario = runner.get();
     target.plc = &plc;
     target.addresses = {{(*server)->address().network, (*server)->address().node}};
     target.instructions = &(*server)->instructions();
@@ -368,6 +373,7 @@ int serve(const Settings& s) {
 
     const auto shut_down = [&] {
         schedule.stop();
+        if (runner) runner->stop();
         (*server)->stop();
         gateway_ports.close_all();
         if (control) control->stop();
