@@ -29,7 +29,7 @@
 #include <fmt/core.h>
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
-#include <asio/io_context.hpp>
+#include <boost/asio/io_context.hpp>
 
 #include "fins/client.hpp"
 #include "fins/commands/file_memory.hpp"
@@ -38,6 +38,7 @@
 
 #include "client/lossy_proxy.hpp"
 #include "echo_server.hpp"
+#include "transport/asio.hpp"
 
 namespace {
 

@@ -18,8 +18,8 @@
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
-#include <asio/io_context.hpp>
-#include <asio/post.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
 
 #include "fins/client.hpp"
 #include "fins/compoway_f.hpp"
@@ -28,6 +28,7 @@
 #include "plc/plc.hpp"
 #include "server/serial/serial_ports.hpp"
 #include "server/sessions/server.hpp"
+#include "transport/asio.hpp"
 
 int main(int argc, char** argv) {
     CLI::App app{"28 03 request rate through a Serial Gateway port over a pty"};

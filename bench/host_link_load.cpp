@@ -25,9 +25,9 @@
 
 #include <fmt/core.h>
 #include <CLI/CLI.hpp>
-#include <asio/executor_work_guard.hpp>
-#include <asio/io_context.hpp>
-#include <asio/post.hpp>
+#include <boost/asio/executor_work_guard.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
 
 #include "fins/client.hpp"
 #include "fins/commands/memory_area.hpp"
@@ -37,6 +37,7 @@
 #include "plc/profile.hpp"
 #include "server/dispatch/dispatcher.hpp"
 #include "server/serial/serial_session.hpp"
+#include "transport/asio.hpp"
 
 namespace {
 

@@ -19,13 +19,14 @@
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
-#include <asio/executor_work_guard.hpp>
-#include <asio/io_context.hpp>
-#include <asio/post.hpp>
+#include <boost/asio/executor_work_guard.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
 
 #include "plc/plc.hpp"
 #include "server/instructions/network_instructions.hpp"
 #include "server/sessions/server.hpp"
+#include "transport/asio.hpp"
 
 namespace {
 

@@ -30,7 +30,7 @@
 #include <fmt/core.h>
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
-#include <asio/io_context.hpp>
+#include <boost/asio/io_context.hpp>
 
 #include "fins/commands/memory_area.hpp"
 #include "fins/frame.hpp"
@@ -40,6 +40,7 @@
 #include "server/sessions/server.hpp"
 
 #include "echo_server.hpp"
+#include "transport/asio.hpp"
 
 namespace {
 

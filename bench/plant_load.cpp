@@ -12,13 +12,14 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
-#include <asio/io_context.hpp>
-#include <asio/post.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
 
 #include "fins/client.hpp"
 #include "fins/commands/memory_area.hpp"
 #include "server/routing/plant.hpp"
 #include "server/sessions/server.hpp"
+#include "transport/asio.hpp"
 
 namespace {
 

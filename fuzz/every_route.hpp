@@ -8,12 +8,13 @@
 
 #include <memory>
 
-#include <asio/io_context.hpp>
+#include <boost/asio/io_context.hpp>
 
 #include "plc/plc.hpp"
 #include "plc/routing_tables.hpp"
 #include "server/serial/serial_gateway_port.hpp"
 #include "server/serial/serial_ports.hpp"
+#include "transport/asio.hpp"
 
 namespace fins_fuzz {
 

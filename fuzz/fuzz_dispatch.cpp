@@ -16,7 +16,7 @@
 #include <memory>
 
 #include <spdlog/spdlog.h>
-#include <asio/io_context.hpp>
+#include <boost/asio/io_context.hpp>
 
 #include "answer_check.hpp"
 #include "every_route.hpp"
@@ -26,6 +26,7 @@
 #include "server/dispatch/dispatcher.hpp"
 #include "server/routing/router.hpp"
 #include "server/serial/serial_ports.hpp"
+#include "transport/asio.hpp"
 
 namespace {
 

@@ -24,13 +24,14 @@
 #include <vector>
 
 #include <spdlog/spdlog.h>
-#include <asio/io_context.hpp>
+#include <boost/asio/io_context.hpp>
 
 #include "fins/frame.hpp"
 #include "fins/host_link.hpp"
 #include "plc/plc.hpp"
 #include "server/dispatch/dispatcher.hpp"
 #include "server/serial/serial_session.hpp"
+#include "transport/asio.hpp"
 
 namespace {
 

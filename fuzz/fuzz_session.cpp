@@ -30,7 +30,7 @@
 #include <vector>
 
 #include <spdlog/spdlog.h>
-#include <asio/io_context.hpp>
+#include <boost/asio/io_context.hpp>
 
 #include "every_route.hpp"
 #include "fins/frame.hpp"
@@ -41,6 +41,7 @@
 #include "server/routing/router.hpp"
 #include "server/serial/serial_ports.hpp"
 #include "server/sessions/server.hpp"
+#include "transport/asio.hpp"
 
 namespace {
 

@@ -13,9 +13,9 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 #include <spdlog/spdlog.h>
-#include <asio/executor_work_guard.hpp>
-#include <asio/io_context.hpp>
-#include <asio/post.hpp>
+#include <boost/asio/executor_work_guard.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
 
 #include "cli/finsd/config.hpp"
 #include "errors.hpp"
@@ -25,6 +25,7 @@
 #include "plc/profile.hpp"
 #include "plc/storage.hpp"
 #include "server/sessions/server.hpp"
+#include "transport/asio.hpp"
 
 namespace py = pybind11;
 using release = py::call_guard<py::gil_scoped_release>;

@@ -6,9 +6,10 @@
 #include <string>
 #include <utility>
 
-#include <asio/post.hpp>
+#include <boost/asio/post.hpp>
 
 #include "client/client_impl.hpp"
+#include "transport/asio.hpp"
 
 namespace fins {
 

@@ -6,12 +6,13 @@
 #include <optional>
 #include <utility>
 
-#include <asio/io_context.hpp>
-#include <asio/steady_timer.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/steady_timer.hpp>
 
 #include "client/request_tracker.hpp"
 #include "fins/client.hpp"
 #include "fins/host_link.hpp"
+#include "transport/asio.hpp"
 #include "transport/host_link_transport.hpp"
 #include "transport/tcp_transport.hpp"
 #include "transport/udp_transport.hpp"

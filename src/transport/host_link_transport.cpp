@@ -4,8 +4,10 @@
 #include <cstring>
 #include <utility>
 
-#include <asio/post.hpp>
-#include <asio/write.hpp>
+#include <boost/asio/post.hpp>
+#include <boost/asio/write.hpp>
+
+#include "transport/asio.hpp"
 
 namespace fins::transport {
 namespace {
@@ -62,7 +64,7 @@ void HostLinkTransport::write_next() {
     auto gen = generation_;
     std::weak_ptr<int> life = life_;
     asio::async_write(port_.port(), asio::buffer(queue_.front()),
-                      [this, life, gen](std::error_code ec, std::size_t) {
+                      [this, life, gen](boost::system::error_code ec, std::size_t) {
                           if (life.expired() || gen != generation_) return;
                           writing_ = false;
                           if (ec) return fail(make_error_code(ClientError::connection_closed));
@@ -77,7 +79,7 @@ void HostLinkTransport::receive() {
     // Room is always left: on_bytes() consumes or drops until less than a frame is held.
     port_.port().async_read_some(
         asio::buffer(rx_.data() + rx_size_, rx_.size() - rx_size_),
-        [this, life, gen](std::error_code ec, std::size_t n) {
+        [this, life, gen](boost::system::error_code ec, std::size_t n) {
             if (life.expired() || gen != generation_) return;
             if (ec) return fail(make_error_code(ClientError::connection_closed));
             on_bytes(n);
@@ -120,7 +122,7 @@ void HostLinkTransport::on_frame(Bytes frame) {
     if (on_frame_) on_frame_(Bytes{fins_.data(), decoded->fins_size});
 }
 
-void HostLinkTransport::fail(std::error_code reason) {
+void HostLinkTransport::fail(boost::system::error_code reason) {
     close();
     if (on_close_) on_close_(reason);
 }

@@ -23,10 +23,11 @@
 #include <cstdint>
 #include <memory>
 
-#include <asio/io_context.hpp>
+#include <boost/asio/io_context.hpp>
 
 #include "fins/host_link.hpp"
 #include "fins/serial.hpp"
+#include "transport/asio.hpp"
 #include "transport/serial_port.hpp"
 #include "transport/transport.hpp"
 #include "transport/write_queue.hpp"
@@ -56,7 +57,7 @@ class HostLinkTransport final : public Transport {
     void on_bytes(std::size_t n);
     void on_frame(Bytes frame);
     void write_next();
-    void fail(std::error_code reason);
+    void fail(boost::system::error_code reason);
 
     asio::io_context& io_;
     HostLinkOptions options_;

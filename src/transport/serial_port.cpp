@@ -8,9 +8,9 @@
 
 namespace fins::transport {
 
-std::error_code SerialPort::open(const SerialSettings& line) {
+boost::system::error_code SerialPort::open(const SerialSettings& line) {
     close();
-    std::error_code ec;
+    boost::system::error_code ec;
     port_.open(line.device, ec);
     if (ec) return ec;
     using asio::serial_port_base;
@@ -53,7 +53,7 @@ void SerialPort::flush() noexcept {
 }
 
 void SerialPort::close() noexcept {
-    std::error_code ignored;
+    boost::system::error_code ignored;
     port_.close(ignored);
 }
 

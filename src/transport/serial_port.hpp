@@ -8,10 +8,11 @@
 
 #include <system_error>
 
-#include <asio/io_context.hpp>
-#include <asio/serial_port.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/serial_port.hpp>
 
 #include "fins/serial.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::transport {
 
@@ -20,7 +21,7 @@ class SerialPort {
     explicit SerialPort(asio::io_context& io) : port_(io) {}
 
     // Opens `line.device` and applies the settings; on failure the port stays closed.
-    std::error_code open(const SerialSettings& line);
+    boost::system::error_code open(const SerialSettings& line);
     void close() noexcept;
     [[nodiscard]] bool is_open() const noexcept { return port_.is_open(); }
     // Discards what the kernel holds unread or unsent (TCIOFLUSH).

@@ -10,8 +10,10 @@
 #include <string>
 #include <utility>
 
-#include <asio/connect.hpp>
-#include <asio/write.hpp>
+#include <boost/asio/connect.hpp>
+#include <boost/asio/write.hpp>
+
+#include "transport/asio.hpp"
 
 namespace fins::transport {
 
@@ -19,7 +21,7 @@ using asio::ip::tcp;
 
 namespace {
 
-std::error_code tcp_error_code(std::uint32_t raw) {
+boost::system::error_code tcp_error_code(std::uint32_t raw) {
     return make_error_code(static_cast<TcpError>(static_cast<int>(raw & 0x7FFFFFFF)));
 }
 
@@ -39,26 +41,27 @@ void TcpTransport::async_open(OpenHandler done) {
     auto gen = generation_;
     std::weak_ptr<int> life = life_;
     open_timer_.expires_after(options_.open_timeout);
-    open_timer_.async_wait([this, life, gen](std::error_code ec) {
+    open_timer_.async_wait([this, life, gen](boost::system::error_code ec) {
         if (life.expired() || gen != generation_ || ec || state_ != State::opening) return;
         finish_open(Unexpected(make_error_code(ClientError::timeout)));
     });
     resolver_.async_resolve(
         options_.host, std::to_string(options_.port), tcp::resolver::numeric_service,
-        [this, life, gen](std::error_code ec, tcp::resolver::results_type results) {
+        [this, life, gen](boost::system::error_code ec, tcp::resolver::results_type results) {
             if (life.expired() || gen != generation_) return;
             if (ec) return finish_open(Unexpected(ec));
-            asio::async_connect(socket_, results,
-                                [this, life, gen](std::error_code ec2, const tcp::endpoint&) {
-                                    if (life.expired() || gen != generation_) return;
-                                    if (ec2) return finish_open(Unexpected(ec2));
-                                    on_connected();
-                                });
+            asio::async_connect(
+                socket_, results,
+                [this, life, gen](boost::system::error_code ec2, const tcp::endpoint&) {
+                    if (life.expired() || gen != generation_) return;
+                    if (ec2) return finish_open(Unexpected(ec2));
+                    on_connected();
+                });
         });
 }
 
 void TcpTransport::on_connected() {
-    std::error_code ec;
+    boost::system::error_code ec;
     fd_ = socket_.native_handle();
     socket_.set_option(tcp::no_delay(true), ec);
     if (!ec) set_keepalive(ec);
@@ -69,7 +72,7 @@ void TcpTransport::on_connected() {
     auto gen = generation_;
     std::weak_ptr<int> life = life_;
     asio::async_write(socket_, asio::buffer(hello_.data(), w.size()),
-                      [this, life, gen](std::error_code ec2, std::size_t) {
+                      [this, life, gen](boost::system::error_code ec2, std::size_t) {
                           if (life.expired() || gen != generation_) return;
                           if (ec2) return finish_open(Unexpected(ec2));
                           read_handshake();
@@ -81,7 +84,7 @@ void TcpTransport::read_handshake() {
     std::weak_ptr<int> life = life_;
     socket_.async_read_some(
         asio::buffer(rx_.data() + rx_size_, rx_.size() - rx_size_),
-        [this, life, gen](std::error_code ec, std::size_t n) {
+        [this, life, gen](boost::system::error_code ec, std::size_t n) {
             if (life.expired() || gen != generation_) return;
             // The server closes right after an error answer; EOF before it is a failure.
             if (ec) return finish_open(Unexpected(make_error_code(ClientError::handshake_failed)));
@@ -128,7 +131,7 @@ void TcpTransport::read_frames() {
     auto gen = generation_;
     std::weak_ptr<int> life = life_;
     socket_.async_read_some(asio::buffer(rx_.data() + rx_size_, rx_.size() - rx_size_),
-                            [this, life, gen](std::error_code ec, std::size_t n) {
+                            [this, life, gen](boost::system::error_code ec, std::size_t n) {
                                 if (life.expired() || gen != generation_) return;
                                 if (ec)
                                     return fail(make_error_code(ClientError::connection_closed));
@@ -204,7 +207,7 @@ void TcpTransport::send_error_and_fail(TcpError error) {
     ByteWriter w(packet);
     write_tcp_error(w, TcpCommand::frame_error, error);
     // Best effort, non-blocking: the connection is closed right after anyway.
-    std::error_code ignored;
+    boost::system::error_code ignored;
     socket_.send(asio::buffer(packet.data(), w.size()), 0, ignored);
     fail(make_error_code(error));
 }
@@ -231,7 +234,7 @@ void TcpTransport::write_raw(Bytes first, Bytes second) {
     // Nothing queued: hand the packet to the kernel now; queue only what did not fit.
     std::array<asio::const_buffer, 2> buffers{asio::buffer(first.data(), first.size()),
                                               asio::buffer(second.data(), second.size())};
-    std::error_code ec;
+    boost::system::error_code ec;
     auto written = socket_.send(buffers, 0, ec);
     if (!ec && written == first.size() + second.size()) return;
     // would_block, or a real error that the queued write reports asynchronously (never
@@ -249,7 +252,7 @@ void TcpTransport::write_next() {
     const auto& buffer = queue_.front();
     asio::async_write(socket_,
                       asio::buffer(buffer.data() + front_written_, buffer.size() - front_written_),
-                      [this, life, gen](std::error_code ec, std::size_t) {
+                      [this, life, gen](boost::system::error_code ec, std::size_t) {
                           if (life.expired() || gen != generation_) return;
                           writing_ = false;
                           front_written_ = 0;
@@ -259,12 +262,12 @@ void TcpTransport::write_next() {
                       });
 }
 
-void TcpTransport::fail(std::error_code reason) {
+void TcpTransport::fail(boost::system::error_code reason) {
     close();
     if (on_close_) on_close_(reason);
 }
 
-void TcpTransport::set_keepalive(std::error_code& ec) {
+void TcpTransport::set_keepalive(boost::system::error_code& ec) {
     const auto& k = options_.keepalive;
     if (k.idle.count() <= 0) return;
     const auto fd = fd_;
@@ -276,7 +279,7 @@ void TcpTransport::set_keepalive(std::error_code& ec) {
     const auto user_timeout = static_cast<unsigned>((idle + interval * count) * 1000);
     const auto set = [&](int level, int name, const auto& value) {
         if (!ec && ::setsockopt(fd, level, name, &value, sizeof value) != 0)
-            ec = std::error_code(errno, std::system_category());
+            ec = boost::system::error_code(errno, boost::system::system_category());
     };
     set(SOL_SOCKET, SO_KEEPALIVE, on);
     set(IPPROTO_TCP, TCP_KEEPIDLE, idle);
@@ -287,7 +290,7 @@ void TcpTransport::set_keepalive(std::error_code& ec) {
 
 void TcpTransport::close() {
     ++generation_;
-    std::error_code ignored;
+    boost::system::error_code ignored;
     resolver_.cancel();
     open_timer_.cancel();
     socket_.close(ignored);

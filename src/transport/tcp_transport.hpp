@@ -25,11 +25,12 @@
 #include <memory>
 #include <vector>
 
-#include <asio/io_context.hpp>
-#include <asio/ip/tcp.hpp>
-#include <asio/steady_timer.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
 
 #include "fins/tcp.hpp"
+#include "transport/asio.hpp"
 #include "transport/transport.hpp"
 #include "transport/write_queue.hpp"
 
@@ -55,7 +56,7 @@ class TcpTransport final : public Transport {
   private:
     void on_connected();
     // TransportOptions::keepalive on the connected socket.
-    void set_keepalive(std::error_code& ec);
+    void set_keepalive(boost::system::error_code& ec);
     void read_handshake();
     void finish_open(Result<LinkInfo> result);
     void read_frames();
@@ -64,7 +65,7 @@ class TcpTransport final : public Transport {
     void send_error_and_fail(TcpError error);
     void write_raw(Bytes first, Bytes second);
     void write_next();
-    void fail(std::error_code reason);
+    void fail(boost::system::error_code reason);
     void consume(std::size_t n) noexcept;
     void uncork();
 

@@ -25,10 +25,11 @@
 #include <string>
 #include <system_error>
 
-#include <asio/ip/address.hpp>
+#include <boost/asio/ip/address.hpp>
 
 #include "fins/byte_io.hpp"
 #include "fins/error.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::transport {
 

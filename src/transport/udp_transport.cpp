@@ -7,7 +7,9 @@
 #include <string>
 #include <utility>
 
-#include <asio/connect.hpp>
+#include <boost/asio/connect.hpp>
+
+#include "transport/asio.hpp"
 
 namespace fins::transport {
 
@@ -27,23 +29,23 @@ void UdpTransport::async_open(OpenHandler done) {
     auto gen = generation_;
     std::weak_ptr<int> life = life_;
     open_timer_.expires_after(options_.open_timeout);
-    open_timer_.async_wait([this, life, gen](std::error_code ec) {
+    open_timer_.async_wait([this, life, gen](boost::system::error_code ec) {
         if (life.expired() || gen != generation_ || ec || state_ != State::opening) return;
         finish_open(Unexpected(make_error_code(ClientError::timeout)));
     });
-    resolver_.async_resolve(options_.host, std::to_string(options_.port),
-                            udp::resolver::numeric_service,
-                            [this, life, gen](std::error_code ec, udp::resolver::results_type r) {
-                                if (life.expired() || gen != generation_) return;
-                                if (ec) return finish_open(Unexpected(ec));
-                                connect_first(r);
-                            });
+    resolver_.async_resolve(
+        options_.host, std::to_string(options_.port), udp::resolver::numeric_service,
+        [this, life, gen](boost::system::error_code ec, udp::resolver::results_type r) {
+            if (life.expired() || gen != generation_) return;
+            if (ec) return finish_open(Unexpected(ec));
+            connect_first(r);
+        });
 }
 
 void UdpTransport::connect_first(const udp::resolver::results_type& results) {
-    std::error_code ec = asio::error::host_not_found;
+    boost::system::error_code ec = asio::error::host_not_found;
     for (const auto& entry : results) {
-        std::error_code ignored;
+        boost::system::error_code ignored;
         socket_.close(ignored);
         ec.clear();
         socket_.open(entry.endpoint().protocol(), ec);
@@ -53,7 +55,7 @@ void UdpTransport::connect_first(const udp::resolver::results_type& results) {
     if (!ec) socket_.non_blocking(true, ec);
     if (!ec) {
         // Best effort: the kernel caps it at net.core.rmem_max.
-        std::error_code ignored;
+        boost::system::error_code ignored;
         socket_.set_option(asio::socket_base::receive_buffer_size(udp_receive_buffer), ignored);
     }
     LinkInfo info;
@@ -82,14 +84,14 @@ void UdpTransport::finish_open(Result<LinkInfo> result) {
     if (done) done(std::move(result));
 }
 
-ReceiveError classify_receive_error(std::error_code ec) noexcept {
+ReceiveError classify_receive_error(boost::system::error_code ec) noexcept {
     if (ec == asio::error::connection_refused) return ReceiveError::nothing_listening;
     if (ec == asio::error::host_unreachable || ec == asio::error::network_unreachable ||
-        ec == std::error_code(EHOSTDOWN, std::system_category()) ||
-        ec == std::error_code(ENONET, std::system_category()) || ec == asio::error::network_down ||
-        ec == asio::error::connection_reset || ec == asio::error::timed_out ||
-        ec == std::errc::protocol_error || ec == std::errc::message_size ||
-        ec == asio::error::interrupted)
+        ec == boost::system::error_code(EHOSTDOWN, boost::system::system_category()) ||
+        ec == boost::system::error_code(ENONET, boost::system::system_category()) ||
+        ec == asio::error::network_down || ec == asio::error::connection_reset ||
+        ec == asio::error::timed_out || ec == std::errc::protocol_error ||
+        ec == std::errc::message_size || ec == asio::error::interrupted)
         return ReceiveError::transient;
     return ReceiveError::fatal;
 }
@@ -97,21 +99,24 @@ ReceiveError classify_receive_error(std::error_code ec) noexcept {
 void UdpTransport::receive() {
     auto gen = generation_;
     std::weak_ptr<int> life = life_;
-    socket_.async_receive(asio::buffer(rx_), [this, life, gen](std::error_code ec, std::size_t n) {
-        if (life.expired() || gen != generation_) return;
-        if (!on_receive(ec, n)) return;
-        // Take what else is queued now, without another trip through the reactor.
-        for (int i = 0; i < 64; ++i) {
-            std::error_code e;
-            const auto m = socket_.receive(asio::buffer(rx_), 0, e);
-            if (e == asio::error::would_block || e == asio::error::try_again) break;
-            if (!on_receive(e, m)) return;
-        }
-        receive();
-    });
+    socket_.async_receive(asio::buffer(rx_),
+                          [this, life, gen](boost::system::error_code ec, std::size_t n) {
+                              if (life.expired() || gen != generation_) return;
+                              if (!on_receive(ec, n)) return;
+                              // Take what else is queued now, without another trip through the
+                              // reactor.
+                              for (int i = 0; i < 64; ++i) {
+                                  boost::system::error_code e;
+                                  const auto m = socket_.receive(asio::buffer(rx_), 0, e);
+                                  if (e == asio::error::would_block || e == asio::error::try_again)
+                                      break;
+                                  if (!on_receive(e, m)) return;
+                              }
+                              receive();
+                          });
 }
 
-bool UdpTransport::on_receive(std::error_code ec, std::size_t n) {
+bool UdpTransport::on_receive(boost::system::error_code ec, std::size_t n) {
     auto gen = generation_;
     std::weak_ptr<int> life = life_;
     if (ec) {
@@ -145,7 +150,7 @@ bool UdpTransport::peer_gone() {
 void UdpTransport::send(Bytes frame) {
     if (state_ != State::open) return;
     if (!writing_ && queue_.empty()) {
-        std::error_code ec;
+        boost::system::error_code ec;
         socket_.send(asio::buffer(frame.data(), frame.size()), 0, ec);
         // Lost datagrams are the retry logic's business; only a full buffer is queued.
         if (ec != asio::error::would_block && ec != asio::error::try_again) return;
@@ -160,22 +165,23 @@ void UdpTransport::write_next() {
     auto gen = generation_;
     std::weak_ptr<int> life = life_;
     const auto& buffer = queue_.front();
-    socket_.async_send(asio::buffer(buffer), [this, life, gen](std::error_code, std::size_t) {
-        if (life.expired() || gen != generation_) return;
-        writing_ = false;
-        queue_.pop();
-        write_next();
-    });
+    socket_.async_send(asio::buffer(buffer),
+                       [this, life, gen](boost::system::error_code, std::size_t) {
+                           if (life.expired() || gen != generation_) return;
+                           writing_ = false;
+                           queue_.pop();
+                           write_next();
+                       });
 }
 
-void UdpTransport::fail(std::error_code reason) {
+void UdpTransport::fail(boost::system::error_code reason) {
     close();
     if (on_close_) on_close_(reason);
 }
 
 void UdpTransport::close() {
     ++generation_;
-    std::error_code ignored;
+    boost::system::error_code ignored;
     resolver_.cancel();
     open_timer_.cancel();
     socket_.close(ignored);

@@ -20,11 +20,12 @@
 #include <cstdint>
 #include <memory>
 
-#include <asio/io_context.hpp>
-#include <asio/ip/udp.hpp>
-#include <asio/steady_timer.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/udp.hpp>
+#include <boost/asio/steady_timer.hpp>
 
 #include "fins/frame.hpp"
+#include "transport/asio.hpp"
 #include "transport/transport.hpp"
 #include "transport/write_queue.hpp"
 
@@ -48,9 +49,9 @@ class UdpTransport final : public Transport {
     void finish_open(Result<LinkInfo> result);
     void receive();
     // Handles one receive result; false once the transport was closed or replaced.
-    bool on_receive(std::error_code ec, std::size_t n);
+    bool on_receive(boost::system::error_code ec, std::size_t n);
     void write_next();
-    void fail(std::error_code reason);
+    void fail(boost::system::error_code reason);
 
     TransportOptions options_;
     asio::ip::udp::resolver resolver_;
@@ -71,7 +72,7 @@ enum class ReceiveError {
     transient,          // host/network unreachable and the like: ignore, keep receiving
     fatal,              // the socket itself is broken: close
 };
-ReceiveError classify_receive_error(std::error_code ec) noexcept;
+ReceiveError classify_receive_error(boost::system::error_code ec) noexcept;
 
 // SO_RCVBUF asked for: 256 answers of up to 2,012 bytes, at the ~4.5 KiB the kernel
 // charges for each (the kernel doubles the value it is given).

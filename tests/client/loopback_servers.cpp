@@ -3,10 +3,11 @@
 #include <algorithm>
 #include <deque>
 
-#include <asio/post.hpp>
-#include <asio/write.hpp>
+#include <boost/asio/post.hpp>
+#include <boost/asio/write.hpp>
 
 #include "fins/tcp.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::test {
 
@@ -54,7 +55,7 @@ std::vector<std::uint8_t> ServerBase::record_and_handle(Bytes frame) {
 // ---- UdpResponder ----
 
 UdpResponder::UdpResponder(const std::string& address) : socket_(io_) {
-    std::error_code ec;
+    boost::system::error_code ec;
     auto ip = asio::ip::make_address(address, ec);
     if (!ec) socket_.open(ip.is_v4() ? asio::ip::udp::v4() : asio::ip::udp::v6(), ec);
     if (!ec) socket_.bind({ip, 0}, ec);
@@ -86,7 +87,7 @@ void UdpResponder::set_duplicate(bool duplicate) {
 
 void UdpResponder::receive() {
     socket_.async_receive_from(asio::buffer(buffer_), peer_,
-                               [this](std::error_code ec, std::size_t n) {
+                               [this](boost::system::error_code ec, std::size_t n) {
                                    if (ec) return;
                                    auto answer = record_and_handle(Bytes{buffer_.data(), n});
                                    std::vector<std::vector<std::uint8_t>> out;
@@ -103,7 +104,7 @@ void UdpResponder::receive() {
                                        }
                                    }
                                    for (const auto& frame : out) {
-                                       std::error_code ignored;
+                                       boost::system::error_code ignored;
                                        socket_.send_to(asio::buffer(frame), peer_, 0, ignored);
                                        if (twice)
                                            socket_.send_to(asio::buffer(frame), peer_, 0, ignored);
@@ -132,7 +133,7 @@ struct TcpResponder::Session : std::enable_shared_from_this<Session> {
     void read() {
         auto self = shared_from_this();
         socket.async_read_some(asio::buffer(rx.data() + rx_size, rx.size() - rx_size),
-                               [self](std::error_code ec, std::size_t n) {
+                               [self](boost::system::error_code ec, std::size_t n) {
                                    if (ec) return;
                                    self->rx_size += n;
                                    if (self->process()) self->read();
@@ -250,7 +251,7 @@ struct TcpResponder::Session : std::enable_shared_from_this<Session> {
         writing = true;
         auto self = shared_from_this();
         asio::async_write(socket, asio::buffer(queue.front()),
-                          [self](std::error_code ec, std::size_t) {
+                          [self](boost::system::error_code ec, std::size_t) {
                               self->writing = false;
                               self->queue.pop_front();
                               if (ec) return;
@@ -271,7 +272,7 @@ struct TcpResponder::Session : std::enable_shared_from_this<Session> {
 
 TcpResponder::TcpResponder(TcpBehaviour behaviour, const std::string& address)
     : behaviour_(behaviour), acceptor_(io_) {
-    std::error_code ec;
+    boost::system::error_code ec;
     auto ip = asio::ip::make_address(address, ec);
     if (!ec) acceptor_.open(ip.is_v4() ? asio::ip::tcp::v4() : asio::ip::tcp::v6(), ec);
     if (!ec) acceptor_.bind({ip, 0}, ec);
@@ -289,7 +290,7 @@ TcpResponder::~TcpResponder() {
 }
 
 void TcpResponder::accept() {
-    acceptor_.async_accept([this](std::error_code ec, asio::ip::tcp::socket socket) {
+    acceptor_.async_accept([this](boost::system::error_code ec, asio::ip::tcp::socket socket) {
         if (ec) return;
         auto session = std::make_shared<Session>(*this, std::move(socket));
         sessions_.push_back(session);
@@ -314,7 +315,7 @@ bool TcpResponder::drop_connections(std::chrono::milliseconds limit) {
     bool done = false;
     asio::post(io_, [this, &done] {
         for (auto& session : sessions_) {
-            std::error_code ignored;
+            boost::system::error_code ignored;
             session->socket.close(ignored);
         }
         std::lock_guard lock(mutex_);

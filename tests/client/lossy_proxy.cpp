@@ -2,8 +2,10 @@
 
 #include <memory>
 
-#include <asio/executor_work_guard.hpp>
-#include <asio/steady_timer.hpp>
+#include <boost/asio/executor_work_guard.hpp>
+#include <boost/asio/steady_timer.hpp>
+
+#include "transport/asio.hpp"
 
 namespace fins::test {
 
@@ -39,7 +41,7 @@ LossyUdpProxy::Counts LossyUdpProxy::counts() {
 
 void LossyUdpProxy::receive_front() {
     front_.async_receive_from(asio::buffer(front_buffer_), from_,
-                              [this](std::error_code ec, std::size_t n) {
+                              [this](boost::system::error_code ec, std::size_t n) {
                                   if (ec == asio::error::operation_aborted) return;
                                   if (!ec) {
                                       client_ = from_;
@@ -53,16 +55,17 @@ void LossyUdpProxy::receive_front() {
 }
 
 void LossyUdpProxy::receive_back() {
-    back_.async_receive(asio::buffer(back_buffer_), [this](std::error_code ec, std::size_t n) {
-        if (ec == asio::error::operation_aborted) return;
-        if (!ec && have_client_)
-            pass({back_buffer_.begin(), back_buffer_.begin() + static_cast<long>(n)}, false);
-        receive_back();
-    });
+    back_.async_receive(
+        asio::buffer(back_buffer_), [this](boost::system::error_code ec, std::size_t n) {
+            if (ec == asio::error::operation_aborted) return;
+            if (!ec && have_client_)
+                pass({back_buffer_.begin(), back_buffer_.begin() + static_cast<long>(n)}, false);
+            receive_back();
+        });
 }
 
 void LossyUdpProxy::emit(const std::vector<std::uint8_t>& datagram, bool to_server) {
-    std::error_code ignored;
+    boost::system::error_code ignored;
     if (to_server)
         back_.send(asio::buffer(datagram), 0, ignored);
     else
@@ -88,7 +91,7 @@ void LossyUdpProxy::pass(std::vector<std::uint8_t> datagram, bool to_server) {
         std::uniform_int_distribution<long> ms(1, faults_.max_delay.count());
         auto timer = std::make_shared<asio::steady_timer>(io_, std::chrono::milliseconds(ms(rng_)));
         auto held = std::make_shared<std::vector<std::uint8_t>>(std::move(datagram));
-        timer->async_wait([this, timer, held, to_server](std::error_code ec) {
+        timer->async_wait([this, timer, held, to_server](boost::system::error_code ec) {
             if (!ec) emit(*held, to_server);
         });
         return;

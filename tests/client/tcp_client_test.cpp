@@ -6,10 +6,11 @@
 #include <cstdint>
 #include <vector>
 
-#include <asio/ip/tcp.hpp>
+#include <boost/asio/ip/tcp.hpp>
 
 #include "client/loopback_servers.hpp"
 #include "fins/client.hpp"
+#include "transport/asio.hpp"
 
 using namespace fins;
 using namespace fins::test;

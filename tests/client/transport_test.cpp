@@ -12,14 +12,15 @@
 #include <string>
 #include <vector>
 
-#include <asio/ip/address.hpp>
-#include <asio/ip/tcp.hpp>
-#include <asio/ip/udp.hpp>
-#include <asio/write.hpp>
+#include <boost/asio/ip/address.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/ip/udp.hpp>
+#include <boost/asio/write.hpp>
 
 #include "client/loopback_servers.hpp"
 #include "fins/client.hpp"
 #include "fins/tcp.hpp"
+#include "transport/asio.hpp"
 #include "transport/tcp_transport.hpp"
 #include "transport/transport.hpp"
 #include "transport/udp_transport.hpp"
@@ -98,7 +99,8 @@ TEST(UdpTransport, IcmpErrorsOtherThanPortUnreachableKeepTheTransportOpen) {
               ReceiveError::nothing_listening);
     EXPECT_EQ(classify_receive_error(asio::error::host_unreachable), ReceiveError::transient);
     EXPECT_EQ(classify_receive_error(asio::error::network_unreachable), ReceiveError::transient);
-    EXPECT_EQ(classify_receive_error(std::error_code(EHOSTDOWN, std::system_category())),
+    EXPECT_EQ(classify_receive_error(
+                  boost::system::error_code(EHOSTDOWN, boost::system::system_category())),
               ReceiveError::transient);
     EXPECT_EQ(classify_receive_error(asio::error::network_down), ReceiveError::transient);
     EXPECT_EQ(classify_receive_error(asio::error::bad_descriptor), ReceiveError::fatal);
@@ -148,7 +150,7 @@ TEST(TcpTransport, SeesAPacketSplitAtEveryBytePosition) {
     acceptor.non_blocking(true);
     for (int i = 0; i < 500 && !server.is_open(); ++i) {
         io.run_for(10ms);
-        std::error_code ec;
+        boost::system::error_code ec;
         acceptor.accept(server, ec);
     }
     ASSERT_TRUE(server.is_open());

@@ -14,11 +14,12 @@
 #include <vector>
 
 #include <gtest/gtest.h>
-#include <asio/io_context.hpp>
-#include <asio/ip/udp.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/udp.hpp>
 #include <nlohmann/json.hpp>
 
 #include "finsd_run.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::test {
 namespace {

@@ -12,13 +12,14 @@
 #include <utility>
 
 #include <gtest/gtest.h>
-#include <asio/io_context.hpp>
-#include <asio/post.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
 
 #include "fins/client.hpp"
 #include "server/routing/plant.hpp"
 #include "server/routing/router.hpp"
 #include "server/sessions/server.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::test {
 

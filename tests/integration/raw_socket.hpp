@@ -12,14 +12,15 @@
 #include <system_error>
 #include <vector>
 
-#include <asio/connect.hpp>
-#include <asio/ip/tcp.hpp>
-#include <asio/ip/udp.hpp>
-#include <asio/write.hpp>
+#include <boost/asio/connect.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/ip/udp.hpp>
+#include <boost/asio/write.hpp>
 
 #include "../fuzz/corpus_dump.hpp"
 #include "fins/frame.hpp"
 #include "fins/tcp.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::test {
 
@@ -95,12 +96,12 @@ class RawTcp {
         return n == 0 || (n < 0 && errno == ECONNRESET);
     }
     void close() {
-        std::error_code ec;
+        boost::system::error_code ec;
         socket_.close(ec);
     }
     [[nodiscard]] int native_handle() { return socket_.native_handle(); }
     // Why the last receive_packet() came back empty (eof = the peer's FIN).
-    [[nodiscard]] std::error_code last_error() const { return last_error_; }
+    [[nodiscard]] boost::system::error_code last_error() const { return last_error_; }
 
   private:
     // Plain recv(): Asio's blocking read turns SO_RCVTIMEO's EAGAIN into an endless
@@ -115,9 +116,10 @@ class RawTcp {
             }
             if (r < 0) {
                 if (errno == EINTR) continue;
-                last_error_ = errno == EAGAIN || errno == EWOULDBLOCK
-                                  ? std::make_error_code(std::errc::timed_out)
-                                  : std::error_code(errno, std::system_category());
+                last_error_ =
+                    errno == EAGAIN || errno == EWOULDBLOCK
+                        ? boost::system::error_code(ETIMEDOUT, boost::system::system_category())
+                        : boost::system::error_code(errno, boost::system::system_category());
                 return false;
             }
             p += r;
@@ -127,7 +129,7 @@ class RawTcp {
     }
 
     asio::ip::tcp::socket socket_;
-    std::error_code last_error_;
+    boost::system::error_code last_error_;
     std::vector<std::uint8_t> sent_;  // everything sent, for the fuzz corpus
 };
 

@@ -19,8 +19,8 @@
 #include <thread>
 #include <vector>
 
-#include <asio/io_context.hpp>
-#include <asio/post.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
 
 #include "codec/test_support.hpp"
 #include "fins/frame.hpp"
@@ -30,6 +30,7 @@
 #include "plc/plc.hpp"
 #include "server/serial/serial_ports.hpp"
 #include "server/sessions/server.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::test {
 namespace {

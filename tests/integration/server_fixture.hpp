@@ -8,12 +8,13 @@
 #include <thread>
 
 #include <gtest/gtest.h>
-#include <asio/io_context.hpp>
-#include <asio/post.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
 
 #include "fins/client.hpp"
 #include "plc/plc.hpp"
 #include "server/sessions/server.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::test {
 

@@ -14,8 +14,8 @@
 #include <vector>
 
 #include <gtest/gtest.h>
-#include <asio/io_context.hpp>
-#include <asio/post.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
 
 #include "fins/client.hpp"
 #include "fins/commands/parameter_area.hpp"
@@ -24,6 +24,7 @@
 #include "process.hpp"
 #include "server/sessions/server.hpp"
 #include "server_fixture.hpp"
+#include "transport/asio.hpp"
 #include "tshark_support.hpp"
 
 namespace fins::test {

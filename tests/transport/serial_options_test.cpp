@@ -8,10 +8,11 @@
 #include <chrono>
 #include <string>
 
-#include <asio/read.hpp>
-#include <asio/write.hpp>
+#include <boost/asio/read.hpp>
+#include <boost/asio/write.hpp>
 
 #include "integration/pty_pair.hpp"
+#include "transport/asio.hpp"
 #include "transport/serial_options.hpp"
 #include "transport/serial_port.hpp"
 

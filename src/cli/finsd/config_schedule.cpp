@@ -7,9 +7,10 @@
 #include <cstdio>
 
 #include <fmt/format.h>
-#include <asio/ip/address.hpp>
+#include <boost/asio/ip/address.hpp>
 
 #include "cli/finsd/config.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::cli::finsd {
 
@@ -79,7 +80,7 @@ std::optional<std::pair<std::string, std::uint16_t>> parse_host_port(const std::
             return std::nullopt;
         port = static_cast<std::uint16_t>(v);
     }
-    std::error_code ec;
+    boost::system::error_code ec;
     asio::ip::make_address(host, ec);
     if (host.empty() || ec) return std::nullopt;
     return std::pair{host, port};

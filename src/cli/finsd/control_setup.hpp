@@ -16,9 +16,10 @@
 #include <optional>
 #include <string>
 
-#include <asio/io_context.hpp>
+#include <boost/asio/io_context.hpp>
 
 #include "server/control/control.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::cli {
 

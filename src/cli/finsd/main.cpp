@@ -27,9 +27,9 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
-#include <asio/io_context.hpp>
-#include <asio/signal_set.hpp>
-#include <asio/steady_timer.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/signal_set.hpp>
+#include <boost/asio/steady_timer.hpp>
 
 #include "cli/finsd/config.hpp"
 #include "cli/finsd/config_plant.hpp"
@@ -48,6 +48,7 @@
 #include "server/instructions/instruction_schedule.hpp"
 #include "server/serial/serial_ports.hpp"
 #include "server/sessions/server.hpp"
+#include "transport/asio.hpp"
 
 namespace {
 

@@ -14,12 +14,13 @@
 #include <string>
 #include <vector>
 
-#include <asio/io_context.hpp>
+#include <boost/asio/io_context.hpp>
 #include <tl/expected.hpp>
 
 #include "cli/finsd/config_serial.hpp"
 #include "plc/profile.hpp"
 #include "server/serial/serial_ports.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::cli::finsd {
 

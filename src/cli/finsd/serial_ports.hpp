@@ -7,12 +7,13 @@
 #include <string>
 #include <vector>
 
-#include <asio/io_context.hpp>
+#include <boost/asio/io_context.hpp>
 #include <tl/expected.hpp>
 
 #include "cli/finsd/config_serial.hpp"
 #include "server/dispatch/dispatcher.hpp"
 #include "server/serial/serial_session.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::cli::finsd {
 

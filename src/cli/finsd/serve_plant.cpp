@@ -10,8 +10,8 @@
 #include <vector>
 
 #include <spdlog/spdlog.h>
-#include <asio/io_context.hpp>
-#include <asio/signal_set.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/signal_set.hpp>
 
 #include "cli/finsd/config_plant.hpp"
 #include "cli/finsd/control_setup.hpp"
@@ -25,6 +25,7 @@
 #include "server/routing/router.hpp"
 #include "server/serial/serial_ports.hpp"
 #include "server/sessions/server.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::cli::finsd {
 

@@ -19,16 +19,17 @@
 #include <vector>
 
 #include <fmt/core.h>
-#include <asio/local/stream_protocol.hpp>
-#include <asio/read_until.hpp>
-#include <asio/steady_timer.hpp>
-#include <asio/streambuf.hpp>
-#include <asio/write.hpp>
+#include <boost/asio/local/stream_protocol.hpp>
+#include <boost/asio/read_until.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <boost/asio/streambuf.hpp>
+#include <boost/asio/write.hpp>
 #include <nlohmann/json.hpp>
 
 #include "server/control/control_instructions.hpp"
 #include "server/control/control_requests.hpp"
 #include "server/control/control_scenario.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::server {
 
@@ -97,7 +98,7 @@ class Session : public std::enable_shared_from_this<Session> {
 
     void start() { read(); }
     void close() {
-        std::error_code ignored;
+        boost::system::error_code ignored;
         open_ = false;
         timer_.cancel();
         socket_.close(ignored);
@@ -111,10 +112,11 @@ class Session : public std::enable_shared_from_this<Session> {
     void read() {
         last_activity_ = Clock::now();
         arm_idle_timer();
-        asio::async_read_until(socket_, buffer_, '\n',
-                               [self = shared_from_this()](std::error_code ec, std::size_t n) {
-                                   self->on_line(ec, n);
-                               });
+        asio::async_read_until(
+            socket_, buffer_, '\n',
+            [self = shared_from_this()](boost::system::error_code ec, std::size_t n) {
+                self->on_line(ec, n);
+            });
     }
 
     void arm_idle_timer() {
@@ -122,13 +124,13 @@ class Session : public std::enable_shared_from_this<Session> {
         if (idle.count() <= 0) return;
         timer_.expires_after(idle);
         timer_.async_wait(
-            [self = shared_from_this(), generation = ++generation_](std::error_code ec) {
+            [self = shared_from_this(), generation = ++generation_](boost::system::error_code ec) {
                 if (ec || generation != self->generation_ || self->waiting_) return;
                 self->close();
             });
     }
 
-    void on_line(std::error_code ec, std::size_t n) {
+    void on_line(boost::system::error_code ec, std::size_t n) {
         ++generation_;  // a line (or the end) came: the idle timer is moot
         timer_.cancel();
         last_activity_ = Clock::now();
@@ -181,7 +183,7 @@ class Session : public std::enable_shared_from_this<Session> {
         last_activity_ = Clock::now();
         asio::async_write(
             socket_, asio::buffer(reply_),
-            [self = shared_from_this(), close_after](std::error_code ec, std::size_t) {
+            [self = shared_from_this(), close_after](boost::system::error_code ec, std::size_t) {
                 if (ec || close_after || self->shared_->stopped) return self->close();
                 self->read();
             });
@@ -220,16 +222,17 @@ struct ControlServer::Impl {
     }
 
     void accept() {
-        acceptor.async_accept([this, shared = shared](std::error_code ec, stream::socket socket) {
-            if (shared->stopped || ec == asio::error::operation_aborted) return;
-            if (!ec) {
-                make_room();
-                auto session = std::make_shared<Session>(std::move(socket), shared);
-                sessions.push_back(session);
-                session->start();
-            }
-            accept();
-        });
+        acceptor.async_accept(
+            [this, shared = shared](boost::system::error_code ec, stream::socket socket) {
+                if (shared->stopped || ec == asio::error::operation_aborted) return;
+                if (!ec) {
+                    make_room();
+                    auto session = std::make_shared<Session>(std::move(socket), shared);
+                    sessions.push_back(session);
+                    session->start();
+                }
+                accept();
+            });
     }
 
     stream::acceptor acceptor;
@@ -258,7 +261,7 @@ Result<std::unique_ptr<ControlServer>> ControlServer::start(asio::io_context& io
     // sockaddr_un holds at most 107 characters and a terminating NUL.
     if (path.empty() || path.native().size() >= sizeof(sockaddr_un{}.sun_path))
         return Unexpected(std::make_error_code(std::errc::filename_too_long));
-    std::error_code ec;
+    boost::system::error_code ec;
     const auto st = std::filesystem::symlink_status(path, ec);
     if (std::filesystem::exists(st)) {
         // Replace a stale socket, never a regular file someone pointed us at by mistake,
@@ -292,7 +295,7 @@ ControlServer::~ControlServer() {
 void ControlServer::stop() {
     if (!impl_ || impl_->shared->stopped) return;
     impl_->shared->stopped = true;
-    std::error_code ec;
+    boost::system::error_code ec;
     impl_->acceptor.close(ec);
     for (auto& w : impl_->sessions)
         if (auto s = w.lock()) s->close();

@@ -24,9 +24,10 @@
 #include <utility>
 #include <vector>
 
-#include <asio/io_context.hpp>
+#include <boost/asio/io_context.hpp>
 
 #include "fins/error.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::plc {
 class Plc;

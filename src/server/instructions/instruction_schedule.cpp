@@ -49,11 +49,12 @@ const InstructionSchedule::EntryCounters& InstructionSchedule::counters(std::siz
 void InstructionSchedule::arm(std::size_t index) {
     Entry& e = *entries_[index];
     e.timer.expires_at(e.next);
-    e.timer.async_wait([this, index, alive = std::weak_ptr<bool>(alive_)](std::error_code ec) {
-        const auto a = alive.lock();
-        if (ec || !a || !*a) return;
-        tick(index);
-    });
+    e.timer.async_wait(
+        [this, index, alive = std::weak_ptr<bool>(alive_)](boost::system::error_code ec) {
+            const auto a = alive.lock();
+            if (ec || !a || !*a) return;
+            tick(index);
+        });
 }
 
 void InstructionSchedule::tick(std::size_t index) {

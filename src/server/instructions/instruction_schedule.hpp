@@ -13,10 +13,11 @@
 #include <memory>
 #include <vector>
 
-#include <asio/any_io_executor.hpp>
-#include <asio/steady_timer.hpp>
+#include <boost/asio/any_io_executor.hpp>
+#include <boost/asio/steady_timer.hpp>
 
 #include "server/instructions/network_instructions.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::server {
 

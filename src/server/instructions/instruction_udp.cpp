@@ -15,7 +15,7 @@ UdpInstructionTransport::UdpInstructionTransport(std::shared_ptr<UdpSession> udp
     : udp_(std::move(udp)), local_(std::move(local)), self_(self) {
     for (const auto& r : remotes) {
         if (r.tcp) continue;  // reached over its TCP client connection only
-        std::error_code ec;
+        boost::system::error_code ec;
         const auto ip = asio::ip::make_address(r.host, ec);
         if (ec) {
             // The config loader checked it; a bad entry here is a caller's bug.

@@ -25,10 +25,11 @@
 #include <string>
 #include <vector>
 
-#include <asio/ip/address.hpp>
-#include <asio/ip/udp.hpp>
+#include <boost/asio/ip/address.hpp>
+#include <boost/asio/ip/udp.hpp>
 
 #include "server/instructions/network_instructions.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::server {
 

@@ -6,10 +6,11 @@
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
-#include <asio/post.hpp>
+#include <boost/asio/post.hpp>
 
 #include "fins/commands/memory_area.hpp"
 #include "plc/plc.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::server {
 
@@ -200,12 +201,12 @@ void NetworkInstructions::arm(std::size_t index) {
     Port& p = *ports_[index];
     const auto generation = ++p.generation;
     p.timer.expires_after(instruction_timeout(p.request.options.timeout));
-    p.timer.async_wait(
-        [this, index, generation, alive = std::weak_ptr<bool>(alive_)](std::error_code ec) {
-            const auto a = alive.lock();
-            if (ec || !a || !*a) return;
-            on_timeout(index, generation);
-        });
+    p.timer.async_wait([this, index, generation,
+                        alive = std::weak_ptr<bool>(alive_)](boost::system::error_code ec) {
+        const auto a = alive.lock();
+        if (ec || !a || !*a) return;
+        on_timeout(index, generation);
+    });
 }
 
 void NetworkInstructions::on_timeout(std::size_t index, std::uint64_t generation) {

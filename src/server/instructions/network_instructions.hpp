@@ -46,13 +46,14 @@
 #include <string_view>
 #include <vector>
 
-#include <asio/any_io_executor.hpp>
-#include <asio/ip/udp.hpp>
-#include <asio/steady_timer.hpp>
+#include <boost/asio/any_io_executor.hpp>
+#include <boost/asio/ip/udp.hpp>
+#include <boost/asio/steady_timer.hpp>
 
 #include "fins/address.hpp"
 #include "fins/frame.hpp"
 #include "server/instructions/instruction_parameters.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::plc {
 class Plc;

@@ -167,7 +167,7 @@ Result<std::unique_ptr<plc::Plc>> open_cpu(const PlantCpuConfig& c, const plc::P
     const std::string file =
         c.data_dir ? (*c.data_dir / "finsd.state").string() : std::string("(heap)");
     if (!opened) {
-        const std::error_code error = opened.error().error;
+        const boost::system::error_code error = opened.error().error;
         if (opened.error().setting_aside)
             spdlog::error("finsd: plc \"{}\": {}: cannot move it aside: {}", c.name, file,
                           error.message());

@@ -25,7 +25,7 @@
 #include <system_error>
 #include <vector>
 
-#include <asio/io_context.hpp>
+#include <boost/asio/io_context.hpp>
 
 #include "fins/error.hpp"
 #include "plc/plc.hpp"
@@ -36,6 +36,7 @@
 #include "server/routing/node_address_table.hpp"
 #include "server/sessions/server.hpp"
 #include "server/sessions/tcp_limits.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::server {
 
@@ -71,7 +72,7 @@ struct FileMemoryOptions {
 // ("" or "plc \"A\": "). The one set-up of finsd's single node and of each plant CPU Unit.
 // Empty, or the line refusing it (a symlink to no usable directory, an attach error).
 struct FileMemoryRefusal {
-    std::error_code error;
+    boost::system::error_code error;
     std::string message;
 };
 std::optional<FileMemoryRefusal> set_up_file_memory(

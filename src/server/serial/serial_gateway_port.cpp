@@ -4,11 +4,12 @@
 #include <algorithm>
 
 #include <spdlog/spdlog.h>
-#include <asio/post.hpp>
-#include <asio/write.hpp>
+#include <boost/asio/post.hpp>
+#include <boost/asio/write.hpp>
 
 #include "fins/compoway_f.hpp"
 #include "fins/modbus.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::server {
 
@@ -26,7 +27,7 @@ SerialGatewayPort::SerialGatewayPort(asio::io_context& io, GatewayPortConfig con
 
 SerialGatewayPort::~SerialGatewayPort() = default;
 
-std::error_code SerialGatewayPort::open() {
+boost::system::error_code SerialGatewayPort::open() {
     last_open_attempt_ = std::chrono::steady_clock::now();
     if (auto ec = port_.open(config_.line)) return ec;
     ++opened_;
@@ -77,12 +78,12 @@ void SerialGatewayPort::start_next() {
     auto self = shared_from_this();
     const Job& job = queue_.front();
     asio::async_write(port_.port(), asio::buffer(job.frame),
-                      [self, generation = generation_](std::error_code ec, std::size_t) {
+                      [self, generation = generation_](boost::system::error_code ec, std::size_t) {
                           self->on_written(generation, ec);
                       });
 }
 
-void SerialGatewayPort::on_written(std::uint64_t generation, std::error_code ec) {
+void SerialGatewayPort::on_written(std::uint64_t generation, boost::system::error_code ec) {
     // The write of a job that already finished (the port was closed or lost meanwhile):
     // it must not act on the job now active.
     if (!active_ || generation != generation_) return;
@@ -96,12 +97,13 @@ void SerialGatewayPort::on_written(std::uint64_t generation, std::error_code ec)
     }
     // W336 6-6-2: the timeout runs from the end of sending until the answer.
     timer_.expires_after(config_.timeout);
-    timer_.async_wait([self = shared_from_this(), generation = generation_](std::error_code e) {
-        if (e || !self->active_ || generation != self->generation_) return;
-        ++self->counters_.timeouts;
-        spdlog::debug("fins/serial: {}: response timeout", self->config_.name);
-        self->finish(EndCode::response_timeout, {});
-    });
+    timer_.async_wait(
+        [self = shared_from_this(), generation = generation_](boost::system::error_code e) {
+            if (e || !self->active_ || generation != self->generation_) return;
+            ++self->counters_.timeouts;
+            spdlog::debug("fins/serial: {}: response timeout", self->config_.name);
+            self->finish(EndCode::response_timeout, {});
+        });
     try_answer();  // the answer may already be in
 }
 
@@ -117,7 +119,7 @@ void SerialGatewayPort::read_more() {
     reading_ = true;
     port_.port().async_read_some(
         asio::buffer(read_buffer_),
-        [self = shared_from_this(), opened = opened_](std::error_code ec, std::size_t n) {
+        [self = shared_from_this(), opened = opened_](boost::system::error_code ec, std::size_t n) {
             // A read of a device closed since: the one open now has its own.
             if (opened != self->opened_) return;
             self->reading_ = false;
@@ -125,7 +127,7 @@ void SerialGatewayPort::read_more() {
         });
 }
 
-void SerialGatewayPort::on_read(std::error_code ec, std::size_t n) {
+void SerialGatewayPort::on_read(boost::system::error_code ec, std::size_t n) {
     if (ec == asio::error::operation_aborted) return;
     if (ec) {
         lost(ec);
@@ -186,7 +188,7 @@ bool SerialGatewayPort::try_answer() {
             // Length unknown from the function code: 3.5 characters of silence end it.
             silence_.expires_after(rtu_silence());
             silence_.async_wait(
-                [self = shared_from_this(), generation = generation_](std::error_code e) {
+                [self = shared_from_this(), generation = generation_](boost::system::error_code e) {
                     if (e || !self->active_ || generation != self->generation_) return;
                     const Bytes frame{self->rx_.data(), self->rx_.size()};
                     if (modbus::rtu_crc_ok(frame)) {
@@ -246,7 +248,7 @@ void SerialGatewayPort::finish(EndCode code, Bytes payload) {
     if (!queue_.empty()) asio::post(io_, [self = shared_from_this()] { self->start_next(); });
 }
 
-void SerialGatewayPort::lost(const std::error_code& ec) {
+void SerialGatewayPort::lost(const boost::system::error_code& ec) {
     spdlog::warn("fins/serial: {}: {}: {} (closed; each request tries to reopen it)", config_.name,
                  config_.line.device, ec.message());
     close_device();

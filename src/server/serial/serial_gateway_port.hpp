@@ -30,12 +30,13 @@
 #include <string>
 #include <vector>
 
-#include <asio/io_context.hpp>
-#include <asio/steady_timer.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/steady_timer.hpp>
 
 #include "fins/byte_io.hpp"
 #include "fins/error.hpp"
 #include "fins/serial.hpp"
+#include "transport/asio.hpp"
 #include "transport/serial_port.hpp"
 
 namespace fins::server {
@@ -84,7 +85,7 @@ class SerialGatewayPort : public std::enable_shared_from_this<SerialGatewayPort>
     SerialGatewayPort& operator=(const SerialGatewayPort&) = delete;
 
     // Opens the device and starts reading; the error when it cannot be opened.
-    std::error_code open();
+    boost::system::error_code open();
     void close();
 
     // Queues one framed request. `expect_answer` false: complete with 0000 once sent.
@@ -108,14 +109,14 @@ class SerialGatewayPort : public std::enable_shared_from_this<SerialGatewayPort>
     void start_next();
     // Every asynchronous completion carries the generation of the job it was started
     // for; a late one (its job already finished: closed, lost, timed out) does nothing.
-    void on_written(std::uint64_t generation, std::error_code ec);
+    void on_written(std::uint64_t generation, boost::system::error_code ec);
     void close_device();
     void read_more();
-    void on_read(std::error_code ec, std::size_t n);
+    void on_read(boost::system::error_code ec, std::size_t n);
     // Looks for the active job's answer in rx_; true when the job finished.
     bool try_answer();
     void finish(EndCode code, Bytes payload);
-    void lost(const std::error_code& ec);
+    void lost(const boost::system::error_code& ec);
     // Silence after a Modbus-RTU answer of unknown length ends it (3.5 characters).
     [[nodiscard]] std::chrono::microseconds rtu_silence() const noexcept;
 

@@ -5,9 +5,10 @@
 #include <utility>
 
 #include <spdlog/spdlog.h>
-#include <asio/write.hpp>
+#include <boost/asio/write.hpp>
 
 #include "server/dispatch/dispatcher.hpp"
+#include "transport/asio.hpp"
 #include "transport/serial_options.hpp"
 
 namespace fins::server {
@@ -64,7 +65,7 @@ bool SerialSession::open() {
     return true;
 }
 
-void SerialSession::lost(std::error_code ec) {
+void SerialSession::lost(boost::system::error_code ec) {
     if (!failure_logged_)
         spdlog::warn("finsd: serial {} ({}): lost: {}; retrying", options_.name,
                      options_.line.device, ec.message());
@@ -82,7 +83,7 @@ void SerialSession::schedule_reopen() {
     std::weak_ptr<SerialSession> weak = weak_from_this();
     const auto gen = generation_;
     timer_.expires_after(backoff_);
-    timer_.async_wait([this, weak, gen](std::error_code ec) {
+    timer_.async_wait([this, weak, gen](boost::system::error_code ec) {
         if (ec || weak.expired() || gen != generation_ || stopped_) return;
         if (open()) return;
         backoff_ = std::min(backoff_ * 2, options_.max_reopen_interval);
@@ -96,7 +97,7 @@ void SerialSession::receive() {
     const auto gen = generation_;
     // on_bytes() leaves less than max_line characters, so there is always room.
     port_.port().async_read_some(asio::buffer(rx_.data() + rx_size_, rx_.size() - rx_size_),
-                                 [this, weak, gen](std::error_code ec, std::size_t n) {
+                                 [this, weak, gen](boost::system::error_code ec, std::size_t n) {
                                      if (weak.expired() || gen != generation_) return;
                                      if (ec) return lost(ec);
                                      on_bytes(n);
@@ -170,7 +171,7 @@ void SerialSession::reply(std::size_t size, std::uint8_t wait) {
     std::weak_ptr<SerialSession> weak = weak_from_this();
     const auto gen = generation_;
     timer_.expires_after(std::chrono::milliseconds(10 * wait));
-    timer_.async_wait([this, weak, gen](std::error_code ec) {
+    timer_.async_wait([this, weak, gen](boost::system::error_code ec) {
         if (ec || weak.expired() || gen != generation_) return;
         write();
     });
@@ -180,7 +181,7 @@ void SerialSession::write() {
     std::weak_ptr<SerialSession> weak = weak_from_this();
     const auto gen = generation_;
     asio::async_write(port_.port(), asio::buffer(tx_.data(), tx_size_),
-                      [this, weak, gen](std::error_code ec, std::size_t) {
+                      [this, weak, gen](boost::system::error_code ec, std::size_t) {
                           if (weak.expired() || gen != generation_) return;
                           if (ec) return lost(ec);
                           busy_ = false;

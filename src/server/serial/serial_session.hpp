@@ -26,11 +26,12 @@
 #include <memory>
 #include <string>
 
-#include <asio/io_context.hpp>
-#include <asio/steady_timer.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/steady_timer.hpp>
 
 #include "fins/host_link.hpp"
 #include "fins/serial.hpp"
+#include "transport/asio.hpp"
 #include "transport/serial_port.hpp"
 
 namespace fins::server {
@@ -74,7 +75,7 @@ class SerialSession : public std::enable_shared_from_this<SerialSession> {
 
   private:
     bool open();
-    void lost(std::error_code ec);
+    void lost(boost::system::error_code ec);
     void schedule_reopen();
     void receive();
     void on_bytes(std::size_t n);

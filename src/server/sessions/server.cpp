@@ -8,20 +8,21 @@
 #include <optional>
 
 #include <spdlog/spdlog.h>
-#include <asio/ip/tcp.hpp>
-#include <asio/ip/udp.hpp>
-#include <asio/steady_timer.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/ip/udp.hpp>
+#include <boost/asio/steady_timer.hpp>
 
 #include "fins/node_address.hpp"
 #include "server/dispatch/dispatcher.hpp"
 #include "server/scenario/fault_hook.hpp"
 #include "server/sessions/tcp_session.hpp"
 #include "server/sessions/udp_session.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::server {
 
 std::uint8_t derive_node(const std::string& bind_address) noexcept {
-    std::error_code ec;
+    boost::system::error_code ec;
     const auto ip = asio::ip::make_address(bind_address, ec);
     if (ec || ip.is_unspecified()) return 1;
     // The same rule as the client's default destination (fins/node_address.hpp).
@@ -44,7 +45,7 @@ struct Server::Impl {
     }
 
     void accept_tcp() {
-        acceptor.async_accept([this](std::error_code ec, asio::ip::tcp::socket socket) {
+        acceptor.async_accept([this](boost::system::error_code ec, asio::ip::tcp::socket socket) {
             if (ec == asio::error::operation_aborted || !acceptor.is_open()) return;
             if (ec == asio::error::connection_aborted) {
                 // The peer gave up while queued: nothing is wrong with us.
@@ -113,7 +114,7 @@ struct Server::Impl {
     // and accepting resumes by itself. At most one failure line per accept_log_interval
     // (a failure that flaps with short recoveries included); the recovery of a logged
     // failure is logged once.
-    void accept_failed(std::error_code ec) {
+    void accept_failed(boost::system::error_code ec) {
         const auto now = std::chrono::steady_clock::now();
         const bool new_episode = accept_failures++ == 0;
         ++accept_unreported;
@@ -133,7 +134,7 @@ struct Server::Impl {
         accept_delay =
             std::clamp(accept_delay * 2, std::chrono::milliseconds(10), accept_retry_max);
         accept_timer.expires_after(accept_delay);
-        accept_timer.async_wait([this](std::error_code timer_ec) {
+        accept_timer.async_wait([this](boost::system::error_code timer_ec) {
             if (timer_ec || !acceptor.is_open()) return;
             accept_tcp();
         });
@@ -168,7 +169,7 @@ struct Server::Impl {
 
 Result<std::unique_ptr<Server>> Server::start(asio::io_context& io, plc::Plc& plc,
                                               const ServerOptions& options) {
-    std::error_code ec;
+    boost::system::error_code ec;
     const auto ip = asio::ip::make_address(options.bind_address, ec);
     if (ec) return Unexpected(ec);
     const std::uint8_t node = options.node != 0 ? options.node : derive_node(options.bind_address);
@@ -244,7 +245,7 @@ std::uint16_t Server::udp_port() const noexcept {
 }
 
 std::uint16_t Server::tcp_port() const noexcept {
-    std::error_code ec;
+    boost::system::error_code ec;
     return impl_->acceptor.is_open() ? impl_->acceptor.local_endpoint(ec).port() : 0;
 }
 
@@ -290,7 +291,7 @@ std::vector<const TcpClient*> Server::tcp_clients() const {
 }
 
 void Server::stop() {
-    std::error_code ignored;
+    boost::system::error_code ignored;
     impl_->instructions->stop();
     for (auto& client : impl_->clients)
         client->stop();

@@ -20,13 +20,14 @@
 #include <string>
 #include <vector>
 
-#include <asio/io_context.hpp>
+#include <boost/asio/io_context.hpp>
 
 #include "fins/error.hpp"
 #include "fins/frame.hpp"
 #include "server/instructions/instruction_udp.hpp"
 #include "server/sessions/tcp_client.hpp"
 #include "server/sessions/tcp_limits.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::plc {
 class Plc;

@@ -36,7 +36,7 @@ TcpClient::TcpClient(asio::io_context& io, Dispatcher& dispatcher, RemoteNode re
       retry_timer_(io),
       random_(std::random_device{}()) {
     transport_.set_frame_handler([this](Bytes frame) { on_frame(frame); });
-    transport_.set_close_handler([this](std::error_code reason) { on_close(reason); });
+    transport_.set_close_handler([this](boost::system::error_code reason) { on_close(reason); });
 }
 
 TcpClient::~TcpClient() {
@@ -104,7 +104,7 @@ void TcpClient::on_open(Result<transport::LinkInfo> link) {
                  remote_.host, remote_.port, client_node_);
 }
 
-void TcpClient::on_close(std::error_code reason) {
+void TcpClient::on_close(boost::system::error_code reason) {
     spdlog::warn("fins/tcp client: connection to node {} at {}:{} lost: {}; reconnecting",
                  remote_.node, remote_.host, remote_.port, reason.message());
     drop();
@@ -149,11 +149,12 @@ void TcpClient::retry_later(std::chrono::milliseconds delay) {
     std::uniform_int_distribution<std::chrono::milliseconds::rep> pick(
         half, std::max(half, delay.count()));
     retry_timer_.expires_after(std::chrono::milliseconds(pick(random_)));
-    retry_timer_.async_wait([this, alive = std::weak_ptr<bool>(alive_)](std::error_code ec) {
-        const auto a = alive.lock();
-        if (ec || !a || !*a) return;
-        open();
-    });
+    retry_timer_.async_wait(
+        [this, alive = std::weak_ptr<bool>(alive_)](boost::system::error_code ec) {
+            const auto a = alive.lock();
+            if (ec || !a || !*a) return;
+            open();
+        });
 }
 
 bool TcpClient::send_frame(Bytes frame) {

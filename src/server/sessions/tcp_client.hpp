@@ -42,12 +42,13 @@
 #include <memory>
 #include <random>
 
-#include <asio/io_context.hpp>
-#include <asio/steady_timer.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/steady_timer.hpp>
 
 #include "fins/frame.hpp"
 #include "server/dispatch/dispatcher.hpp"
 #include "server/instructions/instruction_udp.hpp"
+#include "transport/asio.hpp"
 #include "transport/tcp_transport.hpp"
 
 namespace fins::server {
@@ -115,7 +116,7 @@ class TcpClient {
     void on_open(Result<transport::LinkInfo> link);
     void on_frame(Bytes frame);
     void serve(Bytes command);
-    void on_close(std::error_code reason);
+    void on_close(boost::system::error_code reason);
     void drop();
     void retry_later(std::chrono::milliseconds delay);
     [[nodiscard]] std::chrono::milliseconds next_delay() noexcept;

@@ -10,11 +10,12 @@
 #include <cstring>
 
 #include <spdlog/spdlog.h>
-#include <asio/post.hpp>
-#include <asio/write.hpp>
+#include <boost/asio/post.hpp>
+#include <boost/asio/write.hpp>
 
 #include "fins/frame.hpp"
 #include "server/dispatch/dispatcher.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::server {
 
@@ -36,7 +37,7 @@ TcpSession::TcpSession(asio::ip::tcp::socket socket, Dispatcher& dispatcher, Tcp
       nodes_(nodes),
       limits_(limits),
       timer_(socket_.get_executor()) {
-    std::error_code ignored;
+    boost::system::error_code ignored;
     peer_ = socket_.remote_endpoint(ignored).address();
 }
 
@@ -45,7 +46,7 @@ TcpSession::~TcpSession() {
 }
 
 void TcpSession::start() {
-    std::error_code ignored;
+    boost::system::error_code ignored;
     // Never let a response sit behind Nagle waiting for the client's delayed ACK.
     socket_.set_option(asio::ip::tcp::no_delay(true), ignored);
     if (const auto ec = set_keepalive(socket_, limits_.keepalive))
@@ -61,14 +62,14 @@ void TcpSession::close() {
     timer_.cancel();
     nodes_.release(client_node_, this);
     client_node_ = 0;
-    std::error_code ignored;
+    boost::system::error_code ignored;
     socket_.shutdown(asio::ip::tcp::socket::shutdown_both, ignored);
     socket_.close(ignored);
 }
 
 void TcpSession::wait_readable() {
     socket_.async_wait(asio::socket_base::wait_read,
-                       [self = shared_from_this()](std::error_code ec) {
+                       [self = shared_from_this()](boost::system::error_code ec) {
                            if (ec == asio::error::operation_aborted) return;
                            self->on_readable();
                        });
@@ -154,7 +155,7 @@ bool TcpSession::serve_buffered() {
     // asks for no response gets no answer to carry the ACK. Linux delays that ACK
     // (~40 ms); quick-ack mode does not stick, so re-arm it (issue 6 item 13).
     if (in_size_ > 0 || !answered) {
-        std::error_code ignored;
+        boost::system::error_code ignored;
         socket_.set_option(quick_ack(true), ignored);
     }
     return true;
@@ -312,7 +313,7 @@ void TcpSession::send_and_continue(std::size_t size, bool close_after) {
     auto self = shared_from_this();
     // One write per response: clients that read one response per recv() depend on it.
     asio::async_write(socket_, asio::buffer(out_.data(), size),
-                      [self, close_after](std::error_code ec, std::size_t) {
+                      [self, close_after](boost::system::error_code ec, std::size_t) {
                           self->write_ = Write::idle;
                           if (!self->open()) return;
                           if (ec) {
@@ -346,7 +347,7 @@ void TcpSession::send_confirmation() {
                    peer_.to_string(), client_node_);
     auto self = shared_from_this();
     asio::async_write(socket_, asio::buffer(confirmation_),
-                      [self](std::error_code ec, std::size_t) {
+                      [self](boost::system::error_code ec, std::size_t) {
                           self->write_ = Write::idle;
                           if (!self->open()) return;
                           if (ec) {
@@ -389,7 +390,7 @@ void TcpSession::write_late() {
     start_write(Write::late_frame);
     auto self = shared_from_this();
     asio::async_write(socket_, asio::buffer(late_.front()),
-                      [self](std::error_code ec, std::size_t) {
+                      [self](boost::system::error_code ec, std::size_t) {
                           self->write_ = Write::idle;
                           if (!self->late_.empty()) self->late_.pop_front();
                           if (!self->open()) return;

@@ -37,19 +37,21 @@
 #include <optional>
 #include <vector>
 
-#include <asio/ip/tcp.hpp>
-#include <asio/steady_timer.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
 
 #include "fins/error.hpp"
 #include "fins/tcp.hpp"
 #include "server/dispatch/dispatcher.hpp"
 #include "server/sessions/tcp_limits.hpp"
 #include "server/sessions/tcp_node_table.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::server {
 
 // Turns TCP keep-alive on `socket` on with `idle` (see TcpLimits::keepalive) or off (0).
-std::error_code set_keepalive(asio::ip::tcp::socket& socket, std::chrono::seconds idle) noexcept;
+boost::system::error_code set_keepalive(asio::ip::tcp::socket& socket,
+                                        std::chrono::seconds idle) noexcept;
 
 // Deferred answers (a Serial Gateway port's) wait in a small queue of their own and are
 // written whole between the in-order responses, never interleaved with one.

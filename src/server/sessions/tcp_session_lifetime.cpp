@@ -20,8 +20,9 @@ constexpr std::size_t drain_limit = 256 * 1024;
 
 }  // namespace
 
-std::error_code set_keepalive(asio::ip::tcp::socket& socket, std::chrono::seconds idle) noexcept {
-    std::error_code ec;
+boost::system::error_code set_keepalive(asio::ip::tcp::socket& socket,
+                                        std::chrono::seconds idle) noexcept {
+    boost::system::error_code ec;
     socket.set_option(asio::socket_base::keep_alive(idle.count() > 0), ec);
     if (ec || idle.count() <= 0) return ec;
     const int fd = socket.native_handle();
@@ -31,7 +32,7 @@ std::error_code set_keepalive(asio::ip::tcp::socket& socket, std::chrono::second
     if (::setsockopt(fd, IPPROTO_TCP, TCP_KEEPIDLE, &idle_s, sizeof idle_s) != 0 ||
         ::setsockopt(fd, IPPROTO_TCP, TCP_KEEPINTVL, &interval_s, sizeof interval_s) != 0 ||
         ::setsockopt(fd, IPPROTO_TCP, TCP_KEEPCNT, &probes, sizeof probes) != 0)
-        return {errno, std::system_category()};
+        return {errno, boost::system::system_category()};
     return {};
 }
 
@@ -40,7 +41,7 @@ void TcpSession::close_after_notice() {
     nodes_.release(client_node_, this);
     client_node_ = 0;
     state_ = State::draining;
-    std::error_code ec;
+    boost::system::error_code ec;
     socket_.shutdown(asio::ip::tcp::socket::shutdown_send, ec);
     if (ec) {
         close();
@@ -54,7 +55,7 @@ void TcpSession::close_after_notice() {
 
 void TcpSession::drain() {
     auto self = shared_from_this();
-    socket_.async_read_some(asio::buffer(in_), [self](std::error_code ec, std::size_t n) {
+    socket_.async_read_some(asio::buffer(in_), [self](boost::system::error_code ec, std::size_t n) {
         if (self->state_ != State::draining) return;
         self->drained_ += n;
         // End of the peer's data (it read our notice and closed), an error, or too much.
@@ -82,7 +83,7 @@ void TcpSession::arm_timer(Clock::time_point at) {
     const auto generation = ++timer_generation_;
     timer_.expires_at(at);
     auto self = shared_from_this();
-    timer_.async_wait([self, generation](std::error_code) {
+    timer_.async_wait([self, generation](boost::system::error_code) {
         // A newer arm or close() superseded this wait (its cancel may race the expiry).
         if (generation != self->timer_generation_) return;
         self->timer_armed_ = false;

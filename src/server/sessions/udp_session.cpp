@@ -8,9 +8,10 @@
 #include <cstring>
 
 #include <spdlog/spdlog.h>
-#include <asio/post.hpp>
+#include <boost/asio/post.hpp>
 
 #include "server/dispatch/dispatcher.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::server {
 
@@ -63,12 +64,12 @@ void UdpSession::start() {
 }
 
 void UdpSession::close() {
-    std::error_code ignored;
+    boost::system::error_code ignored;
     socket_.close(ignored);
 }
 
 std::uint16_t UdpSession::local_port() const noexcept {
-    std::error_code ec;
+    boost::system::error_code ec;
     if (!socket_.is_open()) return 0;
     const auto endpoint = socket_.local_endpoint(ec);
     if (ec) return 0;
@@ -88,7 +89,7 @@ std::uint16_t UdpSession::local_port() const noexcept {
 
 void UdpSession::wait_readable() {
     socket_.async_wait(asio::socket_base::wait_read,
-                       [self = shared_from_this()](std::error_code ec) {
+                       [self = shared_from_this()](boost::system::error_code ec) {
                            if (ec == asio::error::operation_aborted || !self->open()) return;
                            if (ec) spdlog::debug("fins/udp: wait: {}", ec.message());
                            self->on_readable();

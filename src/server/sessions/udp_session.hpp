@@ -28,11 +28,12 @@
 #include <netinet/in.h>
 #include <sys/socket.h>
 
-#include <asio/generic/datagram_protocol.hpp>
+#include <boost/asio/generic/datagram_protocol.hpp>
 
 #include "fins/frame.hpp"
 #include "server/dispatch/dispatcher.hpp"
 #include "server/sessions/log_summary.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::server {
 

@@ -10,14 +10,15 @@
 #include <thread>
 #include <vector>
 
-#include <asio/io_context.hpp>
-#include <asio/post.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
 #include <nlohmann/json.hpp>
 
 #include "plc/plc.hpp"
 #include "server/control/control.hpp"
 #include "server/control/control_client.hpp"
 #include "server/instructions/network_instructions.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::test {
 namespace {

@@ -12,11 +12,12 @@
 #include <memory>
 #include <new>
 
-#include <asio/generic/datagram_protocol.hpp>
-#include <asio/io_context.hpp>
+#include <boost/asio/generic/datagram_protocol.hpp>
+#include <boost/asio/io_context.hpp>
 
 #include "server/frame_builder.hpp"
 #include "server/sessions/udp_session.hpp"
+#include "transport/asio.hpp"
 
 namespace {
 std::atomic<std::size_t> allocations{0};

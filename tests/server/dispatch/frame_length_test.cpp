@@ -9,7 +9,7 @@
 #include <memory>
 #include <vector>
 
-#include <asio/io_context.hpp>
+#include <boost/asio/io_context.hpp>
 
 #include "fins/frame.hpp"
 #include "plc/plc.hpp"
@@ -17,6 +17,7 @@
 #include "server/dispatch/dispatcher.hpp"
 #include "server/routing/router.hpp"
 #include "server/serial/serial_ports.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::server {
 namespace {

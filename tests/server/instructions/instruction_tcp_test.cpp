@@ -10,14 +10,15 @@
 #include <thread>
 #include <vector>
 
-#include <asio/io_context.hpp>
-#include <asio/post.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
 
 #include "fins/tcp.hpp"
 #include "server/frame_builder.hpp"
 #include "server/instructions/network_instructions.hpp"
 #include "server/sessions/server.hpp"
 #include "server/sessions/tcp_peer.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::test {
 namespace {

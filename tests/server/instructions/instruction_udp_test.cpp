@@ -4,12 +4,13 @@
 
 #include <gtest/gtest.h>
 
-#include <asio/io_context.hpp>
-#include <asio/ip/udp.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/udp.hpp>
 
 #include "plc/plc.hpp"
 #include "server/dispatch/dispatcher.hpp"
 #include "server/sessions/udp_session.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::test {
 namespace {

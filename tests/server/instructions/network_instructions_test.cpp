@@ -8,10 +8,11 @@
 #include <optional>
 #include <vector>
 
-#include <asio/io_context.hpp>
+#include <boost/asio/io_context.hpp>
 
 #include "plc/plc.hpp"
 #include "plc/profile.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::test {
 namespace {

@@ -11,7 +11,7 @@
 #include <memory>
 #include <vector>
 
-#include <asio/io_context.hpp>
+#include <boost/asio/io_context.hpp>
 
 #include "fins/modbus.hpp"
 #include "plc/plc.hpp"
@@ -19,6 +19,7 @@
 #include "server/dispatch/dispatcher.hpp"
 #include "server/routing/router.hpp"
 #include "server/serial/serial_ports.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::server {
 namespace {

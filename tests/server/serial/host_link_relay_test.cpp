@@ -13,12 +13,13 @@
 #include <string>
 #include <vector>
 
-#include <asio/io_context.hpp>
+#include <boost/asio/io_context.hpp>
 
 #include "fins/host_link.hpp"
 #include "plc/plc.hpp"
 #include "server/dispatch/dispatcher.hpp"
 #include "server/serial/serial_ports.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::server {
 namespace {

@@ -14,10 +14,11 @@
 #include <string>
 #include <vector>
 
-#include <asio/io_context.hpp>
+#include <boost/asio/io_context.hpp>
 
 #include "fins/modbus.hpp"
 #include "server/serial/serial_gateway_port.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::server {
 namespace {

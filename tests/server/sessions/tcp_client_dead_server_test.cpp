@@ -21,12 +21,13 @@
 #include <thread>
 #include <vector>
 
-#include <asio/io_context.hpp>
-#include <asio/post.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
 
 #include "plc/plc.hpp"
 #include "server/frame_builder.hpp"
 #include "server/sessions/server.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::test {
 namespace {

@@ -10,12 +10,13 @@
 #include <memory>
 #include <thread>
 
-#include <asio/io_context.hpp>
-#include <asio/post.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
 
 #include "plc/plc.hpp"
 #include "server/sessions/server.hpp"
 #include "server/sessions/tcp_peer.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::test {
 namespace {

@@ -20,11 +20,12 @@
 #include <memory>
 #include <vector>
 
-#include <asio/io_context.hpp>
+#include <boost/asio/io_context.hpp>
 
 #include "fins/tcp.hpp"
 #include "server/frame_builder.hpp"
 #include "server/sessions/server.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::test {
 namespace {

@@ -16,12 +16,13 @@
 #include <vector>
 
 #include <fmt/format.h>
-#include <asio/io_context.hpp>
+#include <boost/asio/io_context.hpp>
 
 #include "fins/tcp.hpp"
 #include "server/frame_builder.hpp"
 #include "server/sessions/server.hpp"
 #include "server/sessions/tcp_peer.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::test {
 namespace {

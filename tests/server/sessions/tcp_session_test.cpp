@@ -5,11 +5,12 @@
 #include <sys/socket.h>
 
 #include <gtest/gtest.h>
-#include <asio/io_context.hpp>
-#include <asio/ip/tcp.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
 
 #include "server/sessions/tcp_node_table.hpp"
 #include "server/sessions/tcp_session.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::server {
 namespace {

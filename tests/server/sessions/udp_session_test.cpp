@@ -17,17 +17,18 @@
 #include <thread>
 #include <vector>
 
-#include <asio/generic/datagram_protocol.hpp>
-#include <asio/io_context.hpp>
-#include <asio/ip/tcp.hpp>
-#include <asio/ip/udp.hpp>
-#include <asio/post.hpp>
+#include <boost/asio/generic/datagram_protocol.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/ip/udp.hpp>
+#include <boost/asio/post.hpp>
 
 #include "fins/tcp.hpp"
 #include "server/frame_builder.hpp"
 #include "server/sessions/server.hpp"
 #include "server/sessions/tcp_peer.hpp"
 #include "server/sessions/udp_session.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::test {
 namespace {
