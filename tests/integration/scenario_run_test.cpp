@@ -88,6 +88,47 @@ TEST(ScenarioRun, TankFillsWhileThePumpRunsAndDrainsThroughTheValve) {
     EXPECT_NE(ctl(socket, {"scenario", "trigger", "no_such_event"}).exit_code, 0);
 }
 
+TEST(ScenarioRun, ConveyorCountsBoxesAndJamsOnSchedule) {
+    ScratchDir dir("scenario-conveyor");
+    const std::string socket = (dir.path() / "ctl.sock").string();
+    Finsd d({"--scenario", examples + "conveyor.toml", "--control", socket});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    auto c = d.client();
+    ASSERT_NE(c, nullptr);
+    write_bit(*c, "CIO1.00", true);  // start the belt
+    run_for(socket, 20);
+    EXPECT_EQ(read_int16(*c, "D20"), 30);
+    EXPECT_EQ(read_int16(*c, "D21"), 10);  // a box every 2 s
+    run_for(socket, 285);                  // t = 305: jammed since 300
+    EXPECT_EQ(read_int16(*c, "D20"), 0);
+    const auto during = read_int16(*c, "D21");
+    const Json jammed = Json::parse(ctl(socket, {"status"}).out)["status"];
+    EXPECT_EQ(jammed["error_code"], "410A") << jammed.dump();  // FAL 10
+    run_for(socket, 10);
+    EXPECT_EQ(read_int16(*c, "D21"), during);  // nothing passes the eye while jammed
+    run_for(socket, 10);                       // t = 325: running again
+    EXPECT_EQ(read_int16(*c, "D20"), 30);
+    EXPECT_EQ(Json::parse(ctl(socket, {"status"}).out)["status"]["error_code"], "0000");
+}
+
+TEST(ScenarioRun, TemperaturePvFollowsTheSetpointWrittenOverFins) {
+    ScratchDir dir("scenario-temperature");
+    const std::string socket = (dir.path() / "ctl.sock").string();
+    Finsd d({"--scenario", examples + "temperature.toml", "--control", socket});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    auto c = d.client();
+    ASSERT_NE(c, nullptr);
+    run_for(socket, 1);
+    EXPECT_NEAR(read_int16(*c, "D201"), 200, 15);
+    ASSERT_TRUE(c->write_words(addr("D200"), std::vector<std::uint16_t>{800}).has_value());
+    run_for(socket, 5);
+    EXPECT_EQ(c->read_bits(addr("W20.00"), 1).value_or(std::vector<bool>{false})[0], true);
+    EXPECT_GT(read_int16(*c, "D202"), 0);  // the heater is on
+    run_for(socket, 200);                  // ten time constants
+    EXPECT_NEAR(read_int16(*c, "D201"), 800, 15);
+    EXPECT_EQ(c->read_bits(addr("W20.00"), 1).value_or(std::vector<bool>{true})[0], false);
+}
+
 TEST(ScenarioRun, SameSeedAndSameWritesAtTheSameTimesGiveTheSameMemory) {
     const auto run_once = [](const std::string& tag) {
         ScratchDir dir(tag);

@@ -6,10 +6,11 @@
 #include <memory>
 #include <optional>
 
-#include <asio/io_context.hpp>
+#include <boost/asio/io_context.hpp>
 
 #include "cli/finsd/config_scenario.hpp"
 #include "server/scenario/scenario_runner.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::cli::finsd {
 

@@ -51,13 +51,13 @@ void ScenarioRunner::stop() {
 
 void ScenarioRunner::schedule() {
     timer_.expires_at(next_);
-    timer_.async_wait([this, alive = alive_](std::error_code ec) {
+    timer_.async_wait([this, alive = alive_](boost::system::error_code ec) {
         if (!*alive) return;
         on_tick(ec);
     });
 }
 
-void ScenarioRunner::on_tick(std::error_code ec) {
+void ScenarioRunner::on_tick(boost::system::error_code ec) {
     if (ec || !running_ || paused_ || scenario_->definition().virtual_time) return;
     const auto now = std::chrono::steady_clock::now();
     unsigned ran = 0;
@@ -163,7 +163,7 @@ void ScenarioRunner::flush_delayed() {
     delay_armed_ = !delayed_.empty();
     if (!delay_armed_) return;
     delay_timer_.expires_at(delayed_.front().due);
-    delay_timer_.async_wait([this, alive = alive_](std::error_code ec) {
+    delay_timer_.async_wait([this, alive = alive_](boost::system::error_code ec) {
         if (!*alive || ec) return;
         flush_delayed();
     });

@@ -19,13 +19,14 @@
 #include <string>
 #include <vector>
 
-#include <asio/io_context.hpp>
-#include <asio/steady_timer.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/steady_timer.hpp>
 
 #include "scenario/random.hpp"
 #include "scenario/scenario.hpp"
 #include "server/scenario/fault_hook.hpp"
 #include "server/scenario/scenario_control.hpp"
+#include "transport/asio.hpp"
 
 namespace fins::server {
 
@@ -66,7 +67,7 @@ class ScenarioRunner final : public ScenarioControl, public FaultHook {
 
   private:
     void schedule();
-    void on_tick(std::error_code ec);
+    void on_tick(boost::system::error_code ec);
     void flush_delayed();
 
     asio::io_context& io_;

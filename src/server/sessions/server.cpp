@@ -66,7 +66,7 @@ struct Server::Impl {
             }
             // A scenario's "node offline" (server/scenario/fault_hook.hpp): refused.
             if (dispatcher.faults() != nullptr && dispatcher.faults()->offline()) {
-                std::error_code ignored;
+                boost::system::error_code ignored;
                 socket.close(ignored);
                 accept_tcp();
                 return;
