@@ -129,6 +129,25 @@ TEST(ScenarioRun, TemperaturePvFollowsTheSetpointWrittenOverFins) {
     EXPECT_EQ(c->read_bits(addr("W20.00"), 1).value_or(std::vector<bool>{true})[0], false);
 }
 
+TEST(ScenarioRun, APlantOfFiftyMachinesWithStaggeredFaults) {
+    ScratchDir dir("scenario-plant");
+    const std::string socket = (dir.path() / "ctl.sock").string();
+    Finsd d({"--config", examples + "plant-50.toml", "--control", socket});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    // Each CPU Unit has its own scenario time: only machine-03 moves to 35 s.
+    ASSERT_EQ(ctl(socket, {"--plc", "machine-03", "scenario", "advance", "35"}).exit_code, 0);
+    const auto status = [&](const char* plc) {
+        return Json::parse(ctl(socket, {"--plc", plc, "status"}).out)["status"];
+    };
+    EXPECT_EQ(status("machine-03")["error_code"], "4103");  // FAL 3 from 30 s to 60 s
+    EXPECT_EQ(status("machine-04")["error_code"], "0000");
+    ASSERT_EQ(ctl(socket, {"--plc", "machine-04", "scenario", "advance", "45"}).exit_code, 0);
+    EXPECT_EQ(status("machine-04")["error_code"], "4104");
+    const Json s = Json::parse(ctl(socket, {"--plc", "machine-50", "scenario", "status"}).out);
+    EXPECT_EQ(s["scenario"]["seed"], 50);
+    EXPECT_EQ(s["scenario"]["events"].size(), 3u);  // FAL, stuck spindle, offline
+}
+
 TEST(ScenarioRun, SameSeedAndSameWritesAtTheSameTimesGiveTheSameMemory) {
     const auto run_once = [](const std::string& tag) {
         ScratchDir dir(tag);
