@@ -18,7 +18,7 @@ esac
 if command -v ccache >/dev/null; then args+=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
 cmake -S "$root" -B "$root/$dir" -G Ninja "${args[@]}" >/dev/null
 if [[ "$kind" == fuzz ]]; then
-  ninja -C "$root/$dir" -j "$jobs" fuzz_frame fuzz_tcp fuzz_address fuzz_dispatch fuzz_session fuzz_files fuzz_host_link fuzz_router fuzz_serial_gateway fuzz_serial_session fuzz_http
+  ninja -C "$root/$dir" -j "$jobs" fuzz_frame fuzz_tcp fuzz_address fuzz_dispatch fuzz_session fuzz_files fuzz_host_link fuzz_router fuzz_serial_gateway fuzz_serial_session fuzz_http fuzz_scenario_expr
 else
   ninja -C "$root/$dir" -j "$jobs" "$@"
 fi

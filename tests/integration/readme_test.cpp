@@ -5,7 +5,7 @@
 // Checked: every fenced block with at least one line starting with "$ ". Such a block
 // is a session against a finsd started for it alone (port 0, a control socket, a
 // scratch working directory); an HTML comment on the line before the fence adds finsd
-// flags:   <!-- readme-test: finsd --profile cs1h-lcb -->
+// flags:   <!-- readme-test: finsd --profile cs1h-lcb -->  ("{source}": the source tree)
 // In the block:
 //   "$ fins ARGS"       runs build/bin/fins with --port of that finsd added
 //   "$ finsd ctl ARGS"  runs finsd ctl with --socket of that finsd added
@@ -263,6 +263,10 @@ TEST_P(Doc, EverySampleSessionPrintsWhatThePageShows) {
         ScratchDir dir("readme");
         const std::string socket = (dir.path() / "ctl.sock").string();
         auto args = block.finsd_args;
+        // "{source}" in a flag is the source tree (an example file: docs/scenarios.md).
+        for (auto& arg : args)
+            if (const auto at = arg.find("{source}"); at != std::string::npos)
+                arg.replace(at, 8, source_dir.string());
         args.insert(args.end(), {"--control", socket});
         Finsd finsd(args);
         ASSERT_TRUE(finsd.started()) << finsd.result().err;

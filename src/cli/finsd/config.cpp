@@ -64,6 +64,9 @@ class Loader {
                 r = load_schedule(key, node, source_, s_);
             else if (k == "http")
                 r = load_http_table(node, source_, s_.http);
+
+            else if (k == "scenario")
+                r = scenario(node);
             else
                 r = fail(key, k, "unknown key");
             if (!r) return r;
@@ -129,6 +132,13 @@ class Loader {
         if (v->get() < lo || v->get() > hi)
             return fail(key, path, fmt::format("{} is not {}-{}", v->get(), lo, hi));
         return v->get();
+    }
+
+    Expected<void> scenario(const toml::node& node) {
+        auto config = load_scenario_table(node, source_, "scenario");
+        if (!config) return tl::unexpected(config.error());
+        s_.scenario = std::move(*config);
+        return {};
     }
 
     Expected<void> mode(const toml::key& key, const toml::node& node) {

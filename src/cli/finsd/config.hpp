@@ -18,6 +18,8 @@
 #include <tl/expected.hpp>
 
 #include "cli/finsd/config_http.hpp"
+
+#include "cli/finsd/config_scenario.hpp"
 #include "cli/finsd/config_schedule.hpp"
 #include "cli/finsd/config_serial.hpp"
 #include "fins/address.hpp"
@@ -86,6 +88,8 @@ struct Settings : CpuUnitOptions, server::FileMemoryOptions {
         std::vector<MemoryInit> memory;         // [plc.memory]
         std::vector<SerialPortConfig> serial;   // [plc.serial]
         std::vector<ScheduleEntry> schedule;    // [[plc.schedule]]
+        // [plc.scenario] (config_scenario.hpp)
+        std::optional<ScenarioConfig> scenario;
         // Per [[plc.ethernet]]: true when it sets `port`; the others take `port` above
         // (--port, [network] port).
         std::vector<bool> port_given;
@@ -97,6 +101,9 @@ struct Settings : CpuUnitOptions, server::FileMemoryOptions {
     std::vector<ScheduleEntry> schedule;      // [[schedule]]
 
     HttpSettings http;  // [http], --http (config_http.hpp, docs/web.md)
+
+    // [scenario], --scenario (config_scenario.hpp)
+    std::optional<ScenarioConfig> scenario;
 };
 
 // Command-line values; a set optional overrides the file.

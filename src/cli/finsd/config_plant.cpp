@@ -279,6 +279,10 @@ class PlantLoader {
                     cpu.remotes.push_back(std::move(remote));
                 for (auto& entry : scratch.schedule)
                     extra.schedule.push_back(std::move(entry));
+            } else if (key == "scenario") {
+                auto config = load_scenario_table(v, source_, p);
+                if (!config) return tl::unexpected(config.error());
+                extra.scenario = std::move(*config);
             } else if (key == "relay") {
                 r = tables(v, p, [&](const toml::table& e, const std::string& ep) {
                     return load_relay(e, ep, cpu);
@@ -289,6 +293,7 @@ class PlantLoader {
             if (!r) return r;
         }
         if (cpu.name.empty()) return fail(t.source(), path, "name: missing");
+        if (extra.scenario) extra.scenario->plc = cpu.name;  // reload finds it by name
         if (cpu.durability == plc::Durability::power && !cpu.data_dir)
             return fail(*storage_at, path + ".storage.durability",
                         "\"power\" needs data_dir (without one nothing is kept)");

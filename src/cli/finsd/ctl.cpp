@@ -19,12 +19,15 @@
 //   send JSON                       any request line as is
 //   send|recv|sendcmd|instructions  PLC-initiated messages (ctl_instructions.hpp; their
 //                                   own exit codes)
+//   scenario status|pause|resume|advance SECONDS|trigger EVENT|reload
+//                                   the CPU Unit's scenario (ctl_scenario.hpp)
 //
 // Exit codes: 0 the server answered "ok"; 2 usage error or the server refused the
 // request (its message on stderr); 3 cannot connect, or no answer within 5 s.
 #include "cli/finsd/ctl.hpp"
 #include "cli/finsd/control_setup.hpp"
 #include "cli/finsd/ctl_instructions.hpp"
+#include "cli/finsd/ctl_scenario.hpp"
 
 #include <poll.h>
 #include <sys/socket.h>
@@ -209,6 +212,7 @@ int run_ctl(int argc, char** argv) {
     });
     InstructionVerbs verbs;
     add_instruction_verbs(app, request, verbs);
+    add_scenario_verbs(app, request);
 
     try {
         // argv[0] is "ctl": CLI11 skips it as the program name.

@@ -35,6 +35,7 @@
 #include "cli/finsd/config_plant.hpp"
 #include "cli/finsd/control_setup.hpp"
 #include "cli/finsd/ctl.hpp"
+#include "cli/finsd/scenario_setup.hpp"
 #include "cli/finsd/serial_gateway_setup.hpp"
 #include "cli/finsd/serial_ports.hpp"
 #include "cli/finsd/web_setup.hpp"
@@ -43,6 +44,7 @@
 #include "plc/storage.hpp"
 #include "plc/storage_format.hpp"
 #include "plc/storage_guard.hpp"
+#include "scenario/scenario.hpp"
 #include "server/control/control.hpp"
 #include "server/instructions/instruction_schedule.hpp"
 #include "server/serial/serial_ports.hpp"
@@ -181,6 +183,12 @@ int configure(int argc, char** argv, Settings& settings) {
                    ",timeout=1]; NAME cpu, scuN.P or board.P (repeatable; README Host Link)");
     fins::cli::finsd::HttpFlags http;
     fins::cli::finsd::add_http_flags(app, http);
+
+    std::string scenario_file;
+    auto* o_scenario = app.add_option(
+        "--scenario", scenario_file,
+        "A file with a [scenario] table: signals, links and events that make memory move "
+        "(docs/scenarios.md); replaces the configuration's [scenario]");
     app.add_flag("--reset-state", o.reset_state,
                  "Move a refused state file aside (never deleted) and start with a new one");
     try {
@@ -195,6 +203,15 @@ int configure(int argc, char** argv, Settings& settings) {
     }
     if (!config.empty())
         if (auto r = load_config_file(config, settings); !r) return fail(2, r.error());
+    if (o_scenario->count() > 0) {
+        if (!settings.plant.cpus.empty())
+            return fail(2,
+                        "--scenario is for a single node: give each [[plc]] its own "
+                        "[plc.scenario] (docs/scenarios.md)");
+        auto loaded = fins::cli::finsd::load_scenario_file(scenario_file);
+        if (!loaded) return fail(2, loaded.error());
+        settings.scenario = std::move(*loaded);
+    }
     take(o_profile, profile, o.profile);
     take(o_mode, mode, o.mode);
     take(o_data, data_dir, o.data_dir);
@@ -302,6 +319,13 @@ int serve(const Settings& s) {
     if (!s.memory.empty()) spdlog::info("finsd: {} [memory] entries written", written);
     plc.change_mode(s.mode, std::chrono::system_clock::now());
     fins::cli::finsd::apply_cpu_options(s, plc);
+    // [scenario], --scenario: compiled against this CPU Unit; every error is a start error.
+    std::unique_ptr<fins::scenario::Scenario> scenario;
+    if (s.scenario) {
+        auto compiled = fins::cli::finsd::compile_scenario(*s.scenario, plc);
+        if (!compiled) return fail(2, compiled.error());
+        scenario = std::move(*compiled);
+    }
     // File memory (22 xx): <data_dir>/card and <data_dir>/em; else a temp dir removed at exit.
     if (const auto refused = fins::server::set_up_file_memory(plc, s, s.data_dir, ""))
         return fail(3, refused->message);
@@ -326,8 +350,12 @@ int serve(const Settings& s) {
     fins::server::SerialPorts gateway_ports;
     fins::cli::finsd::open_gateway_ports(io, s.serial, gateway_ports);
     (*server)->attach_serial_ports(&gateway_ports);
+    // The scenario ticks on this io_context; its unit faults reach the dispatcher.
+    auto runner = fins::cli::finsd::run_scenario(io, s.scenario, std::move(scenario), plc);
+    if (runner) (*server)->dispatcher().attach_faults(runner.get());
     // --control, FINSD_SOCKET or the default path (control_setup.hpp).
     fins::server::ControlTarget target;
+    target.scenario = runner.get();
     target.plc = &plc;
     target.addresses = {{(*server)->address().network, (*server)->address().node}};
     target.instructions = &(*server)->instructions();
@@ -355,6 +383,7 @@ int serve(const Settings& s) {
 
     const auto shut_down = [&] {
         schedule.stop();
+        if (runner) runner->stop();
         (*server)->stop();
         gateway_ports.close_all();
         if (control) control->stop();

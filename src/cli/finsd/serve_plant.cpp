@@ -17,6 +17,7 @@
 
 #include "cli/finsd/config_plant.hpp"
 #include "cli/finsd/control_setup.hpp"
+#include "cli/finsd/scenario_setup.hpp"
 #include "cli/finsd/serial_gateway_setup.hpp"
 #include "cli/finsd/serial_ports.hpp"
 #include "cli/finsd/web_setup.hpp"
@@ -126,8 +127,11 @@ struct CpuUnitExtras {
     std::vector<std::unique_ptr<server::SerialPorts>> gateways;
     std::vector<SerialPorts> host_link;
     std::vector<std::unique_ptr<server::InstructionSchedule>> schedules;
+    std::vector<std::unique_ptr<server::ScenarioRunner>> scenarios;  // per CPU Unit, or null
 
     void stop() {
+        for (auto& scenario : scenarios)
+            if (scenario) scenario->stop();
         for (auto& schedule : schedules)
             schedule->stop();
         for (auto& gateway : gateways)
@@ -158,6 +162,17 @@ int set_up_cpu(asio::io_context& io, const Settings& s, server::Plant& plant, st
             plant.cpu_count() <= units_logged_at_info ? spdlog::level::info : spdlog::level::debug,
             "finsd: plc \"{}\": {} memory entries written", config.name, written);
     apply_cpu_options(cpu, plc);  // [plc.protection], [plc.inject]
+    // [plc.scenario]: compiled against this CPU Unit, ticking on the io_context, its unit
+    // faults on every unit of the CPU Unit.
+    std::unique_ptr<scenario::Scenario> compiled;
+    if (cpu.scenario) {
+        auto c = compile_scenario(*cpu.scenario, plc);
+        if (!c) return fail(2, c.error());
+        compiled = std::move(*c);
+    }
+    extras.scenarios.push_back(run_scenario(io, cpu.scenario, std::move(compiled), plc));
+    for (std::size_t k = 0; k < config.ports.size() && extras.scenarios.back(); ++k)
+        plant.server(i, k).dispatcher().attach_faults(extras.scenarios.back().get());
 
     // Serial Gateway ports answer on every unit of the CPU Unit; the Host Link slave
     // ports talk to the CPU Unit through its first unit (frames for other networks are
@@ -214,6 +229,7 @@ int serve_plant(const Settings& s) {
         targets[i].name = s.plant.cpus[i].name;
         // send / recv / sendcmd leave through the CPU Unit's first unit.
         targets[i].instructions = &(*plant)->server(i, 0).instructions();
+        if (i < extras.scenarios.size()) targets[i].scenario = extras.scenarios[i].get();
     }
     for (std::size_t i = 0; i < (*plant)->router().port_count(); ++i) {
         const auto& p = (*plant)->router().port(i);

@@ -37,6 +37,7 @@ namespace fins::server {
 
 class NetworkInstructions;
 class InstructionSchedule;
+class ScenarioControl;
 
 // One CPU Unit the channel drives.
 struct ControlTarget {
@@ -46,6 +47,7 @@ struct ControlTarget {
     // With an engine, the send / recv / sendcmd verbs run on it.
     NetworkInstructions* instructions = nullptr;
     const InstructionSchedule* schedule = nullptr;
+    ScenarioControl* scenario = nullptr;  // its running scenario, if any (control_scenario.hpp)
 };
 
 struct ControlOptions {

@@ -8,6 +8,7 @@
 #include <fmt/core.h>
 
 #include "server/control/control_requests.hpp"
+#include "server/control/control_scenario.hpp"
 
 namespace fins::server {
 
@@ -67,7 +68,8 @@ void dispatch_control_request(std::span<const ControlTarget> targets, const Json
     Json answer;
     try {
         if (handle_instruction_request(target->instructions, target->schedule, j, reply)) return;
-        answer = handle_control_request(*target->plc, j);
+        answer = j["cmd"] == "scenario" ? handle_scenario_request(target->scenario, j)
+                                        : handle_control_request(*target->plc, j);
     } catch (const std::exception& e) {
         answer = control_error(std::string("bad request: ") + e.what());
     }

@@ -1,6 +1,7 @@
 // Dispatcher::handle: the stages of a request in order (length, route, destination,
 // command, execution conditions, handler; see dispatcher.hpp for the contract).
 #include "server/dispatch/dispatcher.hpp"
+#include "server/scenario/fault_hook.hpp"
 
 #include <algorithm>
 
@@ -106,6 +107,8 @@ std::size_t Dispatcher::handle(Bytes request, MutableBytes out, const RequestCon
     if (to.route == Route::host_link)
         return handlers::relay_to_host_link(*to.host_link, request, header, to.self, out, context);
     if (header.is_response()) return 0;
+    // A scenario's unit faults: switched off, or this answer dropped (fault_hook.hpp).
+    if (faults_ != nullptr && faults_->silent()) return 0;
 
     Reply reply{plc_, header, command, to.self, deliverable, out};
     if (const auto code = check_destination(header.destination, to.self, plc_.profile(), serial_);
@@ -131,7 +134,23 @@ std::size_t Dispatcher::handle(Bytes request, MutableBytes out, const RequestCon
         return reply.answer(code);
 
     // 5. The command's handler, and the answer now or later.
+    if (faults_ != nullptr)
+        return run_with_faults(reply, *info, *entry, decoded->parameters, context);
     return run(reply, *info, *entry, decoded->parameters, context);
+}
+
+// A scenario's end code for an area (memory area commands name the area in their first
+// parameter byte) and its latency (the answer leaves through the session's deferred path).
+std::size_t Dispatcher::run_with_faults(Reply& reply, const CommandInfo& info,
+                                        const handlers::HandlerEntry& entry, Bytes parameters,
+                                        const RequestContext& context) {
+    if (reply.command.main == 0x01 && !parameters.empty())
+        if (const auto code = faults_->area_end_code(parameters[0]); code != 0)
+            return reply.answer(static_cast<EndCode>(code));
+    const std::size_t n = run(reply, info, entry, parameters, context);
+    if (n == 0 || faults_->latency().count() <= 0 || context.reply_path == nullptr) return n;
+    faults_->send_later(Bytes(reply.out.data(), n), context.reply_path->defer());
+    return 0;
 }
 
 Dispatcher::Reply::Reply(plc::Plc& cpu_unit, const Header& request, CommandCode command_code,

@@ -32,6 +32,7 @@ namespace fins::server {
 
 class Router;
 class SerialGatewayPort;
+class FaultHook;
 
 namespace handlers {
 struct HandlerEntry;
@@ -97,6 +98,9 @@ class Dispatcher {
     // router decides whether a frame is for this CPU Unit (any of its ports) and forwards
     // the others. Without a router only `self` is "me" (the single-node finsd).
     void attach(Router& router, std::size_t port) noexcept;
+    // A scenario's unit faults (server/scenario/fault_hook.hpp); null: none.
+    void attach_faults(FaultHook* faults) noexcept { faults_ = faults; }
+    [[nodiscard]] FaultHook* faults() const noexcept { return faults_; }
 
   private:
     enum class Route : std::uint8_t { this_node, router, host_link };
@@ -127,12 +131,16 @@ class Dispatcher {
                                 bool deliverable, MutableBytes out) noexcept;
     std::size_t run(Reply& reply, const CommandInfo& info, const handlers::HandlerEntry& entry,
                     Bytes parameters, const RequestContext& context);
+    std::size_t run_with_faults(Reply& reply, const CommandInfo& info,
+                                const handlers::HandlerEntry& entry, Bytes parameters,
+                                const RequestContext& context);
 
     plc::Plc& plc_;
     NodeAddress self_;
     SerialPorts* serial_ = nullptr;
     Router* router_ = nullptr;
     std::size_t port_ = 0;
+    FaultHook* faults_ = nullptr;
 };
 
 }  // namespace fins::server

@@ -14,6 +14,7 @@
 
 #include "fins/node_address.hpp"
 #include "server/dispatch/dispatcher.hpp"
+#include "server/scenario/fault_hook.hpp"
 #include "server/sessions/tcp_session.hpp"
 #include "server/sessions/udp_session.hpp"
 #include "transport/asio.hpp"
@@ -62,6 +63,13 @@ struct Server::Impl {
                 accept_failures = 0;
                 accept_episode_logged = false;
                 accept_delay = std::chrono::milliseconds(0);
+            }
+            // A scenario's "node offline" (server/scenario/fault_hook.hpp): refused.
+            if (dispatcher.faults() != nullptr && dispatcher.faults()->offline()) {
+                boost::system::error_code ignored;
+                socket.close(ignored);
+                accept_tcp();
+                return;
             }
             sessions.remove_if([](const std::weak_ptr<TcpSession>& w) {
                 auto s = w.lock();

@@ -1,0 +1,105 @@
+// fins_scenario_tick: the cost of scenario ticks at plant scale (issue 19, docs/benchmarks.md
+// "Scenario ticks"). N CPU Units (plc::Plc on the heap, no sockets) each run a scenario of
+// T tags: a quarter sines, a quarter random walks, a quarter lags toward a setpoint, a
+// quarter links reading two other tags with noise(). Ticks every unit `--ticks` times and
+// prints the CPU time per round of ticks and the share of one core at the tick period.
+//   fins_scenario_tick --units 1000 --tags 100 --tick-ms 100 --ticks 50
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+
+#include "plc/plc.hpp"
+#include "scenario/scenario.hpp"
+
+namespace {
+
+double cpu_seconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+}
+
+fins::scenario::ScenarioDef make_definition(unsigned tags, unsigned tick_ms, std::uint64_t seed) {
+    using namespace fins::scenario;
+    ScenarioDef def;
+    def.seed = seed;
+    def.tick_s = tick_ms / 1000.0;
+    def.virtual_time = true;
+    for (unsigned i = 0; i < tags; ++i) {
+        TagDef t;
+        t.address.text = "D" + std::to_string(1000 + i);
+        t.type = ValueType::int16;
+        switch (i % 4) {
+            case 0:
+                t.kind = SignalKind::sine;
+                t.min = 0;
+                t.max = 1000;
+                t.period_s = 10 + i;
+                break;
+            case 1:
+                t.kind = SignalKind::random_walk;
+                t.min = -500;
+                t.max = 500;
+                t.step = 3;
+                break;
+            case 2:
+                t.kind = SignalKind::lag;
+                t.input.text = "D" + std::to_string(1000 + i - 2);
+                t.tau_s = 5;
+                t.noise = 1;
+                break;
+            default:
+                t.kind = SignalKind::link;
+                t.input.text = "D" + std::to_string(1000 + i - 3) + " + D" +
+                               std::to_string(1000 + i - 2) + " / 2 + noise(2)";
+                break;
+        }
+        def.tags.push_back(std::move(t));
+    }
+    return def;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"fins_scenario_tick: CPU cost of scenario ticks for a plant"};
+    unsigned units = 1000, tags = 100, tick_ms = 100, ticks = 50;
+    app.add_option("--units", units, "CPU Units")->check(CLI::Range(1u, 20000u));
+    app.add_option("--tags", tags, "Tags per CPU Unit")->check(CLI::Range(4u, 10000u));
+    app.add_option("--tick-ms", tick_ms, "Tick period")->check(CLI::Range(1u, 3600000u));
+    app.add_option("--ticks", ticks, "Rounds of ticks to time")->check(CLI::Range(1u, 100000u));
+    CLI11_PARSE(app, argc, argv);
+
+    std::vector<std::unique_ptr<fins::plc::Plc>> plcs;
+    std::vector<std::unique_ptr<fins::scenario::Scenario>> scenarios;
+    for (unsigned u = 0; u < units; ++u) {
+        plcs.push_back(std::make_unique<fins::plc::Plc>());
+        auto s = fins::scenario::Scenario::compile(make_definition(tags, tick_ms, u), *plcs.back());
+        if (!s) {
+            std::fprintf(stderr, "compile: %s\n", s.error().message.c_str());
+            return 1;
+        }
+        scenarios.push_back(std::move(*s));
+    }
+    const auto now = std::chrono::system_clock::now();
+    for (auto& s : scenarios)
+        s->tick(now);  // warm-up
+    const double start = cpu_seconds();
+    for (unsigned k = 0; k < ticks; ++k)
+        for (auto& s : scenarios)
+            s->tick(now);
+    const double per_round = (cpu_seconds() - start) / ticks;
+    const double share = per_round / (tick_ms / 1000.0);
+    fmt::print(
+        "{} CPU Units x {} tags, tick {} ms: {:.2f} ms CPU per round of ticks "
+        "({:.0f} ns per tag), {:.1f} % of one core\n",
+        units, tags, tick_ms, per_round * 1e3, per_round * 1e9 / (double{1} * units * tags),
+        share * 100);
+    return 0;
+}

@@ -1,0 +1,24 @@
+// Starting a CPU Unit's scenario (contract in scenario_setup.hpp).
+#include "cli/finsd/scenario_setup.hpp"
+
+#include "scenario/scenario.hpp"
+
+namespace fins::cli::finsd {
+
+std::unique_ptr<server::ScenarioRunner> run_scenario(asio::io_context& io,
+                                                     const std::optional<ScenarioConfig>& config,
+                                                     std::unique_ptr<scenario::Scenario> compiled,
+                                                     plc::Plc& plc) {
+    if (!config || !compiled) return nullptr;
+    auto reload = [where = *config, &plc]() -> server::ScenarioRunner::Compiled {
+        auto fresh = reload_scenario(where);
+        if (!fresh) return tl::unexpected(fresh.error());
+        return compile_scenario(*fresh, plc);
+    };
+    auto runner = std::make_unique<server::ScenarioRunner>(
+        io, std::move(compiled), std::move(reload), config->reload_file.string());
+    runner->start();
+    return runner;
+}
+
+}  // namespace fins::cli::finsd

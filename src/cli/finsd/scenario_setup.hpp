@@ -1,0 +1,23 @@
+// A CPU Unit's scenario, compiled at start (config_scenario.hpp), set running on the
+// server's io_context (server/scenario/scenario_runner.hpp), with a reload that reads
+// its file again and compiles it against the same CPU Unit.
+#pragma once
+
+#include <memory>
+#include <optional>
+
+#include <boost/asio/io_context.hpp>
+
+#include "cli/finsd/config_scenario.hpp"
+#include "server/scenario/scenario_runner.hpp"
+#include "transport/asio.hpp"
+
+namespace fins::cli::finsd {
+
+// Null when `config` is empty. Starts the runner.
+std::unique_ptr<server::ScenarioRunner> run_scenario(asio::io_context& io,
+                                                     const std::optional<ScenarioConfig>& config,
+                                                     std::unique_ptr<scenario::Scenario> compiled,
+                                                     plc::Plc& plc);
+
+}  // namespace fins::cli::finsd

@@ -1,0 +1,102 @@
+// A running scenario: the tags of a ScenarioDef bound to one CPU Unit's memory, computed
+// tick by tick, and the events that fault them. No sockets, no clock of its own: the
+// glue (src/server/scenario) calls tick() from a steady timer, or advance() for virtual
+// time, and passes the host time only for what the CPU Unit stamps (error log, clock).
+//
+// One tick at scenario time t = ticks() * tick_s:
+//   1. events whose start time has come start (value faults attach to their tag, unit
+//      faults change the CPU Unit or transport()); events whose duration ran out end;
+//   2. every tag, in dependency order (a tag after the tags its expressions read; a
+//      cycle is a compile error), computes its value and writes it through
+//      IoMemory::write, the path of a FINS 01 02 write: a forced bit keeps its forced
+//      state, exactly as a ladder program cannot override it;
+//   3. when anything was written, the FINS write access log gets one record from node
+//      0.0.0 (the CPU Unit itself), so a client sees that the scenario wrote.
+// Stateful kinds (random_walk, counter, totaliser, lag) keep their state in a double but
+// adopt the memory's value when a client (or a force) changed the tag since the last
+// write: an HMI writing 0 to a counter resets it.
+//
+// Determinism: time moves in whole ticks; every random draw comes from one Random seeded
+// with `seed`, in tag order then event order. The same definition, seed and client writes
+// at the same ticks give the same memory, byte for byte.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <tl/expected.hpp>
+
+#include "plc/io_memory.hpp"
+#include "scenario/definition.hpp"
+
+namespace fins::plc {
+class Plc;
+}
+
+namespace fins::scenario {
+
+struct CompileError {
+    SourcePos pos;
+    std::string message;
+};
+
+// Unit faults the transport applies (node offline, latency, drop fraction) and the
+// dispatcher-level end-code fault. Read by the sessions on the io thread that ticks.
+struct TransportFaults {
+    bool offline = false;
+    std::uint32_t latency_ms = 0;
+    double drop_fraction = 0.0;
+    // end_code != 0: memory area commands on this area answer it.
+    std::uint8_t area_code = 0;  // the word code of the area (0x82 = DM, ...)
+    std::uint16_t end_code = 0;
+};
+
+struct EventStatus {
+    std::string name;
+    std::string fault;
+    bool active = false;
+    double next_start_s = -1;  // -1: never again
+};
+
+struct Status {
+    double time_s = 0;
+    std::uint64_t ticks = 0;
+    std::uint64_t writes = 0;          // tag writes since start
+    std::uint64_t skipped_writes = 0;  // NaN/infinite results, when = false
+    std::size_t tags = 0;
+    std::vector<EventStatus> events;
+};
+
+class Scenario {
+  public:
+    static tl::expected<std::unique_ptr<Scenario>, CompileError> compile(ScenarioDef definition,
+                                                                         plc::Plc& plc);
+    ~Scenario();
+    Scenario(const Scenario&) = delete;
+    Scenario& operator=(const Scenario&) = delete;
+
+    [[nodiscard]] const ScenarioDef& definition() const noexcept;
+    // One tick of tick_s. `now` stamps what the CPU Unit records (error log, clock jump).
+    void tick(plc::TimePoint now) noexcept;
+    // Runs the whole ticks that fit in `seconds` (plus what earlier calls left over);
+    // returns how many ran.
+    std::uint64_t advance(double seconds, plc::TimePoint now) noexcept;
+    // Starts the event named `name` now (its duration from now). False: no such event.
+    bool trigger(std::string_view name, plc::TimePoint now) noexcept;
+
+    [[nodiscard]] double time() const noexcept;
+    [[nodiscard]] std::uint64_t ticks() const noexcept;
+    [[nodiscard]] const TransportFaults& transport() const noexcept;
+    [[nodiscard]] Status status() const;
+
+    struct Impl;
+
+  private:
+    explicit Scenario(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace fins::scenario

@@ -1,0 +1,172 @@
+// A CPU Unit's running scenario on the io_context (contract in scenario_runner.hpp).
+#include "server/scenario/scenario_runner.hpp"
+
+#include <cmath>
+
+#include <spdlog/spdlog.h>
+
+namespace fins::server {
+
+namespace {
+
+std::chrono::system_clock::time_point host_now() {
+    return std::chrono::system_clock::now();
+}
+
+}  // namespace
+
+ScenarioRunner::ScenarioRunner(asio::io_context& io, std::unique_ptr<scenario::Scenario> scenario,
+                               Reloader reload, std::string source)
+    : io_(io),
+      scenario_(std::move(scenario)),
+      reload_(std::move(reload)),
+      source_(std::move(source)),
+      timer_(io),
+      drops_(scenario_->definition().seed ^ 0xD809D809D809D809ULL),
+      delay_timer_(io) {}
+
+ScenarioRunner::~ScenarioRunner() {
+    *alive_ = false;
+}
+
+void ScenarioRunner::start() {
+    const auto& def = scenario_->definition();
+    period_ = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+        std::chrono::duration<double>(def.tick_s / def.time_scale));
+    if (period_ <= std::chrono::steady_clock::duration::zero())
+        period_ = std::chrono::microseconds(1);
+    running_ = true;
+    if (def.virtual_time || paused_) return;
+    scenario_->tick(host_now());
+    next_ = std::chrono::steady_clock::now() + period_;
+    schedule();
+}
+
+void ScenarioRunner::stop() {
+    running_ = false;
+    timer_.cancel();
+    delay_timer_.cancel();
+    delayed_.clear();
+}
+
+void ScenarioRunner::schedule() {
+    timer_.expires_at(next_);
+    timer_.async_wait([this, alive = alive_](boost::system::error_code ec) {
+        if (!*alive) return;
+        on_tick(ec);
+    });
+}
+
+void ScenarioRunner::on_tick(boost::system::error_code ec) {
+    if (ec || !running_ || paused_ || scenario_->definition().virtual_time) return;
+    const auto now = std::chrono::steady_clock::now();
+    unsigned ran = 0;
+    while (next_ <= now && ran < max_catch_up) {
+        scenario_->tick(host_now());
+        next_ += period_;
+        ++ran;
+    }
+    // Too far behind: drop the backlog rather than stall every request behind it.
+    if (next_ <= now) next_ = now + period_;
+    schedule();
+}
+
+ScenarioRunStatus ScenarioRunner::run_status() const {
+    const auto& def = scenario_->definition();
+    ScenarioRunStatus s;
+    s.status = scenario_->status();
+    s.paused = paused_;
+    s.virtual_time = def.virtual_time;
+    s.time_scale = def.time_scale;
+    s.tick_s = def.tick_s;
+    s.seed = def.seed;
+    s.reloads = reloads_;
+    s.source = source_;
+    return s;
+}
+
+void ScenarioRunner::pause() {
+    paused_ = true;
+    timer_.cancel();
+}
+
+void ScenarioRunner::resume() {
+    if (!paused_) return;
+    paused_ = false;
+    if (!running_ || scenario_->definition().virtual_time) return;
+    next_ = std::chrono::steady_clock::now() + period_;
+    schedule();
+}
+
+std::uint64_t ScenarioRunner::advance(double seconds) {
+    return scenario_->advance(seconds, host_now());
+}
+
+bool ScenarioRunner::trigger(std::string_view event) {
+    return scenario_->trigger(event, host_now());
+}
+
+tl::expected<void, std::string> ScenarioRunner::reload() {
+    if (!reload_) return tl::unexpected(std::string("this scenario has no file to reload"));
+    auto fresh = reload_();
+    if (!fresh) return tl::unexpected(fresh.error());
+    timer_.cancel();
+    scenario_ = std::move(*fresh);
+    ++reloads_;
+    spdlog::info("finsd: scenario reloaded from {}", source_);
+    if (running_) {
+        running_ = false;
+        start();
+    }
+    return {};
+}
+
+bool ScenarioRunner::offline() const noexcept {
+    return scenario_->transport().offline;
+}
+
+bool ScenarioRunner::silent() noexcept {
+    const auto& f = scenario_->transport();
+    if (f.offline) return true;
+    return f.drop_fraction > 0 && drops_.uniform() < f.drop_fraction;
+}
+
+std::uint16_t ScenarioRunner::area_end_code(std::uint8_t area_code) const noexcept {
+    const auto& f = scenario_->transport();
+    return f.end_code != 0 && f.area_code == area_code ? f.end_code : 0;
+}
+
+std::chrono::milliseconds ScenarioRunner::latency() const noexcept {
+    return std::chrono::milliseconds(scenario_->transport().latency_ms);
+}
+
+void ScenarioRunner::send_later(Bytes response, Completion completion) {
+    // Bounded: beyond max_delayed_answers the oldest goes out now, late but not lost.
+    if (delayed_.size() >= max_delayed_answers) {
+        auto oldest = std::move(delayed_.front());
+        delayed_.pop_front();
+        oldest.completion(Bytes(oldest.frame.data(), oldest.frame.size()));
+    }
+    delayed_.push_back({std::chrono::steady_clock::now() + latency(),
+                        std::vector<std::uint8_t>(response.begin(), response.end()),
+                        std::move(completion)});
+    if (!delay_armed_) flush_delayed();
+}
+
+void ScenarioRunner::flush_delayed() {
+    const auto now = std::chrono::steady_clock::now();
+    while (!delayed_.empty() && delayed_.front().due <= now) {
+        auto d = std::move(delayed_.front());
+        delayed_.pop_front();
+        d.completion(Bytes(d.frame.data(), d.frame.size()));
+    }
+    delay_armed_ = !delayed_.empty();
+    if (!delay_armed_) return;
+    delay_timer_.expires_at(delayed_.front().due);
+    delay_timer_.async_wait([this, alive = alive_](boost::system::error_code ec) {
+        if (!*alive || ec) return;
+        flush_delayed();
+    });
+}
+
+}  // namespace fins::server

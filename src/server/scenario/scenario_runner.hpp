@@ -1,0 +1,97 @@
+// A CPU Unit's running scenario on the server's io_context (issue 19): the steady timer
+// that ticks it, the control verbs (ScenarioControl) and the unit faults the network side
+// consults (FaultHook). One per CPU Unit; everything runs on the io_context's one thread.
+//
+// Real time: ticks every tick_s / time_scale wall-clock seconds, drift-free (each expiry
+// is the previous one plus the period, not "now" plus the period). A late timer (a busy
+// host) runs the missed ticks, at most max_catch_up at once; beyond that scenario time
+// falls behind rather than stalling the requests. Scenario time is always ticks * tick_s,
+// so a run is the same whatever the host's timing.
+// Virtual time: no timer; time moves only by advance() (`finsd ctl scenario advance`).
+// Reload compiles the new file first and swaps only on success; the unit faults the old
+// one had started are cleared with it.
+#pragma once
+
+#include <chrono>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/steady_timer.hpp>
+
+#include "scenario/random.hpp"
+#include "scenario/scenario.hpp"
+#include "server/scenario/fault_hook.hpp"
+#include "server/scenario/scenario_control.hpp"
+#include "transport/asio.hpp"
+
+namespace fins::server {
+
+class ScenarioRunner final : public ScenarioControl, public FaultHook {
+  public:
+    using Compiled = tl::expected<std::unique_ptr<scenario::Scenario>, std::string>;
+    // Reads and compiles the scenario again (for reload).
+    using Reloader = std::function<Compiled()>;
+
+    static constexpr unsigned max_catch_up = 10;
+    static constexpr std::size_t max_delayed_answers = 1024;
+
+    ScenarioRunner(asio::io_context& io, std::unique_ptr<scenario::Scenario> scenario,
+                   Reloader reload, std::string source);
+    ~ScenarioRunner() override;
+    ScenarioRunner(const ScenarioRunner&) = delete;
+    ScenarioRunner& operator=(const ScenarioRunner&) = delete;
+
+    // Real time: the first tick now, then the timer. Virtual: nothing until advance().
+    void start();
+    void stop();
+    [[nodiscard]] const scenario::Scenario& scenario() const noexcept { return *scenario_; }
+
+    // ScenarioControl
+    [[nodiscard]] ScenarioRunStatus run_status() const override;
+    void pause() override;
+    void resume() override;
+    std::uint64_t advance(double seconds) override;
+    bool trigger(std::string_view event) override;
+    tl::expected<void, std::string> reload() override;
+
+    // FaultHook
+    [[nodiscard]] bool offline() const noexcept override;
+    bool silent() noexcept override;
+    [[nodiscard]] std::uint16_t area_end_code(std::uint8_t area_code) const noexcept override;
+    [[nodiscard]] std::chrono::milliseconds latency() const noexcept override;
+    void send_later(Bytes response, Completion completion) override;
+
+  private:
+    void schedule();
+    void on_tick(boost::system::error_code ec);
+    void flush_delayed();
+
+    asio::io_context& io_;
+    std::unique_ptr<scenario::Scenario> scenario_;
+    Reloader reload_;
+    std::string source_;
+    asio::steady_timer timer_;
+    std::chrono::steady_clock::duration period_{};
+    std::chrono::steady_clock::time_point next_{};
+    bool running_ = false;
+    bool paused_ = false;
+    std::uint64_t reloads_ = 0;
+    // Draws for the drop fraction: its own generator, so that client traffic never
+    // changes the scenario's random numbers (and memory stays deterministic).
+    scenario::Random drops_;
+    struct Delayed {
+        std::chrono::steady_clock::time_point due;
+        std::vector<std::uint8_t> frame;
+        Completion completion;
+    };
+    std::deque<Delayed> delayed_;
+    asio::steady_timer delay_timer_;
+    bool delay_armed_ = false;
+    std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+};
+
+}  // namespace fins::server

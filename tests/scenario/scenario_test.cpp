@@ -1,0 +1,328 @@
+// The scenario model on a virtual CPU Unit, no sockets: signal kinds, links in dependency
+// order, events, forcing, the write access log, compile errors, determinism.
+#include "scenario/scenario.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "fins/values.hpp"
+#include "plc/plc.hpp"
+
+namespace fins::scenario {
+namespace {
+
+const plc::TimePoint now{std::chrono::seconds(1'700'000'000)};
+
+TagDef tag(std::string address, SignalKind kind, ValueType type = ValueType::int16) {
+    TagDef t;
+    t.address.text = std::move(address);
+    t.kind = kind;
+    t.type = type;
+    return t;
+}
+TagDef link(std::string address, std::string expr, ValueType type = ValueType::int16) {
+    TagDef t = tag(std::move(address), SignalKind::link, type);
+    t.input.text = std::move(expr);
+    return t;
+}
+
+std::unique_ptr<Scenario> compile(ScenarioDef def, plc::Plc& plc) {
+    auto s = Scenario::compile(std::move(def), plc);
+    EXPECT_TRUE(s.has_value()) << (s ? "" : s.error().message);
+    return s ? std::move(*s) : nullptr;
+}
+
+std::string compile_error(ScenarioDef def, const char* profile = "cj2h") {
+    plc::Plc plc(*plc::find_profile(profile));
+    auto s = Scenario::compile(std::move(def), plc);
+    EXPECT_FALSE(s.has_value());
+    return s ? "" : s.error().message;
+}
+
+std::uint16_t dm(plc::Plc& plc, std::uint32_t word) {
+    return plc.memory().words(Region::dm)[word];
+}
+
+TEST(Scenario, SineFollowsTheIssueFormulaAndLinksReadItInTheSameTick) {
+    plc::Plc plc;
+    ScenarioDef def;
+    // The link comes first in the file: dependency order still computes D100 first.
+    def.tags.push_back(link("D101", "2 * D100"));
+    TagDef sine = tag("D100", SignalKind::sine);
+    sine.min = 0;
+    sine.max = 1000;
+    sine.period_s = 10;
+    def.tags.push_back(sine);
+    auto s = compile(def, plc);
+    ASSERT_TRUE(s);
+    s->tick(now);  // t = 0
+    EXPECT_EQ(dm(plc, 100), 500);
+    EXPECT_EQ(dm(plc, 101), 1000);
+    EXPECT_EQ(s->advance(2.5, now), 25u);  // ticks at 0.1 ... 2.5
+    EXPECT_EQ(dm(plc, 100), 1000);
+    EXPECT_EQ(dm(plc, 101), 2000);
+    s->advance(5.0, now);  // t = 7.5
+    EXPECT_EQ(dm(plc, 100), 0);
+    EXPECT_DOUBLE_EQ(s->time(), 7.6);
+}
+
+TEST(Scenario, WaveformsAndSteps) {
+    plc::Plc plc;
+    ScenarioDef def;
+    def.tick_s = 0.5;
+    for (auto [addr, kind] : {std::pair{"D0", SignalKind::square},
+                              {"D1", SignalKind::triangle},
+                              {"D2", SignalKind::sawtooth},
+                              {"D3", SignalKind::ramp}}) {
+        TagDef t = tag(addr, kind);
+        t.min = 0;
+        t.max = 100;
+        t.period_s = 4;
+        def.tags.push_back(t);
+    }
+    TagDef steps = tag("D4", SignalKind::steps);
+    steps.steps = {{0, 5}, {1, 7}, {2, 9}};
+    steps.repeat_s = 3;
+    def.tags.push_back(steps);
+    TagDef k = tag("D5", SignalKind::constant, ValueType::float32);
+    k.value = 1.5;
+    def.tags.push_back(k);
+    auto s = compile(def, plc);
+    s->tick(now);  // t = 0
+    EXPECT_EQ(dm(plc, 0), 100);
+    EXPECT_EQ(dm(plc, 1), 0);
+    EXPECT_EQ(dm(plc, 4), 5);
+    EXPECT_EQ(words_to_float(std::span<const std::uint16_t>(&plc.memory().words(Region::dm)[5], 2))
+                  .value(),
+              1.5f);
+    s->advance(1.0, now);  // t = 1
+    EXPECT_EQ(dm(plc, 1), 50);
+    EXPECT_EQ(dm(plc, 2), 25);
+    EXPECT_EQ(dm(plc, 3), 25);
+    EXPECT_EQ(dm(plc, 4), 7);
+    s->advance(2.0, now);  // t = 3
+    EXPECT_EQ(dm(plc, 0), 0);
+    EXPECT_EQ(dm(plc, 1), 50);
+    EXPECT_EQ(dm(plc, 2), 75);
+    EXPECT_EQ(dm(plc, 4), 5);  // the schedule restarted at 3 s
+    s->advance(3.0, now);      // t = 6: the ramp holds its max
+    EXPECT_EQ(dm(plc, 3), 100);
+}
+
+TEST(Scenario, PumpOnMakesTheLevelRiseThroughWhenAndTotaliser) {
+    plc::Plc plc;
+    ScenarioDef def;
+    TagDef flow = link("D10", "if(CIO0.00, 50, 0)");
+    def.tags.push_back(flow);
+    TagDef level = tag("D11", SignalKind::totaliser, ValueType::float32);
+    level.input.text = "D10 - 20 * CIO0.01";  // the valve drains
+    def.tags.push_back(level);
+    auto s = compile(def, plc);
+    auto level_value = [&] {
+        return words_to_float(
+                   std::span<const std::uint16_t>(&plc.memory().words(Region::dm)[11], 2))
+            .value();
+    };
+    s->advance(1.0, now);
+    EXPECT_EQ(level_value(), 0.0f);
+    plc.memory().words(Region::cio)[0] = 0x0001;  // the HMI switches the pump on
+    s->advance(1.0, now);
+    EXPECT_NEAR(level_value(), 50.0f, 1e-3);
+    plc.memory().words(Region::cio)[0] = 0x0002;  // pump off, valve open
+    s->advance(1.0, now);
+    EXPECT_NEAR(level_value(), 30.0f, 1e-3);
+}
+
+TEST(Scenario, CounterCountsEdgesAndTakesAClientResetAsItsState) {
+    plc::Plc plc;
+    ScenarioDef def;
+    TagDef pulse = tag("W0.00", SignalKind::square, ValueType::boolean);
+    pulse.min = 0;
+    pulse.max = 1;
+    pulse.period_s = 1;
+    def.tags.push_back(pulse);
+    TagDef count = tag("D20", SignalKind::counter, ValueType::uint16);
+    count.input.text = "W0.00";
+    def.tags.push_back(count);
+    auto s = compile(def, plc);
+    s->advance(10.0, now);
+    EXPECT_EQ(dm(plc, 20), 10);
+    plc.memory().words(Region::dm)[20] = 0;  // the HMI resets the counter
+    s->advance(3.0, now);
+    EXPECT_EQ(dm(plc, 20), 3);
+}
+
+TEST(Scenario, LagFollowsTheSetpointAClientWrites) {
+    plc::Plc plc;
+    ScenarioDef def;
+    TagDef pv = tag("D30", SignalKind::lag);
+    pv.input.text = "D31";
+    pv.tau_s = 2;
+    def.tags.push_back(pv);
+    auto s = compile(def, plc);
+    plc.memory().words(Region::dm)[31] = 800;
+    s->advance(2.0, now);  // one time constant: 63 %
+    EXPECT_NEAR(dm(plc, 30), 800 * (1 - std::exp(-1.0)), 2);
+    s->advance(20.0, now);
+    EXPECT_EQ(dm(plc, 30), 800);
+}
+
+TEST(Scenario, HysteresisAndDelay) {
+    plc::Plc plc;
+    ScenarioDef def;
+    TagDef ramp = tag("D40", SignalKind::ramp);
+    ramp.min = 0;
+    ramp.max = 100;
+    ramp.period_s = 10;
+    def.tags.push_back(ramp);
+    TagDef alarm = tag("W1.00", SignalKind::hysteresis, ValueType::boolean);
+    alarm.input.text = "D40";
+    alarm.on_above = 50;
+    alarm.off_below = 20;
+    def.tags.push_back(alarm);
+    TagDef delayed = link("D41", "D40");
+    delayed.delay_s = 1;
+    def.tags.push_back(delayed);
+    auto s = compile(def, plc);
+    s->advance(0.5, now);
+    EXPECT_EQ(dm(plc, 41), 0);  // nothing written before the delay has passed
+    s->advance(5.6, now);       // t = 6.0
+    EXPECT_EQ(plc.memory().words(Region::work)[1] & 1, 1);
+    EXPECT_EQ(dm(plc, 41), 50);  // D40 of t = 5.0
+}
+
+TEST(Scenario, AForcedBitIsNotChangedAndWritesAreLoggedAsTheCpuUnits) {
+    plc::Plc plc;
+    ScenarioDef def;
+    TagDef on = tag("CIO5.03", SignalKind::constant, ValueType::boolean);
+    on.value = 1;
+    def.tags.push_back(on);
+    plc.memory().force_bit(Region::cio, 5, 3, false);
+    auto s = compile(def, plc);
+    s->advance(1.0, now);
+    EXPECT_EQ(plc.memory().words(Region::cio)[5] & 0x0008, 0);
+    ASSERT_EQ(plc.write_access_log().size(), 1u);
+    EXPECT_EQ(plc.write_access_log().at(0).source.node, 0);
+    plc.memory().release_bit(Region::cio, 5, 3);
+    s->advance(0.1, now);
+    EXPECT_EQ(plc.memory().words(Region::cio)[5] & 0x0008, 0x0008);
+}
+
+TEST(Scenario, ValueFaultsAndUnitFaults) {
+    plc::Plc plc;
+    ScenarioDef def;
+    TagDef ramp = tag("D50", SignalKind::ramp);
+    ramp.min = 0;
+    ramp.max = 100;
+    ramp.period_s = 10;
+    def.tags.push_back(ramp);
+    EventDef stuck;
+    stuck.at_s = 2;
+    stuck.duration_s = 3;
+    stuck.fault = FaultKind::stuck;
+    stuck.address.text = "D50";
+    def.events.push_back(stuck);
+    EventDef fal;
+    fal.name = "overheat";
+    fal.at_s = 100;
+    fal.duration_s = 1;
+    fal.fault = FaultKind::fal;
+    fal.number = 7;
+    def.events.push_back(fal);
+    EventDef off;
+    off.every_s = 4;
+    off.duration_s = 1;
+    off.fault = FaultKind::offline;
+    def.events.push_back(off);
+    auto s = compile(def, plc);
+    s->advance(4.0, now);  // t = 3.9
+    EXPECT_EQ(dm(plc, 50), 20);
+    EXPECT_FALSE(s->transport().offline);
+    s->advance(0.2, now);  // t = 4.1
+    EXPECT_TRUE(s->transport().offline);
+    s->advance(1.0, now);  // t = 5.1: stuck ended at 5, offline at 5
+    EXPECT_EQ(dm(plc, 50), 51);
+    EXPECT_FALSE(s->transport().offline);
+    ASSERT_TRUE(s->trigger("overheat", now));
+    EXPECT_TRUE(plc.errors().is_active(0x4107));
+    s->advance(1.1, now);
+    EXPECT_FALSE(plc.errors().is_active(0x4107));
+    EXPECT_FALSE(s->trigger("nope", now));
+}
+
+TEST(Scenario, SameSeedAndSameClientWritesGiveTheSameMemory) {
+    auto run = [](std::uint64_t seed) {
+        plc::Plc plc;
+        ScenarioDef def;
+        def.seed = seed;
+        TagDef walk = tag("D60", SignalKind::random_walk, ValueType::float64);
+        walk.min = -100;
+        walk.max = 100;
+        walk.step = 3;
+        def.tags.push_back(walk);
+        def.tags.push_back(link("D64", "D60 + noise(5) + uniform(0, 1) + D70"));
+        TagDef pv = tag("D65", SignalKind::lag, ValueType::float32);
+        pv.input.text = "D70";
+        pv.noise = 0.5;
+        def.tags.push_back(pv);
+        auto s = Scenario::compile(def, plc);
+        for (int i = 0; i < 50; ++i) {
+            if (i == 20) plc.memory().words(Region::dm)[70] = 300;  // a client write
+            (*s)->advance(0.1, now);
+        }
+        auto d = plc.memory().words(Region::dm);
+        return std::vector<std::uint16_t>(d.begin(), d.begin() + 100);
+    };
+    EXPECT_EQ(run(42), run(42));
+    EXPECT_NE(run(42), run(43));
+}
+
+TEST(Scenario, CompileErrorsNameTheProblem) {
+    ScenarioDef cycle;
+    cycle.tags = {link("D1", "D2 + 1"), link("D2", "D3"), link("D3", "D1")};
+    EXPECT_EQ(compile_error(cycle), "the links form a cycle: D1 -> D2 -> D3 -> D1");
+
+    ScenarioDef read_only;
+    read_only.tags = {tag("A10", SignalKind::constant)};
+    EXPECT_EQ(compile_error(read_only), "A10 is in a read-only area");
+
+    ScenarioDef no_bank;
+    no_bank.tags = {tag("E3_0", SignalKind::constant)};
+    EXPECT_NE(compile_error(no_bank, "cj1m").find("has no E3_0"), std::string::npos);
+
+    ScenarioDef bit_as_word;
+    bit_as_word.tags = {tag("CIO0.01", SignalKind::constant)};
+    EXPECT_NE(compile_error(bit_as_word).find("must be \"bool\""), std::string::npos);
+
+    ScenarioDef word_as_bit;
+    word_as_bit.tags = {tag("D0", SignalKind::constant, ValueType::boolean)};
+    EXPECT_NE(compile_error(word_as_bit).find("needs a bit address"), std::string::npos);
+
+    ScenarioDef overlap;
+    overlap.tags = {tag("D0", SignalKind::constant, ValueType::int32),
+                    tag("D1", SignalKind::constant)};
+    EXPECT_NE(compile_error(overlap).find("D1 overlaps D0 (int32)"), std::string::npos);
+
+    ScenarioDef unknown_tag;
+    unknown_tag.tags = {tag("D0", SignalKind::constant)};
+    EventDef e;
+    e.at_s = 1;
+    e.fault = FaultKind::stuck;
+    e.address.text = "D9";
+    unknown_tag.events = {e};
+    EXPECT_NE(compile_error(unknown_tag).find("D9 is not a tag"), std::string::npos);
+
+    ScenarioDef bad_expr;
+    TagDef l = link("D0", "1 + ");
+    l.input.pos = {12, 8};
+    bad_expr.tags = {l};
+    plc::Plc plc;
+    auto s = Scenario::compile(bad_expr, plc);
+    ASSERT_FALSE(s);
+    EXPECT_EQ(s.error().pos.line, 12u);
+    EXPECT_EQ(s.error().pos.column, 8u + 5u);  // the quote, then column 5 of "1 + "
+}
+
+}  // namespace
+}  // namespace fins::scenario
