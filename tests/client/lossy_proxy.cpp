@@ -40,18 +40,16 @@ LossyUdpProxy::Counts LossyUdpProxy::counts() {
 }
 
 void LossyUdpProxy::receive_front() {
-    front_.async_receive_from(asio::buffer(front_buffer_), from_,
-                              [this](boost::system::error_code ec, std::size_t n) {
-                                  if (ec == asio::error::operation_aborted) return;
-                                  if (!ec) {
-                                      client_ = from_;
-                                      have_client_ = true;
-                                      pass({front_buffer_.begin(), front_buffer_.begin() +
-                                                                       static_cast<long>(n)},
-                                           true);
-                                  }
-                                  receive_front();
-                              });
+    front_.async_receive_from(
+        asio::buffer(front_buffer_), from_, [this](boost::system::error_code ec, std::size_t n) {
+            if (ec == asio::error::operation_aborted) return;
+            if (!ec) {
+                client_ = from_;
+                have_client_ = true;
+                pass({front_buffer_.begin(), front_buffer_.begin() + static_cast<long>(n)}, true);
+            }
+            receive_front();
+        });
 }
 
 void LossyUdpProxy::receive_back() {
