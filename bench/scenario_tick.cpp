@@ -16,6 +16,7 @@
 
 #include "plc/plc.hpp"
 #include "scenario/scenario.hpp"
+#include "scenario_workload.hpp"
 
 namespace {
 
@@ -23,46 +24,6 @@ double cpu_seconds() {
     timespec ts{};
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
     return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
-}
-
-fins::scenario::ScenarioDef make_definition(unsigned tags, unsigned tick_ms, std::uint64_t seed) {
-    using namespace fins::scenario;
-    ScenarioDef def;
-    def.seed = seed;
-    def.tick_s = tick_ms / 1000.0;
-    def.virtual_time = true;
-    for (unsigned i = 0; i < tags; ++i) {
-        TagDef t;
-        t.address.text = "D" + std::to_string(1000 + i);
-        t.type = ValueType::int16;
-        switch (i % 4) {
-            case 0:
-                t.kind = SignalKind::sine;
-                t.min = 0;
-                t.max = 1000;
-                t.period_s = 10 + i;
-                break;
-            case 1:
-                t.kind = SignalKind::random_walk;
-                t.min = -500;
-                t.max = 500;
-                t.step = 3;
-                break;
-            case 2:
-                t.kind = SignalKind::lag;
-                t.input.text = "D" + std::to_string(1000 + i - 2);
-                t.tau_s = 5;
-                t.noise = 1;
-                break;
-            default:
-                t.kind = SignalKind::link;
-                t.input.text = "D" + std::to_string(1000 + i - 3) + " + D" +
-                               std::to_string(1000 + i - 2) + " / 2 + noise(2)";
-                break;
-        }
-        def.tags.push_back(std::move(t));
-    }
-    return def;
 }
 
 }  // namespace
@@ -80,7 +41,8 @@ int main(int argc, char** argv) {
     std::vector<std::unique_ptr<fins::scenario::Scenario>> scenarios;
     for (unsigned u = 0; u < units; ++u) {
         plcs.push_back(std::make_unique<fins::plc::Plc>());
-        auto s = fins::scenario::Scenario::compile(make_definition(tags, tick_ms, u), *plcs.back());
+        auto s = fins::scenario::Scenario::compile(fins_bench::scenario_workload(tags, tick_ms, u),
+                                                   *plcs.back());
         if (!s) {
             std::fprintf(stderr, "compile: %s\n", s.error().message.c_str());
             return 1;

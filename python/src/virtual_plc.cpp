@@ -1,6 +1,8 @@
 // finskit.VirtualPlc: finsd's Server and virtual CPU Unit in-process, on their own
 // thread. The PLC is touched only on that thread (as in finsd): direct memory access
 // and injected conditions are posted to it and waited for with the GIL released.
+// A scenario (docs/scenarios.md) runs on that thread too, as in finsd; with
+// time = "virtual" it moves only by advance().
 #include <chrono>
 #include <filesystem>
 #include <future>
@@ -18,12 +20,17 @@
 #include <boost/asio/post.hpp>
 
 #include "cli/finsd/config.hpp"
+#include "cli/finsd/config_scenario.hpp"
+#include "cli/finsd/scenario_setup.hpp"
 #include "errors.hpp"
 #include "fins/address.hpp"
 #include "plc/injections.hpp"
 #include "plc/plc.hpp"
 #include "plc/profile.hpp"
 #include "plc/storage.hpp"
+#include "scenario/scenario.hpp"
+#include "server/scenario/scenario_control.hpp"
+#include "server/scenario/scenario_runner.hpp"
 #include "server/sessions/server.hpp"
 #include "transport/asio.hpp"
 
@@ -42,11 +49,32 @@ fins::plc::Profile find(const std::string& name) {
     throw BadArgument("unknown profile '" + name + "' (known: " + known + ")");
 }
 
+// Where a scenario comes from: a file, or TOML text holding a [scenario] table.
+struct ScenarioSource {
+    std::string value;
+    bool is_text = false;
+};
+
+// VirtualPlc(scenario=...): a str with a line break is TOML text, any other str or an
+// os.PathLike names a file. Runs with the GIL held (before the constructor releases it).
+std::optional<ScenarioSource> scenario_source(const py::object& scenario) {
+    if (scenario.is_none()) return std::nullopt;
+    if (py::isinstance<py::str>(scenario)) {
+        auto text = scenario.cast<std::string>();
+        const bool is_text = text.find('\n') != std::string::npos;
+        return ScenarioSource{std::move(text), is_text};
+    }
+    if (py::hasattr(scenario, "__fspath__"))
+        return ScenarioSource{
+            py::module_::import("os").attr("fspath")(scenario).cast<std::string>(), false};
+    throw BadArgument("scenario must be a file path or TOML text holding a [scenario] table");
+}
+
 class VirtualPlc {
   public:
     VirtualPlc(const std::string& profile, std::string host, std::uint16_t port,
                const std::string& mode, std::optional<std::string> data_dir, std::uint8_t node,
-               const std::string& log_level)
+               const std::string& log_level, const std::optional<ScenarioSource>& scenario)
         : host_(std::move(host)) {
         // finsd's log (spdlog, process-wide); "warn" keeps test output quiet.
         const auto level = spdlog::level::from_str(log_level);
@@ -72,6 +100,7 @@ class VirtualPlc {
         server_ =
             value_or_throw(fins::server::Server::start(io_, *plc_, options), "listen on " + host_);
         port_ = server_->udp_port() != 0 ? server_->udp_port() : server_->tcp_port();
+        if (scenario) start_scenario(*scenario);
         thread_ = std::thread([this] { io_.run(); });
     }
     ~VirtualPlc() { stop(); }
@@ -81,12 +110,14 @@ class VirtualPlc {
     void stop() {
         if (!thread_.joinable()) return;
         asio::post(io_, [this] {
+            if (scenario_) scenario_->stop();
             server_->stop();
             work_.reset();
             io_.stop();
         });
         thread_.join();
         // Releases the state file (and its lock) so another VirtualPlc may open it.
+        scenario_.reset();
         server_.reset();
         plc_->storage().flush();
         plc_.reset();
@@ -156,7 +187,57 @@ class VirtualPlc {
         });
     }
 
+    // The scenario's control verbs (`finsd ctl scenario ...`).
+    std::uint64_t advance(double seconds) {
+        if (!(seconds > 0 && seconds <= fins::server::max_advance_seconds))
+            throw BadArgument("seconds must be above 0 and at most a week (604800)");
+        return on_scenario([&](fins::server::ScenarioRunner& s) { return s.advance(seconds); });
+    }
+    void trigger(const std::string& event) {
+        on_scenario([&](fins::server::ScenarioRunner& s) {
+            if (!s.trigger(event)) throw BadArgument("the scenario has no event named " + event);
+            return 0;
+        });
+    }
+    void pause() {
+        on_scenario([](fins::server::ScenarioRunner& s) {
+            s.pause();
+            return 0;
+        });
+    }
+    void resume() {
+        on_scenario([](fins::server::ScenarioRunner& s) {
+            s.resume();
+            return 0;
+        });
+    }
+    [[nodiscard]] bool has_scenario() const { return scenario_ != nullptr; }
+    // Copied on the PLC's thread; turned into a dict with the GIL held.
+    fins::server::ScenarioRunStatus scenario_status() {
+        return on_scenario([](fins::server::ScenarioRunner& s) { return s.run_status(); });
+    }
+
   private:
+    void start_scenario(const ScenarioSource& source) {
+        auto loaded = source.is_text
+                          ? fins::cli::finsd::load_scenario_text(source.value, "<scenario>")
+                          : fins::cli::finsd::load_scenario_file(source.value);
+        if (!loaded) throw BadArgument(loaded.error());
+        auto compiled = fins::cli::finsd::compile_scenario(*loaded, *plc_);
+        if (!compiled) throw BadArgument(compiled.error());
+        // Started before the I/O thread runs: its first real-time tick is on that thread.
+        scenario_ = fins::cli::finsd::run_scenario(io_, std::optional(std::move(*loaded)),
+                                                   std::move(*compiled), *plc_);
+        server_->dispatcher().attach_faults(scenario_.get());
+    }
+
+    template <class F>
+    auto on_scenario(F f) -> decltype(f(std::declval<fins::server::ScenarioRunner&>())) {
+        if (!scenario_)
+            throw BadArgument("this VirtualPlc runs no scenario (VirtualPlc(scenario=...))");
+        return on_plc([&] { return f(*scenario_); });
+    }
+
     fins::plc::ElementRange locate(const std::string& text, std::uint32_t count, fins::AreaUse use,
                                    fins::plc::Intent intent) {
         const auto a = value_or_throw(fins::parse_address(text), "address '" + text + "'");
@@ -184,6 +265,7 @@ class VirtualPlc {
     asio::executor_work_guard<asio::io_context::executor_type> work_{io_.get_executor()};
     std::unique_ptr<fins::plc::Plc> plc_;
     std::unique_ptr<fins::server::Server> server_;
+    std::unique_ptr<fins::server::ScenarioRunner> scenario_;
     std::thread thread_;
 };
 
@@ -193,11 +275,18 @@ void register_virtual_plc(py::module_& m) {
     py::class_<VirtualPlc>(m, "VirtualPlc",
                            "finsd's virtual CPU Unit and FINS/UDP+TCP server, in this process "
                            "on its own thread. Port 0 picks a free port (see .port).")
-        .def(py::init<const std::string&, std::string, std::uint16_t, const std::string&,
-                      std::optional<std::string>, std::uint8_t, const std::string&>(),
+        .def(py::init([](const std::string& profile, std::string host, std::uint16_t port,
+                         const std::string& mode, std::optional<std::string> data_dir,
+                         std::uint8_t node, const std::string& log_level,
+                         const py::object& scenario) {
+                 const auto source = scenario_source(scenario);
+                 py::gil_scoped_release unlocked;
+                 return std::make_unique<VirtualPlc>(profile, std::move(host), port, mode,
+                                                     std::move(data_dir), node, log_level, source);
+             }),
              py::arg("profile") = "cj2h", py::arg("host") = "127.0.0.1", py::arg("port") = 0,
              py::arg("mode") = "run", py::arg("data_dir") = py::none(), py::arg("node") = 0,
-             py::arg("log_level") = "warn", release())
+             py::arg("log_level") = "warn", py::arg("scenario") = py::none())
         .def("__enter__", [](VirtualPlc& self) -> VirtualPlc& { return self; })
         .def(
             "__exit__", [](VirtualPlc& self, const py::args&) { self.stop(); }, release())
@@ -218,7 +307,42 @@ void register_virtual_plc(py::module_& m) {
              py::arg("fals") = py::none(),
              py::arg("messages") = std::vector<std::pair<std::size_t, std::string>>{},
              py::arg("errors") = std::vector<std::uint16_t>{}, release(),
-             "Raises errors and registers messages as finsd's [inject] section does.");
+             "Raises errors and registers messages as finsd's [inject] section does.")
+        .def_property_readonly("has_scenario", &VirtualPlc::has_scenario)
+        .def("advance", &VirtualPlc::advance, py::arg("seconds"), release(),
+             "Runs that many seconds of scenario time now; returns the ticks run.")
+        .def("trigger", &VirtualPlc::trigger, py::arg("event"), release(),
+             "Starts the scenario's event of that name now.")
+        .def("pause", &VirtualPlc::pause, release(), "Stops the scenario's real time.")
+        .def("resume", &VirtualPlc::resume, release(), "Lets the scenario's real time go on.")
+        .def(
+            "scenario_status",
+            [](VirtualPlc& self) {
+                fins::server::ScenarioRunStatus st;
+                {
+                    py::gil_scoped_release unlocked;
+                    st = self.scenario_status();
+                }
+                py::list events;
+                for (const auto& e : st.status.events) {
+                    py::dict d;
+                    d["name"] = e.name;
+                    d["fault"] = e.fault;
+                    d["active"] = e.active;
+                    events.append(d);
+                }
+                py::dict d;
+                d["time_s"] = st.status.time_s;
+                d["ticks"] = st.status.ticks;
+                d["writes"] = st.status.writes;
+                d["tags"] = st.status.tags;
+                d["paused"] = st.paused;
+                d["virtual_time"] = st.virtual_time;
+                d["seed"] = st.seed;
+                d["events"] = events;
+                return d;
+            },
+            "The scenario's time, ticks, writes and events (as finsd ctl scenario status).");
 }
 
 }  // namespace finskit

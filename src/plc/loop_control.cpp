@@ -65,4 +65,43 @@ std::optional<FunctionBlockItemValue> LoopControl::read(const FunctionBlock& blo
     return std::nullopt;
 }
 
+void LoopControl::set_sources(const void* owner, std::vector<ItemSource> sources) {
+    sources_owner_ = owner;
+    sources_ = std::move(sources);
+}
+
+void LoopControl::clear_sources(const void* owner) noexcept {
+    if (owner != sources_owner_) return;
+    sources_owner_ = nullptr;
+    sources_.clear();
+}
+
+std::optional<FunctionBlockItemValue> LoopControl::read_item(const FunctionBlock& block,
+                                                             std::uint16_t item) const noexcept {
+    auto value = read(block, item);
+    if (!value) return value;
+    for (const auto& source : sources_) {
+        if (source.block != block.address || source.item != item) continue;
+        const std::uint16_t w0 = source.words[0];
+        switch (value->length) {
+            case 1:
+                value->bytes[0] = static_cast<std::uint8_t>(w0);
+                break;
+            case 2:
+                value->bytes[0] = static_cast<std::uint8_t>(w0 >> 8);
+                value->bytes[1] = static_cast<std::uint8_t>(w0);
+                break;
+            default: {
+                // CS/CJ 32-bit values: the low word first (fins/values.hpp).
+                const std::uint32_t v = (std::uint32_t{source.words[1]} << 16) | w0;
+                for (std::uint8_t i = 0; i < 4; ++i)
+                    value->bytes[i] = static_cast<std::uint8_t>(v >> (8 * (3 - i)));
+                break;
+            }
+        }
+        break;
+    }
+    return value;
+}
+
 }  // namespace fins::plc

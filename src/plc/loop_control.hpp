@@ -22,7 +22,10 @@
 //              (ITEM011 onwards) in the Step Ladder Program block (Block Model 301)")
 //
 // Values are read-only: finsd answers only 02 40 ITEM read (02 41 ITEM write is undefined,
-// 0401), so nothing is stored.
+// 0401), so nothing is stored. A scenario may give ITEMs live values (set_sources, issue
+// 19: the temperature loop's PV): such an ITEM answers the words of a memory address
+// the scenario writes, its length unchanged (1 byte: the low byte of the word; 2: the
+// word; 4: the two words as a CS/CJ 32-bit value, low word first).
 #pragma once
 
 #include <array>
@@ -30,6 +33,7 @@
 #include <optional>
 #include <span>
 #include <string_view>
+#include <vector>
 
 #include "plc/profile.hpp"
 #include "plc/storage.hpp"
@@ -70,8 +74,25 @@ class LoopControl {
     [[nodiscard]] static std::optional<FunctionBlockItemValue> read(const FunctionBlock& block,
                                                                     std::uint16_t item) noexcept;
 
+    // An ITEM whose value is memory: `words` points at the word(s) of the CPU Unit's
+    // memory it reads (one word, or two for a 4-byte ITEM).
+    struct ItemSource {
+        std::uint16_t block = 0;
+        std::uint16_t item = 0;
+        const std::uint16_t* words = nullptr;
+    };
+    // Replaces every source with `sources`, held for `owner` (a running scenario);
+    // clear_sources(owner) drops them unless another owner has set its own since.
+    void set_sources(const void* owner, std::vector<ItemSource> sources);
+    void clear_sources(const void* owner) noexcept;
+    // What 02 40 answers: the ITEM's source when it has one, else read().
+    [[nodiscard]] std::optional<FunctionBlockItemValue> read_item(
+        const FunctionBlock& block, std::uint16_t item) const noexcept;
+
   private:
     bool present_ = false;
+    const void* sources_owner_ = nullptr;
+    std::vector<ItemSource> sources_;
 };
 
 }  // namespace fins::plc

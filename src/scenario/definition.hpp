@@ -129,6 +129,16 @@ struct EventDef {
     std::uint16_t end_code = 0;
 };
 
+// An ITEM of a Loop Control Board function block that 02 40 answers from memory: the
+// word(s) at `address`, usually a tag of the scenario (the loop's PV, SP or MV). Only on
+// a profile with the board (cs1h-lcb).
+struct LoopItemDef {
+    SourcePos pos;
+    std::int64_t block = -1;
+    std::int64_t item = -1;
+    Text address;
+};
+
 inline constexpr std::size_t max_tags = 100000;
 inline constexpr std::size_t max_events = 10000;
 inline constexpr double max_delay_s = 3600;
@@ -142,6 +152,7 @@ struct ScenarioDef {
     std::vector<TagDef> tags;   // in file order: signals first, then links
     std::vector<InputDef> inputs;
     std::vector<EventDef> events;
+    std::vector<LoopItemDef> loop_items;
 };
 
 }  // namespace fins::scenario

@@ -34,6 +34,8 @@ namespace fins::scenario {
 
 inline constexpr std::size_t max_expression_length = 4096;
 inline constexpr std::size_t max_expression_depth = 64;  // nested parentheses and calls
+// Deepest evaluation stack a program may need.
+inline constexpr std::size_t max_expression_stack = 256;
 
 // A position inside the expression text, 1-based.
 struct ExpressionError {
@@ -65,6 +67,9 @@ class Expression {
 
     // NaN or infinity when the arithmetic gives one (1/0, ln(-1), ...).
     double evaluate(ExpressionContext& context) const noexcept;
+    // The same for any context with ExpressionContext's members (expression_eval.hpp).
+    template <class Context>
+    double run(Context& context) const noexcept;
 
     // The reference numbers the expression reads, each once.
     [[nodiscard]] const std::vector<std::uint32_t>& references() const noexcept {

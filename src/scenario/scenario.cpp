@@ -156,6 +156,20 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
                                          value_type_name(def.tags[j].type), def.tags[j].pos.line));
         s.tags[i].def = &t;
         s.tags[i].reference = *r;
+        s.tags[i].p = TagParams{t.kind,
+                                t.repeat,
+                                t.value,
+                                t.min,
+                                t.max,
+                                t.period_s,
+                                t.phase_s,
+                                t.duty,
+                                t.step,
+                                t.rate,
+                                1 - std::exp(-def.tick_s / t.tau_s),
+                                t.noise,
+                                t.on_above,
+                                t.off_below};
         if (t.kind == SignalKind::steps) {
             if (t.steps.empty())
                 return error(t.pos, "kind = \"steps\" needs steps = [[t, value], ...]");
@@ -207,6 +221,7 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
         if (!when) return tl::unexpected(when.error());
         s.tags[i].input = std::move(*input);
         s.tags[i].when = std::move(*when);
+        s.tags[i].has_when = s.tags[i].when.has_value();
     }
 
     // Dependency order: depth-first in file order, a tag after the tags it reads.
@@ -244,6 +259,8 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
     for (std::uint32_t i = 0; i < s.tags.size(); ++i)
         visit(visit, i);
     if (cycle) return tl::unexpected(*cycle);
+    for (auto& reference : s.references)
+        s.bind_direct(reference);
 
     s.events.resize(def.events.size());
     for (std::size_t i = 0; i < def.events.size(); ++i) {
@@ -309,7 +326,46 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
                 break;
         }
     }
+    // Loop Control Board ITEMs answered from memory, set last (only a scenario that
+    // compiled replaces the running one's).
+    std::vector<plc::LoopControl::ItemSource> sources;
+    for (const auto& l : def.loop_items) {
+        if (!plc.loop_control().present())
+            return error(l.pos, fmt::format("the {} has no Loop Control Board (02 40): use a "
+                                            "profile with one (cs1h-lcb)",
+                                            plc.profile().model));
+        const auto* block = l.block >= 0 && l.block <= 0xFFFF
+                                ? plc::LoopControl::find_block(static_cast<std::uint16_t>(l.block))
+                                : nullptr;
+        if (block == nullptr)
+            return error(l.pos,
+                         fmt::format("block {} is not a function block of the board", l.block));
+        const auto value = l.item >= 0 && l.item <= 0xFFFF
+                               ? plc::LoopControl::read(*block, static_cast<std::uint16_t>(l.item))
+                               : std::nullopt;
+        if (!value)
+            return error(l.pos, fmt::format("block {} ({}) has no readable ITEM {}", l.block,
+                                            block->name, l.item));
+        auto address = parse_address(l.address.text);
+        if (!address)
+            return error(l.address.pos, fmt::format("\"{}\" is not an address: {}", l.address.text,
+                                                    address.error().message()));
+        const auto type = value->length == 4 ? ValueType::uint32 : ValueType::uint16;
+        auto r = c.locate(*address, type, l.address.text, plc::Intent::read, -1);
+        if (!r) return error(l.address.pos, r.error());
+        s.bind_direct(s.references[*r]);
+        if (s.references[*r].words == nullptr)
+            return error(l.address.pos, fmt::format("{} is not in a word area (CIO, W, H, A, D, E)",
+                                                    l.address.text));
+        sources.push_back(
+            {block->address, static_cast<std::uint16_t>(l.item), s.references[*r].words});
+    }
+    if (!sources.empty()) plc.loop_control().set_sources(&s, std::move(sources));
     return std::unique_ptr<Scenario>(new Scenario(std::move(impl)));
+}
+
+Scenario::Impl::~Impl() {
+    if (plc != nullptr && !def.loop_items.empty()) plc->loop_control().clear_sources(this);
 }
 
 const ScenarioDef& Scenario::definition() const noexcept {

@@ -43,6 +43,19 @@ TEST(ScenarioConfig, BadScenariosExit2WithTheirPosition) {
          "bad.toml:7:11: ", "D7 is not a tag of this scenario"},
         {"[[scenario.event]]\nat_s = 1\nfault = \"meltdown\"\n",
          "bad.toml:3:9: ", "scenario.event[0].fault: 'meltdown' is not stuck"},
+        // [[scenario.loop]]: a Loop Control Board ITEM answered from memory.
+        {"[[scenario.loop]]\nblock = 1\nitem = 6\naddress = \"D0\"\n",
+         "bad.toml:1:1: ", "the CJ2H-CPU68-EIP has no Loop Control Board (02 40)"},
+        {"profile = \"cs1h-lcb\"\n[[scenario.loop]]\nblock = 7\nitem = 6\naddress = \"D0\"\n",
+         "bad.toml:2:1: ", "block 7 is not a function block of the board"},
+        {"profile = \"cs1h-lcb\"\n[[scenario.loop]]\nblock = 100\nitem = 12\naddress = "
+         "\"D0\"\n",
+         "bad.toml:2:1: ", "block 100 (Step Ladder Program) has no readable ITEM 12"},
+        {"profile = \"cs1h-lcb\"\n[[scenario.loop]]\nblock = 1\nitem = 6\naddress = "
+         "\"CIO0.00\"\n",
+         "bad.toml:5:11: ", "CIO0.00 is a bit"},
+        {"[[scenario.loop]]\nblock = 1\naddress = \"D0\"\n",
+         "bad.toml:1:1: ", "scenario.loop[0]: item: missing"},
     };
     for (const auto& c : cases) {
         Finsd d({"--config", dir.write("bad.toml", c.text)});

@@ -129,6 +129,42 @@ TEST(ScenarioRun, TemperaturePvFollowsTheSetpointWrittenOverFins) {
     EXPECT_EQ(c->read_bits(addr("W20.00"), 1).value_or(std::vector<bool>{true})[0], false);
 }
 
+// On the Loop Control Board profile, 02 40 on Basic PID block 001 answers the PV, SP and
+// MV the scenario produces (examples/scenarios/temperature-lcb.toml), read over FINS with
+// `fins loop-read` from the board (unit E1).
+TEST(ScenarioRun, LoopControlBoardAnswersThePvTheScenarioProduces) {
+    ScratchDir dir("scenario-temperature-lcb");
+    const std::string socket = (dir.path() / "ctl.sock").string();
+    Finsd d({"--config", examples + "temperature-lcb.toml", "--control", socket});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    auto items = [&] {
+        const auto r =
+            run({std::string(FINS_BIN_DIR) + "/fins", "--port", std::to_string(d.port()),
+                 "--timeout", "3", "--json", "--dest", "0.1.E1", "loop-read", "1", "6", "7", "8"});
+        EXPECT_EQ(r.exit_code, 0) << r.err;
+        std::vector<double> values;
+        const Json j = Json::parse(r.out, nullptr, false);
+        if (j.is_discarded()) return values;
+        for (const auto& item : j["items"])
+            values.push_back(item["value"].get<double>());
+        return values;
+    };
+    run_for(socket, 1);
+    auto pv_sp_mv = items();
+    ASSERT_EQ(pv_sp_mv.size(), 3u);
+    EXPECT_NEAR(pv_sp_mv[0], 1000, 75);  // PV 20.0 degC: 10.00 % of 0-200 degC
+    auto c = d.client();
+    ASSERT_NE(c, nullptr);
+    ASSERT_TRUE(c->write_words(addr("D200"), std::vector<std::uint16_t>{800}).has_value());
+    run_for(socket, 200);  // ten time constants
+    pv_sp_mv = items();
+    ASSERT_EQ(pv_sp_mv.size(), 3u);
+    EXPECT_NEAR(pv_sp_mv[0], 5.0 * read_int16(*c, "D201"), 0.5);  // the PV of DM, in 0.01 %
+    EXPECT_NEAR(pv_sp_mv[0], 4000, 75);                           // 80.0 degC = 40.00 %
+    EXPECT_EQ(pv_sp_mv[1], 4000);                                 // SP 80.0 degC
+    EXPECT_EQ(pv_sp_mv[2], 100 * read_int16(*c, "D202"));
+}
+
 TEST(ScenarioRun, APlantOfFiftyMachinesWithStaggeredFaults) {
     ScratchDir dir("scenario-plant");
     const std::string socket = (dir.path() / "ctl.sock").string();

@@ -209,6 +209,37 @@ TEST(Scenario, AForcedBitIsNotChangedAndWritesAreLoggedAsTheCpuUnits) {
     EXPECT_EQ(plc.memory().words(Region::cio)[5] & 0x0008, 0x0008);
 }
 
+// Word tags are written straight on the area's words (not through IoMemory::write): a
+// forced bit inside a word tag keeps its state, the other bits take the value, and a
+// client's write to a stateful tag is still seen.
+TEST(Scenario, WordTagsKeepForcedBitsAndSeeClientWrites) {
+    plc::Plc plc;
+    ScenarioDef def;
+    TagDef word = tag("CIO7", SignalKind::constant, ValueType::uint16);
+    word.value = 0x00FF;
+    def.tags.push_back(word);
+    TagDef total = tag("W40", SignalKind::totaliser, ValueType::int32);
+    total.input.text = "10";
+    def.tags.push_back(total);
+    plc.memory().force_bit(Region::cio, 7, 9, true);   // forced ON
+    plc.memory().force_bit(Region::cio, 7, 0, false);  // forced OFF
+    auto s = compile(def, plc);
+    s->advance(1.0, now);
+    EXPECT_EQ(plc.memory().words(Region::cio)[7], 0x02FE);
+    const auto w = plc.memory().words(Region::work);
+    EXPECT_EQ(words_to_int32(Words(&w[40], 2)).value_or(-1), 10);  // 10 ticks x 10 x 0.1 s
+    // A client writes 1000 to the totaliser: it goes on from there.
+    const auto thousand = int32_to_words(1000);
+    plc.memory().words(Region::work)[40] = thousand[0];
+    plc.memory().words(Region::work)[41] = thousand[1];
+    s->advance(0.1, now);
+    EXPECT_EQ(words_to_int32(Words(&w[40], 2)).value_or(-1), 1001);
+    plc.memory().release_bit(Region::cio, 7, 9);
+    plc.memory().release_bit(Region::cio, 7, 0);
+    s->advance(0.1, now);
+    EXPECT_EQ(plc.memory().words(Region::cio)[7], 0x00FF);
+}
+
 TEST(Scenario, ValueFaultsAndUnitFaults) {
     plc::Plc plc;
     ScenarioDef def;

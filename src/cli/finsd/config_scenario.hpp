@@ -46,6 +46,10 @@ tl::expected<ScenarioConfig, std::string> load_scenario_table(const toml::node& 
                                                               const std::string& path);
 // A file holding a [scenario] table (finsd --scenario FILE).
 tl::expected<ScenarioConfig, std::string> load_scenario_file(const std::filesystem::path& file);
+// A [scenario] table in TOML text (finskit.VirtualPlc(scenario=...)); `source` names it
+// in errors, and a `file = ...` it names is relative to the working directory.
+tl::expected<ScenarioConfig, std::string> load_scenario_text(std::string_view text,
+                                                             std::string_view source);
 // Reads the scenario again from where it came from (reload_file, plc).
 tl::expected<ScenarioConfig, std::string> reload_scenario(const ScenarioConfig& old);
 // Compiles the definition against `plc`, wording errors with their file position.

@@ -8,7 +8,7 @@ namespace fins::cli::finsd {
 std::unique_ptr<server::ScenarioRunner> run_scenario(asio::io_context& io,
                                                      const std::optional<ScenarioConfig>& config,
                                                      std::unique_ptr<scenario::Scenario> compiled,
-                                                     plc::Plc& plc) {
+                                                     plc::Plc& plc, double phase) {
     if (!config || !compiled) return nullptr;
     auto reload = [where = *config, &plc]() -> server::ScenarioRunner::Compiled {
         auto fresh = reload_scenario(where);
@@ -17,7 +17,7 @@ std::unique_ptr<server::ScenarioRunner> run_scenario(asio::io_context& io,
     };
     auto runner = std::make_unique<server::ScenarioRunner>(
         io, std::move(compiled), std::move(reload), config->reload_file.string());
-    runner->start();
+    runner->start(phase);
     return runner;
 }
 

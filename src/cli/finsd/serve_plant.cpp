@@ -170,7 +170,9 @@ int set_up_cpu(asio::io_context& io, const Settings& s, server::Plant& plant, st
         if (!c) return fail(2, c.error());
         compiled = std::move(*c);
     }
-    extras.scenarios.push_back(run_scenario(io, cpu.scenario, std::move(compiled), plc));
+    // The plant's ticks spread over the period in groups (ScenarioRunner::phase_of).
+    extras.scenarios.push_back(run_scenario(io, cpu.scenario, std::move(compiled), plc,
+                                            server::ScenarioRunner::phase_of(i)));
     for (std::size_t k = 0; k < config.ports.size() && extras.scenarios.back(); ++k)
         plant.server(i, k).dispatcher().attach_faults(extras.scenarios.back().get());
 

@@ -95,7 +95,7 @@ EndCode function_block_item_read(HandlerContext& context, Bytes parameters, Byte
     std::size_t section = 0;
     std::uint16_t read = 0;
     for (const auto item : command->items) {
-        const auto value = plc::LoopControl::read(*block, item);
+        const auto value = context.plc.loop_control().read_item(*block, item);
         if (!value) continue;
         section += std::size_t{3} + value->length;  // address, length, data
         if (section > max_item_read_data) return EndCode::response_too_long;

@@ -29,7 +29,7 @@ ScenarioRunner::~ScenarioRunner() {
     *alive_ = false;
 }
 
-void ScenarioRunner::start() {
+void ScenarioRunner::start(double phase) {
     const auto& def = scenario_->definition();
     period_ = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
         std::chrono::duration<double>(def.tick_s / def.time_scale));
@@ -37,6 +37,12 @@ void ScenarioRunner::start() {
         period_ = std::chrono::microseconds(1);
     running_ = true;
     if (def.virtual_time || paused_) return;
+    if (phase > 0 && phase < 1) {
+        next_ = std::chrono::steady_clock::now() +
+                std::chrono::duration_cast<std::chrono::steady_clock::duration>(period_ * phase);
+        schedule();
+        return;
+    }
     scenario_->tick(host_now());
     next_ = std::chrono::steady_clock::now() + period_;
     schedule();
@@ -94,7 +100,10 @@ void ScenarioRunner::resume() {
     if (!paused_) return;
     paused_ = false;
     if (!running_ || scenario_->definition().virtual_time) return;
-    next_ = std::chrono::steady_clock::now() + period_;
+    // The next tick in the same phase of the period as before the pause (a plant's
+    // units stay spread over the period); the paused periods are not run.
+    const auto now = std::chrono::steady_clock::now();
+    if (next_ <= now) next_ += ((now - next_) / period_ + 1) * period_;
     schedule();
 }
 

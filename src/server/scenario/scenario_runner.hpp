@@ -37,6 +37,14 @@ class ScenarioRunner final : public ScenarioControl, public FaultHook {
     using Reloader = std::function<Compiled()>;
 
     static constexpr unsigned max_catch_up = 10;
+    // A plant's CPU Units tick in this many groups spread over the period (phase_of):
+    // each group's ticks are one short burst on the I/O thread, and the thread wakes
+    // for ticks only this many times a period, however many units there are.
+    static constexpr unsigned phase_groups = 10;
+    // The start phase of the plant's `unit`-th CPU Unit.
+    [[nodiscard]] static double phase_of(std::size_t unit) noexcept {
+        return static_cast<double>(unit % phase_groups) / phase_groups;
+    }
     static constexpr std::size_t max_delayed_answers = 1024;
 
     ScenarioRunner(asio::io_context& io, std::unique_ptr<scenario::Scenario> scenario,
@@ -46,7 +54,10 @@ class ScenarioRunner final : public ScenarioControl, public FaultHook {
     ScenarioRunner& operator=(const ScenarioRunner&) = delete;
 
     // Real time: the first tick now, then the timer. Virtual: nothing until advance().
-    void start();
+    // `phase` (0-1): the first tick that fraction of a period from now instead; a plant
+    // spreads its CPU Units' ticks over the period so that no round of every unit's tick
+    // holds the I/O thread (and the requests waiting on it) at once.
+    void start(double phase = 0.0);
     void stop();
     [[nodiscard]] const scenario::Scenario& scenario() const noexcept { return *scenario_; }
 
