@@ -193,7 +193,7 @@ int main(int argc, char** argv) {
     // As finsd starts a plant's scenarios: in groups spread over the period (--groups 1:
     // every unit's first tick now, all in one burst per period).
     for (std::size_t u = 0; u < runners.size(); ++u)
-        runners[u]->start(static_cast<double>(u % groups) / groups);
+        runners[u]->start(static_cast<double>(u % groups) / groups);  // on the shared grid
     std::thread server_thread([&] { io.run(); });
 
     // Pauses or resumes every scenario on the I/O thread and waits until it has.

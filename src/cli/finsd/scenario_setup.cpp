@@ -8,7 +8,7 @@ namespace fins::cli::finsd {
 std::unique_ptr<server::ScenarioRunner> run_scenario(asio::io_context& io,
                                                      const std::optional<ScenarioConfig>& config,
                                                      std::unique_ptr<scenario::Scenario> compiled,
-                                                     plc::Plc& plc, double phase) {
+                                                     plc::Plc& plc, std::optional<double> phase) {
     if (!config || !compiled) return nullptr;
     auto reload = [where = *config, &plc]() -> server::ScenarioRunner::Compiled {
         auto fresh = reload_scenario(where);

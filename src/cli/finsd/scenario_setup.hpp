@@ -14,11 +14,11 @@
 
 namespace fins::cli::finsd {
 
-// Null when `config` is empty. Starts the runner, its first real-time tick `phase` (0-1)
-// of a period from now (ScenarioRunner::start).
+// Null when `config` is empty. Starts the runner (`phase`: ScenarioRunner::start).
 std::unique_ptr<server::ScenarioRunner> run_scenario(asio::io_context& io,
                                                      const std::optional<ScenarioConfig>& config,
                                                      std::unique_ptr<scenario::Scenario> compiled,
-                                                     plc::Plc& plc, double phase = 0.0);
+                                                     plc::Plc& plc,
+                                                     std::optional<double> phase = std::nullopt);
 
 }  // namespace fins::cli::finsd

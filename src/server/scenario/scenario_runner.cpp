@@ -1,6 +1,7 @@
 // A CPU Unit's running scenario on the io_context (contract in scenario_runner.hpp).
 #include "server/scenario/scenario_runner.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <spdlog/spdlog.h>
@@ -29,7 +30,7 @@ ScenarioRunner::~ScenarioRunner() {
     *alive_ = false;
 }
 
-void ScenarioRunner::start(double phase) {
+void ScenarioRunner::start(std::optional<double> phase) {
     const auto& def = scenario_->definition();
     period_ = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
         std::chrono::duration<double>(def.tick_s / def.time_scale));
@@ -37,9 +38,13 @@ void ScenarioRunner::start(double phase) {
         period_ = std::chrono::microseconds(1);
     running_ = true;
     if (def.virtual_time || paused_) return;
-    if (phase > 0 && phase < 1) {
-        next_ = std::chrono::steady_clock::now() +
-                std::chrono::duration_cast<std::chrono::steady_clock::duration>(period_ * phase);
+    if (phase) {
+        const auto now = std::chrono::steady_clock::now();
+        const auto offset = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+            period_ * std::clamp(*phase, 0.0, 1.0));
+        // The start of this period on the grid every runner shares, plus the phase.
+        next_ = now - now.time_since_epoch() % period_ + offset;
+        if (next_ <= now) next_ += period_;
         schedule();
         return;
     }

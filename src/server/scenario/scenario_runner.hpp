@@ -16,6 +16,7 @@
 #include <deque>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -54,10 +55,12 @@ class ScenarioRunner final : public ScenarioControl, public FaultHook {
     ScenarioRunner& operator=(const ScenarioRunner&) = delete;
 
     // Real time: the first tick now, then the timer. Virtual: nothing until advance().
-    // `phase` (0-1): the first tick that fraction of a period from now instead; a plant
-    // spreads its CPU Units' ticks over the period so that no round of every unit's tick
-    // holds the I/O thread (and the requests waiting on it) at once.
-    void start(double phase = 0.0);
+    // With `phase` (0-1): the ticks fall on a grid of the period shared by every runner
+    // of the process (steady clock), that fraction into each period. A plant gives its
+    // units phase_of(i): the units of a group expire at the same instant (one wakeup of
+    // the I/O thread for the group), and the groups spread over the period, so no burst
+    // of every unit's tick holds the requests waiting on that thread.
+    void start(std::optional<double> phase = std::nullopt);
     void stop();
     [[nodiscard]] const scenario::Scenario& scenario() const noexcept { return *scenario_; }
 
