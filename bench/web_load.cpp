@@ -3,14 +3,26 @@
 // with a tick on that thread that changes `words` words every --tick-ms. Measured: the
 // CPU time that thread spends (CLOCK_THREAD_CPUTIME_ID) per second of wall time, with
 // no client, with --clients clients each watching the `words` changing words, and with
-// as many idle clients (connected, subscribed to nothing: the cost of an idle page).
+// as many idle pages (each subscribed, as the page is, to the status topic and a window of
+// 300 words that do not change).
 // FINS shares that thread, so at saturation its request rate loses that fraction
 // (docs/benchmarks.md). The WebSocket clients run on a second thread and count what
 // they receive. Output: one line per case, or JSON lines with --json.
+//
+// --fins measures that directly, side by side: finsd's FINS/UDP server on the same
+// thread, driven as fins_load's udp-32 case does (1-word MEMORY AREA READs, 32 in
+// flight, from the main thread), alternately alone and with the clients watching, in
+// --rounds slices each; prints both request rates (medians) and the median of the
+// rounds' ratios (with / alone).
 // Timing lives here, never in pass/fail tests.
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <time.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -30,7 +42,10 @@
 #include <boost/beast/core/tcp_stream.hpp>
 #include <boost/beast/websocket.hpp>
 
+#include "fins/commands/memory_area.hpp"
+#include "fins/frame.hpp"
 #include "plc/plc.hpp"
+#include "server/sessions/server.hpp"
 #include "transport/asio.hpp"
 #include "web/http_server.hpp"
 
@@ -55,9 +70,15 @@ class Clients {
             auto& s = beast::get_lowest_layer(c->ws);
             s.connect(asio::ip::tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
             c->ws.handshake("127.0.0.1", "/ws");
-            if (subscribe)
+            if (subscribe) {
                 c->ws.write(asio::buffer(fmt::format(
                     R"({{"op":"subscribe","id":"s","address":"D0","count":{}}})", words)));
+            } else {  // an idle page: the status and a grid of words nothing changes
+                c->ws.write(
+                    asio::buffer(std::string(R"({"op":"subscribe","id":"st","topic":"status"})")));
+                c->ws.write(asio::buffer(
+                    std::string(R"({"op":"subscribe","id":"g","address":"D5000","count":300})")));
+            }
             clients_.push_back(std::move(c));
         }
         for (auto& c : clients_)
@@ -97,6 +118,50 @@ class Clients {
     std::thread thread_;
 };
 
+// FINS/UDP requests per second with `depth` 1-word reads of D0 in flight for `seconds`.
+double fins_udp_rate(std::uint16_t port, double seconds, unsigned depth = 32) {
+    std::array<std::uint8_t, 32> params{};
+    fins::ByteWriter pw{params};
+    fins::MemoryAreaRead{{0x82, 0, 0}, 1}.encode(pw);
+    fins::Header h;
+    h.destination = {0, 1, 0};
+    h.source = {0, 200, 0};
+    std::vector<std::uint8_t> frame(fins::max_frame_size);
+    frame.resize(
+        fins::encode_request(h, fins::MemoryAreaRead::code, pw.written(), frame).value_or(0));
+    const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    a.sin_port = htons(port);
+    timeval tv{1, 0};  // a lost datagram ends the case, never hangs it
+    ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+    if (::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
+        ::close(fd);
+        return 0;
+    }
+    std::array<std::uint8_t, 256> in{};
+    const auto start = Clock::now();
+    const auto end =
+        start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+    std::uint64_t answers = 0, in_flight = 0;
+    for (unsigned i = 0; i < depth; ++i)
+        in_flight += ::send(fd, frame.data(), frame.size(), 0) > 0 ? 1 : 0;
+    while (in_flight > 0 && ::recv(fd, in.data(), in.size(), 0) > 0) {
+        --in_flight;
+        ++answers;
+        if (Clock::now() < end) in_flight += ::send(fd, frame.data(), frame.size(), 0) > 0 ? 1 : 0;
+    }
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    ::close(fd);
+    return static_cast<double>(answers) / elapsed;
+}
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0 : v[v.size() / 2];
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -111,6 +176,13 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(1u, 4096u));
     app.add_option("--tick-ms", tick_ms, "Milliseconds between changes")->capture_default_str();
     app.add_flag("--json", json, "Print JSON lines");
+    bool fins_side = false;
+    unsigned rounds = 3;
+    app.add_flag("--fins", fins_side,
+                 "FINS/UDP request rate alone and with the clients watching, and the ratio");
+    app.add_option("--rounds", rounds, "With --fins: alternate the two cases this many times")
+        ->capture_default_str()
+        ->check(CLI::Range(1u, 51u));
     CLI11_PARSE(app, argc, argv);
     spdlog::set_level(spdlog::level::warn);
 
@@ -140,6 +212,18 @@ int main(int argc, char** argv) {
         });
     };
     arm();
+    std::unique_ptr<fins::server::Server> fins_server;
+    if (fins_side) {
+        fins::server::ServerOptions options;
+        options.port = 0;
+        auto started = fins::server::Server::start(io, plc, options);
+        if (!started) {
+            std::fprintf(stderr, "fins_web_load: cannot start the FINS server: %s\n",
+                         started.error().message().c_str());
+            return 1;
+        }
+        fins_server = std::move(*started);
+    }
     std::thread server_thread([&] { io.run(); });
     // The server thread's CPU seconds, read on that thread.
     const auto server_cpu = [&] {
@@ -170,6 +254,47 @@ int main(int argc, char** argv) {
                             name, share, msgs, mbytes);
             std::fflush(stdout);
         };
+    const auto stop = [&] {
+        asio::post(io, [&] {
+            tick.cancel();
+            (*web)->stop();
+            if (fins_server) fins_server->stop();
+            io.stop();
+        });
+        server_thread.join();
+    };
+    if (fins_side) {
+        std::vector<double> alone, watched, messages;
+        const double slice = seconds / rounds;
+        for (unsigned r = 0; r < rounds; ++r) {
+            alone.push_back(fins_udp_rate(fins_server->udp_port(), slice));
+            Clients watching((*web)->port(), clients, words, true);
+            std::this_thread::sleep_for(std::chrono::milliseconds(300));  // snapshots out
+            const auto m0 = watching.messages();
+            const auto w0 = Clock::now();
+            watched.push_back(fins_udp_rate(fins_server->udp_port(), slice));
+            messages.push_back(static_cast<double>(watching.messages() - m0) /
+                               std::chrono::duration<double>(Clock::now() - w0).count());
+        }
+        // The ratio of each round's pair (the machine's load drifts less within a pair).
+        std::vector<double> ratios;
+        for (unsigned r = 0; r < rounds; ++r)
+            ratios.push_back(alone[r] > 0 ? watched[r] / alone[r] : 0);
+        const double a = median(alone), w = median(watched), ratio = median(ratios);
+        if (json)
+            std::printf(
+                "{\"fins_alone_per_s\":%.0f,\"fins_with_web_per_s\":%.0f,\"ratio\":%.3f,"
+                "\"ws_messages_per_s\":%.1f,\"clients\":%u,\"words\":%u}\n",
+                a, w, ratio, median(messages), clients, words);
+        else
+            std::printf(
+                "FINS/UDP alone                          %9.0f req/s\n"
+                "FINS/UDP with %u clients x %u words  %9.0f req/s  (WebSocket %.1f msg/s)\n"
+                "ratio (median of the rounds' ratios)    %9.3f\n",
+                a, clients, words, w, median(messages), ratio);
+        stop();
+        return 0;
+    }
     measure("no WebSocket client", [] { return std::pair<std::uint64_t, std::uint64_t>{0, 0}; });
     {
         Clients watching((*web)->port(), clients, words, true);
@@ -181,15 +306,10 @@ int main(int argc, char** argv) {
     {
         Clients idle((*web)->port(), clients, words, false);
         std::this_thread::sleep_for(std::chrono::milliseconds(500));
-        measure(fmt::format("{} idle clients", clients).c_str(), [&] {
+        measure(fmt::format("{} idle pages", clients).c_str(), [&] {
             return std::pair{idle.messages(), idle.bytes()};
         });
     }
-    asio::post(io, [&] {
-        tick.cancel();
-        (*web)->stop();
-        io.stop();
-    });
-    server_thread.join();
+    stop();
     return 0;
 }

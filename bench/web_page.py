@@ -6,15 +6,22 @@ loopback (Navigation Timing through Selenium), and what an idle page costs finsd
 
 Interactive = the moment the grid holds the first values from the WebSocket (the page's
 performance mark "finsd-first-values"), measured from the start of the navigation; the
-Navigation Timing points before it are printed too. Idle cost = finsd's CPU time
+Navigation Timing points before it are printed too. Write to screen = from the FINS
+answer to a MEMORY AREA WRITE of D3 (a datagram this script sends to finsd's FINS/UDP
+port) to the moment the grid cell of D3 shows the value (polled through the driver,
+which adds a few ms), --writes times (issue 16: "within 1 s"). Idle cost = finsd's CPU time
 (/proc/PID/stat utime + stime) over --idle seconds with no page, then with the page open
 and nothing changing in the PLC, and the WebSocket messages the idle page received.
 """
 import argparse
 import os
 import re
+import json
 import signal
+import socket
 import statistics
+import struct
+import urllib.request
 import subprocess
 import sys
 import tempfile
@@ -84,11 +91,49 @@ def load_once(driver, url):
     sys.exit("the page did not show values within 10 s")
 
 
+CELL = ("const c = document.querySelector(`#grid-rows .cell[data-word='${arguments[0]}']`);"
+        "return c ? c.textContent : null;")
+
+
+def fins_write_word(sock, port, node, word, value, sid):
+    """MEMORY AREA WRITE (01 02) of one DM word over FINS/UDP; returns once answered 0000."""
+    frame = bytes([0x80, 0, 2, 0, node, 0, 0, 254, 0, sid & 0xFF, 0x01, 0x02, 0x82]) + \
+        struct.pack(">HBHH", word, 0, 1, value)
+    sock.sendto(frame, ("127.0.0.1", port))
+    answer = sock.recv(64)
+    if answer[12:14] != b"\x00\x00":
+        sys.exit(f"finsd answered the write with {answer[12:14].hex()}")
+
+
+def write_to_screen(driver, url, writes):
+    """Milliseconds from each FINS write's answer to the value in the grid."""
+    plc = json.load(urllib.request.urlopen(url + "api/plcs"))["plcs"][0]
+    sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    sock.settimeout(2)
+    driver.get(url)
+    deadline = time.monotonic() + 10
+    while driver.execute_script(CELL, 3) is None and time.monotonic() < deadline:
+        time.sleep(0.01)
+    out = []
+    for i in range(writes):
+        value = 1000 + i
+        fins_write_word(sock, plc["udp_port"], plc["node"], 3, value, i)
+        written = time.monotonic()
+        while driver.execute_script(CELL, 3) != str(value):
+            if time.monotonic() - written > 10:
+                sys.exit(f"D3 = {value} did not show within 10 s")
+        out.append((time.monotonic() - written) * 1000)
+        time.sleep(0.137)  # land the next write elsewhere in the 100 ms tick
+    sock.close()
+    return sorted(out)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--bin", type=Path, default=ROOT / "build" / "bin")
     ap.add_argument("--runs", type=int, default=20)
     ap.add_argument("--idle", type=float, default=30.0)
+    ap.add_argument("--writes", type=int, default=20)
     args = ap.parse_args()
     with tempfile.TemporaryDirectory() as workdir:
         proc, url = start_finsd(args.bin, workdir)
@@ -106,6 +151,9 @@ def main():
                 xs = sorted(t[key] for t in warm)
                 print(f"{args.runs} reloads, {name:26}: median {statistics.median(xs):6.1f} ms, "
                       f"max {xs[-1]:6.1f} ms")
+            shown = write_to_screen(driver, url, args.writes)
+            print(f"{args.writes} FINS writes to the screen: median "
+                  f"{statistics.median(shown):6.1f} ms, max {shown[-1]:6.1f} ms")
             driver.get("about:blank")
             time.sleep(1)
             before = cpu_seconds(proc.pid)

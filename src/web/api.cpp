@@ -209,6 +209,7 @@ HttpAnswer write_route(WebContext& context, std::string_view body) {
     if (values == j.end()) return error_answer(400, "\"values\" is required");
     auto written = write_values(t->plc->memory(), address->get<std::string>(), *values, as);
     if (!written) return error_answer(written.error().status, written.error().message);
+    context.watches->touch_topics();  // the status topic shows it at the next tick
     return json_answer(200, Json{{"ok", true}, {"written", *written}});
 }
 
@@ -218,7 +219,8 @@ void control_route(WebContext& context, std::string_view body,
         return done(error_answer(403, "control is off: finsd was started without --http-control"));
     const Json j = Json::parse(body, nullptr, false);
     if (j.is_discarded()) return done(error_answer(400, "the body is not JSON"));
-    server::dispatch_control_request(context.targets, j, [done](Json reply) {
+    server::dispatch_control_request(context.targets, j, [done, &context](Json reply) {
+        context.watches->touch_topics();  // a mode, a fault, a FAL: shown at the next tick
         // The channel's own answer, as the Unix socket gives it; a refusal is a 400.
         const bool refused = reply.contains("error") && !reply.contains("result");
         done(json_answer(refused ? 400 : 200, reply));

@@ -89,6 +89,7 @@ void HttpServer::stop() {
     shared_->stopped = true;
     beast::error_code ignored;
     shared_->acceptor.close(ignored);
+    shared_->tick.cancel();
     for (auto& w : shared_->connections)
         if (auto c = w.lock()) c->close();
     shared_->connections.clear();

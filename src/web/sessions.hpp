@@ -8,6 +8,7 @@
 #include <memory>
 
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <boost/beast/core/tcp_stream.hpp>
 #include <boost/beast/http/message.hpp>
 #include <boost/beast/http/string_body.hpp>
@@ -25,13 +26,22 @@ class Connection {
   public:
     virtual ~Connection() = default;
     virtual void close() = 0;
+    // The server's tick (every min_interval while some WebSocket has subscriptions):
+    // sends what is due; true while this connection has subscriptions.
+    virtual bool poll(SteadyTime /*now*/, std::chrono::system_clock::time_point /*wall*/) {
+        return false;
+    }
 };
 
 struct ServerShared {
     explicit ServerShared(asio::io_context& io, WebContext c)
-        : context(std::move(c)), acceptor(io), resumable(context.options) {}
+        : context(std::move(c)), acceptor(io), tick(io), resumable(context.options) {}
     WebContext context;
     asio::ip::tcp::acceptor acceptor;
+    // One timer polls every WebSocket in the same phase, so a shared Watch is read once
+    // per interval and every subscriber's delta is the same text.
+    asio::steady_timer tick;
+    bool ticking = false;
     ResumeStore resumable;
     std::list<std::weak_ptr<Connection>> connections;
     std::size_t websockets = 0;
@@ -45,6 +55,8 @@ struct ServerShared {
 
 // Serves HTTP requests on `socket` until it closes or upgrades to a WebSocket.
 void run_http_session(asio::ip::tcp::socket socket, std::shared_ptr<ServerShared> shared);
+// Arms the tick if it is not armed (a WebSocket subscribed).
+void arm_tick(const std::shared_ptr<ServerShared>& shared);
 // Takes over `stream` after the upgrade request `request` passed the checks.
 void run_websocket_session(beast::tcp_stream stream, http::request<http::string_body> request,
                            std::shared_ptr<ServerShared> shared);

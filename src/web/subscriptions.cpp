@@ -24,6 +24,16 @@ std::string dump(const Json& j) {
 
 }  // namespace
 
+std::string Message::text() const {
+    if (!body) return head;
+    std::string t;
+    t.reserve(size());
+    t += head;
+    t += *body;
+    t += '}';
+    return t;
+}
+
 Subscriptions::Subscriptions(WebContext& context, std::string session)
     : context_(context), session_(std::move(session)) {}
 
@@ -31,25 +41,27 @@ std::string Subscriptions::hello() const {
     return dump(Json{{"type", "hello"}, {"session", session_}, {"seq", seq_}});
 }
 
-std::string Subscriptions::stamp(Json message) {
-    message["seq"] = ++seq_;
-    std::string text = dump(message);
-    history_.emplace_back(seq_, text);
-    history_size_ += text.size();
+// `message.head` begins after the seq: {"seq":N, is put in front here.
+Message& Subscriptions::stamp(Message message, std::vector<Message>& out) {
+    message.head.insert(0, fmt::format(R"({{"seq":{},)", ++seq_));
+    history_size_ += message.size();
+    history_.emplace_back(seq_, message);
     while (history_size_ > history_bytes && !history_.empty()) {
         history_size_ -= history_.front().second.size();
         history_.pop_front();
     }
-    return text;
+    out.push_back(std::move(message));
+    return out.back();
 }
 
 void Subscriptions::error(std::string_view id, std::string_view message,
-                          std::vector<std::string>& out) {
-    out.push_back(stamp(Json{{"id", id}, {"type", "error"}, {"error", message}}));
+                          std::vector<Message>& out) {
+    const std::string text = dump(Json{{"id", id}, {"type", "error"}, {"error", message}});
+    stamp(Message{text.substr(1), nullptr}, out);  // without its "{"
 }
 
 std::optional<ResumeRequest> Subscriptions::on_message(std::string_view text,
-                                                       std::vector<std::string>& out) {
+                                                       std::vector<Message>& out) {
     const Json j = Json::parse(text, nullptr, false);
     if (j.is_discarded() || !j.is_object()) {
         error("", "a message must be a JSON object", out);
@@ -84,7 +96,7 @@ std::optional<ResumeRequest> Subscriptions::on_message(std::string_view text,
     return std::nullopt;
 }
 
-void Subscriptions::subscribe(const Json& j, std::vector<std::string>& out) {
+void Subscriptions::subscribe(const Json& j, std::vector<Message>& out) {
     const auto id_it = j.find("id");
     if (id_it == j.end() || !id_it->is_string() || id_it->get_ref<const std::string&>().empty() ||
         id_it->get_ref<const std::string&>().size() > max_id_size)
@@ -102,12 +114,12 @@ void Subscriptions::subscribe(const Json& j, std::vector<std::string>& out) {
     if (target == nullptr) return error(id, why, out);
     Sub sub;
     sub.id = id;
-    sub.target = target;
+    sub.id_json = dump(*id_it);
     if (const auto topic = j.find("topic"); topic != j.end()) {
         const std::string t = topic->is_string() ? topic->get<std::string>() : "";
         if (t != "status" && t != "errors" && t != "events")
             return error(id, "\"topic\" must be status, errors or events", out);
-        sub.topic = t;
+        sub.watch = context_.watches->topic(*target, t);
     } else {
         const auto address = j.find("address");
         if (address == j.end() || !address->is_string())
@@ -124,7 +136,7 @@ void Subscriptions::subscribe(const Json& j, std::vector<std::string>& out) {
         }
         auto query = make_query(target->plc->memory(), address->get<std::string>(), count, as);
         if (!query) return error(id, query.error().message, out);
-        sub.query = std::move(*query);
+        sub.watch = context_.watches->values(*target, *query);
     }
     // The same id again replaces that subscription (a page changing its window).
     const auto same =
@@ -142,85 +154,88 @@ void Subscriptions::subscribe(const Json& j, std::vector<std::string>& out) {
 }
 
 void Subscriptions::poll(SteadyTime now, std::chrono::system_clock::time_point wall,
-                         std::vector<std::string>& out) {
-    for (auto& s : subs_) {
-        if (now < s.next_due) continue;
-        if (s.topic.empty())
-            poll_data(s, now, wall, out);
-        else
-            poll_topic(s, now, out);
-    }
+                         std::vector<Message>& out) {
+    for (auto& s : subs_)
+        poll_one(s, now, wall, out);
 }
 
-void Subscriptions::poll_data(Sub& s, SteadyTime now, std::chrono::system_clock::time_point wall,
-                              std::vector<std::string>& out) {
-    const auto& memory = s.target->plc->memory();
-    if (auto r = read_raw(memory, s.query, wall, scratch_); !r) {
-        // The range became invalid (the current EM bank changed): say so once.
-        if (r.error().message != s.last_error) {
-            s.last_error = r.error().message;
+void Subscriptions::poll_one(Sub& s, SteadyTime now, std::chrono::system_clock::time_point wall,
+                             std::vector<Message>& out) {
+    Watch& w = *s.watch;
+    // Once per interval for every subscriber; a subscription sends when its watch moved
+    // on, so at most once per interval too (plus its first snapshot).
+    w.refresh(context_, now, wall);
+    if (!w.error().empty()) {
+        // Say so once; the values last sent are stale now.
+        if (w.error() != s.last_error) {
+            s.last_error = w.error();
             error(s.id, s.last_error, out);
-            s.next_due = now + context_.options.min_interval;
         }
-        return;
-    }
-    if (!s.snapshot && scratch_ == s.raw) return;  // the common case: nothing changed
-    s.raw.swap(scratch_);
-    auto values = decode_values(s.query, s.raw);
-    if (!values) {
-        if (values.error().message != s.last_error) {
-            s.last_error = values.error().message;
-            error(s.id, s.last_error, out);
-            s.next_due = now + context_.options.min_interval;
-        }
-        s.snapshot = true;  // the last values sent are stale now
+        s.snapshot = true;
         return;
     }
     s.last_error.clear();
-    if (s.snapshot || !s.last.is_array() || s.last.size() != values->size()) {
-        out.push_back(stamp(Json{{"id", s.id}, {"type", "snapshot"}, {"values", *values}}));
+    if (!s.snapshot && s.generation == w.generation()) return;  // nothing changed
+    if (!s.snapshot && s.generation + 1 == w.generation() && w.delta() != nullptr) {
+        stamp(Message{fmt::format(R"("id":{},"type":"delta","changes":)", s.id_json), w.delta()},
+              out);
     } else {
-        Json changes = Json::array();
-        for (std::size_t i = 0; i < values->size(); ++i)
-            if ((*values)[i] != s.last[i]) changes.push_back(Json::array({i, (*values)[i]}));
-        if (changes.empty()) {  // only a forced flag moved: nothing the client shows
-            s.last = std::move(*values);
-            return;
-        }
-        out.push_back(stamp(Json{{"id", s.id}, {"type", "delta"}, {"changes", changes}}));
+        const auto& snapshot = w.snapshot();
+        if (snapshot == nullptr) return;  // nothing read yet
+        stamp(Message{fmt::format(R"("id":{},"type":"snapshot","{}":)", s.id_json,
+                                  w.topic() ? "value" : "values"),
+                      snapshot},
+              out);
     }
-    s.last = std::move(*values);
+    s.generation = w.generation();
     s.snapshot = false;
-    s.next_due = now + context_.options.min_interval;
-}
-
-void Subscriptions::poll_topic(Sub& s, SteadyTime now, std::vector<std::string>& out) {
-    Json value = s.topic == "status"   ? status_object(context_, *s.target)
-                 : s.topic == "errors" ? errors_object(*s.target)
-                                       : events_object(*s.target);
-    if (!s.snapshot && value == s.last) return;
-    out.push_back(stamp(Json{{"id", s.id}, {"type", "snapshot"}, {"value", value}}));
-    s.last = std::move(value);
-    s.snapshot = false;
-    s.next_due = now + context_.options.min_interval;
 }
 
 void Subscriptions::resync() noexcept {
-    for (auto& s : subs_) {
+    for (auto& s : subs_)
         s.snapshot = true;
-        s.next_due = {};
-    }
 }
 
-bool Subscriptions::replay_after(std::uint64_t seq, std::vector<std::string>& out) {
+bool Subscriptions::replay_after(std::uint64_t seq, std::vector<Message>& out) {
     if (seq >= seq_) return true;  // nothing missed
     if (history_.empty() || history_.front().first > seq + 1) {
         resync();
         return false;
     }
-    for (const auto& [n, text] : history_)
-        if (n > seq) out.push_back(text);
+    for (const auto& [n, message] : history_)
+        if (n > seq) out.push_back(message);
     return true;
+}
+
+namespace {
+
+void append_texts(const std::vector<Message>& messages, std::vector<std::string>& out) {
+    for (const auto& m : messages)
+        out.push_back(m.text());
+}
+
+}  // namespace
+
+std::optional<ResumeRequest> Subscriptions::on_message(std::string_view text,
+                                                       std::vector<std::string>& out) {
+    std::vector<Message> messages;
+    auto r = on_message(text, messages);
+    append_texts(messages, out);
+    return r;
+}
+
+void Subscriptions::poll(SteadyTime now, std::chrono::system_clock::time_point wall,
+                         std::vector<std::string>& out) {
+    std::vector<Message> messages;
+    poll(now, wall, messages);
+    append_texts(messages, out);
+}
+
+bool Subscriptions::replay_after(std::uint64_t seq, std::vector<std::string>& out) {
+    std::vector<Message> messages;
+    const bool complete = replay_after(seq, messages);
+    append_texts(messages, out);
+    return complete;
 }
 
 void ResumeStore::expire(SteadyTime now) {

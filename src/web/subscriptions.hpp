@@ -11,8 +11,12 @@
 //        {"seq":N,"id":"s1","type":"delta","changes":[[offset,value],...]}
 //        {"seq":N,"id":"st","type":"snapshot","value":{...}}
 //        {"seq":N,"id":"s1","type":"error","error":"..."}
-// A subscription sends when what it watches changed, at most once per min_interval
-// (changes in between are coalesced into one delta against the last message sent). seq
+// A subscription's first message (its snapshot) goes out at the first poll, which the
+// session runs at once after the subscribe; then it sends when what it watches changed,
+// at most once per min_interval (changes in between are coalesced into one delta against
+// the last message sent). What a subscription watches is a shared Watch (watches.hpp):
+// read, compared and printed once per interval for every connection watching it, and a
+// message's values are that Watch's immutable text, shared, not copied (Message). seq
 // rises by one per message. The last history_bytes of messages are kept, so a client
 // that reconnects with "resume" gets what it missed, or fresh snapshots if that is gone.
 #pragma once
@@ -30,11 +34,21 @@
 #include <nlohmann/json.hpp>
 
 #include "web/memory_values.hpp"
+#include "web/watches.hpp"
 #include "web/web_context.hpp"
 
 namespace fins::web {
 
-using SteadyTime = std::chrono::steady_clock::time_point;
+// One message to a client: `head`, then, when `body` is set, the shared text and "}"
+// (the values of a snapshot or delta, written once for every subscriber).
+struct Message {
+    std::string head;
+    SharedText body;
+    [[nodiscard]] std::size_t size() const noexcept {
+        return head.size() + (body ? body->size() + 1 : 0);
+    }
+    [[nodiscard]] std::string text() const;
+};
 
 // Bytes of sent messages each client keeps for "resume".
 inline constexpr std::size_t history_bytes = 256 * 1024;
@@ -55,44 +69,45 @@ class Subscriptions {
     [[nodiscard]] std::string hello() const;
 
     // A client message: answers (errors) go to `out`; a "resume" is returned for the caller.
-    std::optional<ResumeRequest> on_message(std::string_view text, std::vector<std::string>& out);
+    std::optional<ResumeRequest> on_message(std::string_view text, std::vector<Message>& out);
     // The messages due at `now` (`wall` stamps clock pulses and the like).
     void poll(SteadyTime now, std::chrono::system_clock::time_point wall,
-              std::vector<std::string>& out);
+              std::vector<Message>& out);
     // Every subscription's next message is a snapshot (the client fell behind, or what
     // it missed is no longer in the history).
     void resync() noexcept;
     // The messages after `seq` still in the history to `out`; false (and a resync) when
     // some are gone.
+    bool replay_after(std::uint64_t seq, std::vector<Message>& out);
+
+    // The same with whole texts (tests and the fuzzer read them).
+    std::optional<ResumeRequest> on_message(std::string_view text, std::vector<std::string>& out);
+    void poll(SteadyTime now, std::chrono::system_clock::time_point wall,
+              std::vector<std::string>& out);
     bool replay_after(std::uint64_t seq, std::vector<std::string>& out);
 
   private:
     struct Sub {
         std::string id;
-        const server::ControlTarget* target = nullptr;
-        std::string topic;  // "" for a data subscription
-        ValueQuery query;
-        std::vector<std::uint8_t> raw;
-        nlohmann::json last;  // values (data) or the object (topic) last sent
+        std::string id_json;  // the id as a JSON string, for the message heads
+        std::shared_ptr<Watch> watch;
+        std::uint64_t generation = 0;  // of the watch, last sent
         std::string last_error;
         bool snapshot = true;
-        SteadyTime next_due{};
     };
 
-    std::string stamp(nlohmann::json message);
-    void error(std::string_view id, std::string_view message, std::vector<std::string>& out);
-    void subscribe(const nlohmann::json& j, std::vector<std::string>& out);
-    void poll_data(Sub& s, SteadyTime now, std::chrono::system_clock::time_point wall,
-                   std::vector<std::string>& out);
-    void poll_topic(Sub& s, SteadyTime now, std::vector<std::string>& out);
+    Message& stamp(Message message, std::vector<Message>& out);
+    void error(std::string_view id, std::string_view message, std::vector<Message>& out);
+    void subscribe(const nlohmann::json& j, std::vector<Message>& out);
+    void poll_one(Sub& s, SteadyTime now, std::chrono::system_clock::time_point wall,
+                  std::vector<Message>& out);
 
     WebContext& context_;
     std::string session_;
     std::uint64_t seq_ = 0;
     std::vector<Sub> subs_;
-    std::deque<std::pair<std::uint64_t, std::string>> history_;
+    std::deque<std::pair<std::uint64_t, Message>> history_;
     std::size_t history_size_ = 0;
-    std::vector<std::uint8_t> scratch_;
 };
 
 // Subscriptions of closed connections, kept for resume_window so that a page that

@@ -7,12 +7,14 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "server/control/control.hpp"
+#include "web/watches.hpp"
 
 namespace fins::web {
 
@@ -54,6 +56,8 @@ struct WebContext {
     std::function<void(const server::ControlTarget&, nlohmann::json& status)> network_status;
     // The Prometheus text of GET /metrics; absent: 404.
     std::function<std::string()> metrics;
+    // What every connection's subscriptions watch, each read once per interval.
+    std::shared_ptr<Watches> watches = std::make_shared<Watches>();
 };
 
 }  // namespace fins::web

@@ -57,6 +57,39 @@ TEST(FinsdHttp, FinsAndHttpSeeTheSamePlc) {
     EXPECT_EQ(finsd.stop().exit_code, 0);
 }
 
+// /api/status lists who talks FINS to this node: the FINS/UDP peers with the node their
+// frames named and when, and the FINS/TCP connections with the node of their handshake.
+TEST(FinsdHttp, StatusNamesTheUdpPeersAndTcpNodes) {
+    const auto port = free_port();
+    Finsd finsd({"--http", "127.0.0.1:" + std::to_string(port)});
+    ASSERT_TRUE(finsd.started()) << finsd.result().err;
+    ClientOptions udp;
+    udp.port = finsd.port();
+    udp.source.node = 77;
+    udp.timeout = std::chrono::milliseconds(3000);
+    auto u = Client::connect(udp);
+    ASSERT_TRUE(u) << u.error().message();
+    ASSERT_TRUE((*u)->read_words(addr("D0"), 1));
+    ClientOptions tcp = udp;
+    tcp.protocol = ClientOptions::Protocol::tcp;
+    tcp.source.node = 33;
+    auto t = Client::connect(tcp);
+    ASSERT_TRUE(t) << t.error().message();
+    ASSERT_TRUE((*t)->read_words(addr("D0"), 1));  // the handshake is done
+    HttpClient http(port);
+    const auto status = body_json(http.request(http::verb::get, "/api/status"));
+    ASSERT_EQ(status["udp_peers"].size(), 1u) << status["udp_peers"];
+    EXPECT_EQ(status["udp_peers"][0]["address"], "127.0.0.1");
+    EXPECT_EQ(status["udp_peers"][0]["node"], 77);
+    EXPECT_EQ(status["udp_peers"][0]["last_seen"].get<std::string>().size(), 20u);  // ...Z
+    ASSERT_EQ(status["connections"].size(), 1u) << status["connections"];
+    EXPECT_EQ(status["connections"][0]["address"], "127.0.0.1");
+    EXPECT_EQ(status["connections"][0]["node"], 33);
+    EXPECT_EQ(status["connections"][0]["state"], "established");
+    EXPECT_TRUE(status["relays"].is_object());  // one node, no router: nothing relayed
+    EXPECT_EQ(finsd.stop().exit_code, 0);
+}
+
 TEST(FinsdHttp, ReadOnlyByDefault) {
     const auto port = free_port();
     Finsd finsd({"--http", "127.0.0.1:" + std::to_string(port)});

@@ -60,6 +60,7 @@ TEST_F(Subs, SendsASnapshotThenOnlyWhatChanged) {
     EXPECT_TRUE(poll(s).empty());  // nothing changed: nothing sent
     dm()[2] = 9;
     dm()[3] = 1;
+    now_ += 100ms;  // the range is read once per interval
     auto delta = poll(s);
     ASSERT_EQ(delta.size(), 1u);
     EXPECT_EQ(delta[0],
@@ -102,6 +103,7 @@ TEST_F(Subs, TypedViewsAndTopics) {
     now_ += 1s;
     EXPECT_TRUE(poll(s).empty());
     plc_.change_mode(plc::OperatingMode::program, std::chrono::system_clock::now());
+    now_ += web::topic_interval;  // a topic is built again at most this often
     out = poll(s);
     ASSERT_EQ(out.size(), 1u);
     EXPECT_EQ(out[0]["value"]["mode"], "program");
@@ -131,6 +133,55 @@ TEST_F(Subs, RefusesBadRequestsWithAnErrorMessage) {
     EXPECT_EQ(s.size(), 2u);
     EXPECT_TRUE(send(s, R"({"op":"unsubscribe","id":"a"})").empty());
     EXPECT_EQ(s.size(), 1u);
+}
+
+// Issue 16's cost bound: every connection watching the same range shares one Watch,
+// read and printed once per interval; each message's values are the same buffer.
+TEST_F(Subs, SubscribersOfOneRangeShareOneWatchAndItsText) {
+    web::Subscriptions a(context_, "a");
+    web::Subscriptions b(context_, "b");
+    std::vector<web::Message> ma, mb;
+    a.on_message(R"({"op":"subscribe","id":"x","address":"D0","count":3})", ma);
+    b.on_message(R"({"op":"subscribe","id":"y","address":"D0","count":3})", mb);
+    b.on_message(R"({"op":"subscribe","id":"z","address":"D0","count":3,"as":"hex"})", mb);
+    EXPECT_EQ(context_.watches->size(), 2u);  // uint16 D0-D2 (twice), hex D0-D2
+    dm()[0] = 7;
+    const auto wall = std::chrono::system_clock::now();
+    a.poll(now_, wall, ma);
+    b.poll(now_, wall, mb);
+    ASSERT_EQ(ma.size(), 1u);
+    ASSERT_EQ(mb.size(), 2u);
+    ASSERT_NE(ma[0].body, nullptr);
+    EXPECT_EQ(ma[0].body.get(), mb[0].body.get());  // one snapshot text, not two
+    EXPECT_EQ(Json::parse(ma[0].text()),
+              Json::parse(R"({"seq":1,"id":"x","type":"snapshot","values":[7,0,0]})"));
+    EXPECT_EQ(Json::parse(mb[1].text())["values"], Json::parse(R"(["0x0007","0x0000","0x0000"])"));
+    ma.clear();
+    mb.clear();
+    dm()[1] = 5;
+    now_ += 100ms;
+    a.poll(now_, wall, ma);
+    b.poll(now_, wall, mb);
+    ASSERT_EQ(ma.size(), 1u);
+    ASSERT_EQ(mb.size(), 2u);
+    EXPECT_EQ(*ma[0].body, "[[1,5]]");
+    EXPECT_EQ(ma[0].body.get(), mb[0].body.get());  // one delta text
+    EXPECT_EQ(Json::parse(mb[0].text()),
+              Json::parse(R"({"seq":3,"id":"y","type":"delta","changes":[[1,5]]})"));
+    EXPECT_EQ(Json::parse(mb[1].text())["changes"], Json::parse(R"([[1,"0x0005"]])"));
+    // A subscriber that joins later starts from the shared snapshot, then shares deltas.
+    web::Subscriptions c(context_, "c");
+    std::vector<web::Message> mc;
+    c.on_message(R"({"op":"subscribe","id":"w","address":"D0","count":3})", mc);
+    c.poll(now_ + 10ms, wall, mc);
+    ASSERT_EQ(mc.size(), 1u);
+    EXPECT_EQ(Json::parse(mc[0].text())["values"], Json::parse("[7,5,0]"));
+    // Nobody watches: the watches go.
+    a.on_message(R"({"op":"unsubscribe","id":"x"})", ma);
+    b.on_message(R"({"op":"unsubscribe","id":"y"})", mb);
+    b.on_message(R"({"op":"unsubscribe","id":"z"})", mb);
+    c.on_message(R"({"op":"unsubscribe","id":"w"})", mc);
+    EXPECT_EQ(context_.watches->size(), 0u);
 }
 
 TEST_F(Subs, ResyncSendsSnapshotsAgain) {

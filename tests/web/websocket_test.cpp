@@ -74,6 +74,23 @@ TEST(WebSocket, SnapshotThenDeltasWithRisingSeq) {
     EXPECT_EQ(next["changes"], Json::parse("[[5,78],[9,1]]"));
 }
 
+// The snapshot does not wait for the server's tick: with a tick of an hour it still comes.
+TEST(WebSocket, TheSnapshotGoesOutAtOnceAfterTheSubscribe) {
+    web::WebOptions options;
+    options.min_interval = std::chrono::hours(1);
+    WebServer s(options);
+    s.on_io([&] { s.plc().memory().words(Region::dm)[2] = 9; });
+    WsClient ws(s.port());
+    ws.receive();  // hello
+    ws.send(R"({"op":"subscribe","id":"s1","address":"D0","count":3})");
+    EXPECT_EQ(ws.receive(),
+              Json::parse(R"({"seq":1,"id":"s1","type":"snapshot","values":[0,0,9]})"));
+    ws.send(R"({"op":"subscribe","id":"st","topic":"status"})");
+    const auto status = ws.receive();
+    EXPECT_EQ(status["id"], "st");
+    EXPECT_EQ(status["value"]["mode"], "run");
+}
+
 TEST(WebSocket, BadMessagesAreAnsweredAndTheConnectionStays) {
     WebServer s;
     WsClient ws(s.port());

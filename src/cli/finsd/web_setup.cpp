@@ -1,6 +1,8 @@
 // finsd's HTTP front at start-up (contract in web_setup.hpp).
 #include "cli/finsd/web_setup.hpp"
 
+#include <chrono>
+#include <ctime>
 #include <fstream>
 #include <sstream>
 #include <utility>
@@ -9,6 +11,8 @@
 #include <spdlog/spdlog.h>
 
 #include "server/metrics/metrics.hpp"
+#include "server/routing/plant.hpp"
+#include "server/routing/router.hpp"
 #include "server/sessions/server.hpp"
 
 namespace fins::cli::finsd {
@@ -35,12 +39,20 @@ std::optional<std::string> read_token(const std::filesystem::path& file, std::st
     return line.substr(first, last - first + 1);
 }
 
+// "2026-11-26T15:04:05Z": to the second, so an idle peer's entry does not change.
+std::string utc_text(std::chrono::system_clock::time_point t) {
+    const std::time_t seconds = std::chrono::system_clock::to_time_t(t);
+    std::tm utc{};
+    ::gmtime_r(&seconds, &utc);
+    return fmt::format("{:04}-{:02}-{:02}T{:02}:{:02}:{:02}Z", utc.tm_year + 1900, utc.tm_mon + 1,
+                       utc.tm_mday, utc.tm_hour, utc.tm_min, utc.tm_sec);
+}
+
 }  // namespace
 
 WebStart start_web(boost::asio::io_context& io, const HttpSettings& http,
                    std::vector<server::ControlTarget> targets,
                    std::vector<const server::Server*> servers, server::Plant* plant) {
-    (void)plant;
     WebStart out;
     if (!http.listen) return out;
     const auto listen = parse_http_listen(*http.listen);
@@ -72,16 +84,37 @@ WebStart start_web(boost::asio::io_context& io, const HttpSettings& http,
             if (context_targets[i].plc == t.plc) return servers[i];
         return nullptr;
     };
-    context.network_status = [server_of](const server::ControlTarget& t, Json& status) {
+    // A plant's relay counts of a CPU Unit by end code: {"0000": passed, "0501": refused}.
+    const auto relays_of = [plant](const server::ControlTarget& t) {
+        Json relays = Json::object();
+        if (plant != nullptr)
+            for (const auto& [code, n] : plant->router().relay_counts(*t.plc))
+                relays[fmt::format("{:04X}", code)] = n;
+        return relays;
+    };
+    context.network_status = [server_of, relays_of](const server::ControlTarget& t, Json& status) {
+        status["relays"] = relays_of(t);
         const auto* s = server_of(t);
         if (s == nullptr) return;
         Json list = Json::array();
-        for (const auto& c : s->tcp_connection_list())
-            list.push_back(
-                {{"address", c.address}, {"state", c.established ? "established" : "handshake"}});
+        for (const auto& c : s->tcp_connection_list()) {
+            Json entry{{"address", c.address},
+                       {"port", c.port},
+                       {"state", c.established ? "established" : "handshake"}};
+            entry["node"] = c.established ? Json(c.node) : Json(nullptr);
+            list.push_back(std::move(entry));
+        }
         status["connections"] = std::move(list);
+        Json peers = Json::array();
+        for (const auto& p : s->udp_peer_list())
+            peers.push_back({{"address", p.address},
+                             {"port", p.port},
+                             {"node", p.node},
+                             {"last_seen", utc_text(p.last_seen)}});
+        status["udp_peers"] = std::move(peers);
     };
-    context.describe = [server_of](const server::ControlTarget& t, Json& entry) {
+    context.describe = [server_of, relays_of](const server::ControlTarget& t, Json& entry) {
+        entry["relays"] = relays_of(t);
         const auto* s = server_of(t);
         if (s == nullptr) return;
         entry["udp_port"] = s->udp_port();

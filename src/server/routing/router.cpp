@@ -61,8 +61,22 @@ class CrossingReplyPath final : public ReplyPath {
 Router::Router() : by_address_(address_slots, 0) {}
 
 std::size_t Router::add_cpu(plc::Plc& plc, bool nx) {
-    cpus_.push_back(Cpu{&plc, nx, {}});
+    cpus_.push_back(Cpu{&plc, nx, {}, 0, {}});
     return cpus_.size() - 1;
+}
+
+std::vector<std::pair<std::uint16_t, std::uint64_t>> Router::relay_counts(
+    const plc::Plc& plc) const {
+    std::vector<std::pair<std::uint16_t, std::uint64_t>> out;
+    for (const auto& c : cpus_) {
+        if (c.plc != &plc) continue;
+        std::uint64_t refused = 0;
+        for (const auto& [code, n] : c.relays_refused)
+            refused += n;
+        out.emplace_back(0x0000, c.relays_taken - refused);
+        out.insert(out.end(), c.relays_refused.begin(), c.relays_refused.end());
+    }
+    return out;
 }
 
 std::size_t Router::add_port(std::size_t cpu, std::uint8_t unit_number, NodeAddress address) {
@@ -149,8 +163,16 @@ std::size_t Router::forward(std::size_t port, Bytes frame, MutableBytes out,
     const Header header = read_header(reader);
     const CommandCode command{reader.u8(), reader.u8()};
     const Port& arrival = ports_[port];
-    const Cpu& cpu = cpus_[arrival.cpu];
+    Cpu& cpu = cpus_[arrival.cpu];
+    ++cpu.relays_taken;
     const auto fail = [&](EndCode code) {
+        const auto key = static_cast<std::uint16_t>(code);
+        const auto it = std::find_if(cpu.relays_refused.begin(), cpu.relays_refused.end(),
+                                     [&](const auto& kv) { return kv.first == key; });
+        if (it != cpu.relays_refused.end())
+            ++it->second;
+        else
+            cpu.relays_refused.emplace_back(key, 1);  // a handful of end codes at most
         // An answer that cannot be delivered is not answered (there is no one to tell).
         if (header.is_response()) return std::size_t{0};
         return relay_error(header, command, arrival, code, out);

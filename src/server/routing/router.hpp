@@ -33,6 +33,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "fins/error.hpp"
@@ -105,12 +106,19 @@ class Router {
                                                        std::uint8_t node) const noexcept;
     [[nodiscard]] const Port& port(std::size_t index) const noexcept { return ports_[index]; }
     [[nodiscard]] std::size_t port_count() const noexcept { return ports_.size(); }
+    // The frames `plc`'s ports handed to forward(), by end code: 0000 passed on (or
+    // answered by a node of this process), else the relay error it was refused with.
+    // Empty when `plc` is not a CPU Unit of this router.
+    [[nodiscard]] std::vector<std::pair<std::uint16_t, std::uint64_t>> relay_counts(
+        const plc::Plc& plc) const;
 
   private:
     struct Cpu {
         plc::Plc* plc = nullptr;
         bool nx = false;
         std::vector<std::size_t> ports;
+        std::uint64_t relays_taken = 0;
+        std::vector<std::pair<std::uint16_t, std::uint64_t>> relays_refused;  // by end code
     };
 
     std::size_t relay_error(const Header& request, CommandCode command, const Port& arrival,

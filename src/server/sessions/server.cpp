@@ -1,5 +1,7 @@
 #include "server/sessions/server.hpp"
 
+#include <arpa/inet.h>
+
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -283,7 +285,34 @@ std::vector<TcpConnectionInfo> Server::tcp_connection_list() const {
     std::vector<TcpConnectionInfo> out;
     for (const auto& weak : impl_->sessions)
         if (const auto s = weak.lock(); s != nullptr && s->open())
-            out.push_back({s->peer_address().to_string(), !s->pending()});
+            out.push_back(
+                {s->peer_address().to_string(), !s->pending(), s->peer_port(), s->client_node()});
+    return out;
+}
+
+std::vector<UdpPeerInfo> Server::udp_peer_list() const {
+    std::vector<UdpPeerInfo> out;
+    if (impl_->udp == nullptr) return out;
+    for (const auto& p : impl_->udp->recent_peers().peers()) {
+        if (!p.used) continue;
+        UdpPeerInfo info;
+        info.node = p.node;
+        info.last_seen = p.last_seen;
+        char text[INET6_ADDRSTRLEN] = {};
+        if (p.address.ss_family == AF_INET) {
+            const auto& a = reinterpret_cast<const sockaddr_in&>(p.address);
+            ::inet_ntop(AF_INET, &a.sin_addr, text, sizeof text);
+            info.port = ntohs(a.sin_port);
+        } else if (p.address.ss_family == AF_INET6) {
+            const auto& a = reinterpret_cast<const sockaddr_in6&>(p.address);
+            ::inet_ntop(AF_INET6, &a.sin6_addr, text, sizeof text);
+            info.port = ntohs(a.sin6_port);
+        }
+        info.address = text;
+        out.push_back(std::move(info));
+    }
+    std::sort(out.begin(), out.end(),
+              [](const auto& a, const auto& b) { return a.last_seen > b.last_seen; });
     return out;
 }
 

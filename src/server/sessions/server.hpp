@@ -69,6 +69,16 @@ struct ServerOptions {
 struct TcpConnectionInfo {
     std::string address;       // the peer's IP address
     bool established = false;  // false: in the handshake (or closing after a refusal)
+    std::uint16_t port = 0;    // the peer's port
+    std::uint8_t node = 0;     // the client node the handshake gave it (0: none yet)
+};
+
+// A FINS/UDP peer heard from lately (at most RecentPeers::capacity, newest first).
+struct UdpPeerInfo {
+    std::string address;  // the datagrams' source IP address
+    std::uint16_t port = 0;
+    std::uint8_t node = 0;  // SA1 of its last frame
+    std::chrono::system_clock::time_point last_seen{};
 };
 
 // The node number finsd takes when none is given (see ServerOptions::node).
@@ -89,6 +99,8 @@ class Server {
     [[nodiscard]] std::size_t tcp_connections() const noexcept;
     // The FINS/TCP client connections open now, in accept order (allocates: for the page).
     [[nodiscard]] std::vector<TcpConnectionInfo> tcp_connection_list() const;
+    // The FINS/UDP peers heard from lately, newest first (allocates: for the page).
+    [[nodiscard]] std::vector<UdpPeerInfo> udp_peer_list() const;
     // The one dispatcher every session uses (serial sessions attach to it too).
     [[nodiscard]] Dispatcher& dispatcher() noexcept;
     // Sends `frame` as a datagram from the FINS/UDP socket (false: no UDP, or not sent).

@@ -38,7 +38,9 @@ TcpSession::TcpSession(asio::ip::tcp::socket socket, Dispatcher& dispatcher, Tcp
       limits_(limits),
       timer_(socket_.get_executor()) {
     boost::system::error_code ignored;
-    peer_ = socket_.remote_endpoint(ignored).address();
+    const auto remote = socket_.remote_endpoint(ignored);
+    peer_ = remote.address();
+    peer_port_ = remote.port();
 }
 
 TcpSession::~TcpSession() {

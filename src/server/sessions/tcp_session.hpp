@@ -67,6 +67,8 @@ class TcpSession : public std::enable_shared_from_this<TcpSession>, private Repl
     // Closes at once (no notice): shutdown, timeouts, eviction.
     void close();
     [[nodiscard]] bool open() const noexcept { return state_ != State::closed; }
+    // The client node the handshake gave this connection; 0 before it.
+    [[nodiscard]] std::uint8_t client_node() const noexcept { return client_node_; }
     // Accepted but not established: still in the handshake, or draining after a refusal.
     [[nodiscard]] bool pending() const noexcept {
         return state_ == State::handshake || state_ == State::draining;
@@ -76,6 +78,7 @@ class TcpSession : public std::enable_shared_from_this<TcpSession>, private Repl
     // answers with a reset and the read or write that sees it closes this session.
     void confirm_connection();
     [[nodiscard]] const asio::ip::address& peer_address() const noexcept { return peer_; }
+    [[nodiscard]] std::uint16_t peer_port() const noexcept { return peer_port_; }
     // Sends a FINS frame that answers no request of this connection's read loop (in a
     // plant: an answer routed back from another process to this client's node). Queued
     // behind a write in progress, never interleaved; false when the connection is not
@@ -126,6 +129,7 @@ class TcpSession : public std::enable_shared_from_this<TcpSession>, private Repl
     const TcpLimits& limits_;
     asio::steady_timer timer_;
     asio::ip::address peer_;
+    std::uint16_t peer_port_ = 0;
     State state_ = State::handshake;
     std::uint8_t client_node_ = 0;  // 0 until the handshake succeeded
     // The timer fires at timer_at_ and then compares with deadline_, so moving the

@@ -162,6 +162,7 @@ int UdpSession::serve_batch() {
         // A longer datagram was cut to receive_size (MSG_TRUNC), still more than a frame.
         const std::size_t size = std::min<std::size_t>(request.msg_len, receive_size);
         const Bytes frame{s.in[static_cast<std::size_t>(i)].data(), size};
+        if (size >= header_size) peers_.note(*context.peer, frame[7], context.now);  // [7]: SA1
         // An answer to one of this node's own Send/Rcv/SendCmd instructions.
         // One it did not wait for goes on to the dispatcher: in a plant the router
         // relays answers for other nodes; a single node drops them there.

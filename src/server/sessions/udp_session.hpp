@@ -36,6 +36,7 @@
 #include "fins/frame.hpp"
 #include "server/dispatch/dispatcher.hpp"
 #include "server/sessions/log_summary.hpp"
+#include "server/sessions/recent_peers.hpp"
 #include "transport/asio.hpp"
 
 namespace fins::server {
@@ -67,6 +68,8 @@ class UdpSession : public std::enable_shared_from_this<UdpSession>, private Repl
     // The bound IPv4/IPv6 port, 0 when closed or not an IP socket.
     [[nodiscard]] std::uint16_t local_port() const noexcept;
     [[nodiscard]] const Counters& counters() const noexcept { return counters_; }
+    // The peers heard from lately, with the node their last frame named (the page's list).
+    [[nodiscard]] const RecentPeers& recent_peers() const noexcept { return peers_; }
     // Sends one datagram that is not a reply (a frame a plant relays to another
     // process); false when the kernel did not take it whole.
     bool send_to(Bytes frame, const sockaddr_in& to) noexcept;
@@ -101,6 +104,7 @@ class UdpSession : public std::enable_shared_from_this<UdpSession>, private Repl
     std::size_t current_ = 0;  // the datagram being dispatched (defer() answers it)
     ResponseHook response_hook_;
     LogSummary drops_logged_;  // one warning per interval (log_summary.hpp)
+    RecentPeers peers_;
 };
 
 }  // namespace fins::server

@@ -180,9 +180,10 @@ function fillTable(table, rows, columns, empty) {
 export function renderConnections(s) {
   const tcp = Array.isArray(s.connections) ? s.connections : [];
   const udp = Array.isArray(s.udp_peers) ? s.udp_peers : [];
-  fillTable($('tcp-table'), tcp, tcp.length ? null : [['address', 'address'], ['node', 'node'], ['state', 'state']],
+  // The node: the client node the FINS/TCP handshake gave, the SA1 of a UDP peer's frames.
+  fillTable($('tcp-table'), tcp, [['address', 'address'], ['port', 'port'], ['node', 'node'], ['state', 'state']],
             'no FINS/TCP client connected');
-  fillTable($('udp-table'), udp, udp.length ? null : [['address', 'address'], ['node', 'node'], ['last_seen', 'last seen']],
+  fillTable($('udp-table'), udp, [['address', 'address'], ['port', 'port'], ['node', 'node'], ['last_seen', 'last seen']],
             'no FINS/UDP datagram yet');
   $('conn-count').textContent = tcp.length + udp.length ? String(tcp.length + udp.length) : '';
 }

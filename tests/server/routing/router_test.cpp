@@ -73,6 +73,11 @@ TEST(Router, W342_5_1_3_RelayErrorAnswerBytes) {
     auto quiet = request;
     quiet[0] = 0x81;
     EXPECT_EQ(d.handle(quiet, out, {}), 0u);
+    // Both were taken by the router and refused with 0501 (finsd's page shows these).
+    using Counts = std::vector<std::pair<std::uint16_t, std::uint64_t>>;
+    EXPECT_EQ(r.relay_counts(plc), (Counts{{0x0000, 0}, {0x0501, 2}}));
+    plc::Plc other;
+    EXPECT_TRUE(r.relay_counts(other).empty());
 }
 
 TEST(Router, W596_1_2_AnOversizedFrameForAnotherNetworkAnswers1001WithTheRelayFlag) {
