@@ -17,6 +17,7 @@
 #include "plc/routing_tables.hpp"
 #include "server/control/control_dispatch.hpp"
 #include "server/control/control_requests.hpp"
+#include "server/control/control_scenario.hpp"
 #include "web/assets.hpp"
 #include "web/cpu_facts.hpp"
 #include "web/memory_values.hpp"
@@ -308,6 +309,10 @@ Json status_object(const WebContext& context, const server::ControlTarget& targe
     status["udp_peers"] = Json::array();
     add_cpu_facts(*target.plc, status, std::chrono::system_clock::now());
     if (context.network_status) context.network_status(target, status);
+    // The page's Scenario panel: what `finsd ctl scenario status` answers.
+    if (target.scenario != nullptr)
+        status["scenario"] = server::handle_scenario_request(
+            target.scenario, Json{{"cmd", "scenario"}, {"action", "status"}})["scenario"];
     return status;
 }
 

@@ -90,6 +90,38 @@ TEST(FinsdHttp, StatusNamesTheUdpPeersAndTcpNodes) {
     EXPECT_EQ(finsd.stop().exit_code, 0);
 }
 
+// The page's Scenario panel reads /api/status: a CPU Unit running a scenario carries what
+// `finsd ctl scenario status` answers (time, ticks, events), one without carries nothing.
+TEST(FinsdHttp, StatusCarriesTheRunningScenario) {
+    ScratchDir dir("http-scenario");
+    const auto port = free_port();
+    const std::string conveyor = std::string(FINS_SOURCE_DIR) + "/examples/scenarios/conveyor.toml";
+    Finsd finsd({"--http", "127.0.0.1:" + std::to_string(port), "--http-control", "--scenario",
+                 conveyor, "--control", (dir.path() / "ctl.sock").string()});
+    ASSERT_TRUE(finsd.started()) << finsd.result().err;
+    HttpClient http(port);
+    auto advance = http.request(http::verb::post, "/api/control",
+                                R"({"cmd":"scenario","action":"advance","seconds":2.5})");
+    EXPECT_EQ(advance.result_int(), 200u) << advance.body();
+    const auto status = body_json(http.request(http::verb::get, "/api/status"));
+    ASSERT_TRUE(status.contains("scenario")) << status;
+    EXPECT_EQ(status["scenario"]["time"], "virtual");
+    EXPECT_DOUBLE_EQ(status["scenario"]["time_s"].get<double>(), 2.5);
+    EXPECT_EQ(status["scenario"]["ticks"], 25);
+    EXPECT_EQ(status["scenario"]["seed"], 7);
+    ASSERT_TRUE(status["scenario"]["events"].is_array());
+    EXPECT_EQ(status["scenario"]["events"][0]["name"], "jam");
+    EXPECT_EQ(finsd.stop().exit_code, 0);
+
+    const auto plain_port = free_port();
+    Finsd plain({"--http", "127.0.0.1:" + std::to_string(plain_port)});
+    ASSERT_TRUE(plain.started()) << plain.result().err;
+    HttpClient plain_http(plain_port);
+    EXPECT_FALSE(
+        body_json(plain_http.request(http::verb::get, "/api/status")).contains("scenario"));
+    EXPECT_EQ(plain.stop().exit_code, 0);
+}
+
 TEST(FinsdHttp, ReadOnlyByDefault) {
     const auto port = free_port();
     Finsd finsd({"--http", "127.0.0.1:" + std::to_string(port)});
