@@ -5,13 +5,15 @@ import json
 import re
 import socket
 import struct
+import subprocess
 import time
 import urllib.request
+from pathlib import Path
 
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
 
-from conftest import (cell_text, go_to, open_page, screenshot, severe_console_errors, wait_for,
+from conftest import (BIN, cell_text, go_to, open_page, screenshot, severe_console_errors, wait_for,
                       _chrome)
 
 
@@ -231,3 +233,17 @@ def test_fal_raised_on_the_page_reaches_fins(finsd_factory, page):
     wait_for(lambda: "4107" in page.find_element(By.ID, "cpu-errors").text, 5, "FAL 7 on the page")
     page.find_element(By.ID, "clear-errors").click()
     wait_for(lambda: finsd.fins("status")[1]["error_code"] == "0000", 5, "errors cleared")
+
+
+def test_scenario_panel_shows_the_running_scenario(finsd_factory, page):
+    conveyor = str(Path(__file__).resolve().parents[2] / "examples" / "scenarios" / "conveyor.toml")
+    finsd = finsd_factory("--http-control", "--scenario", conveyor)
+    open_page(page, finsd.url)
+    panel = wait_for(lambda: (lambda p: p if p.is_displayed() else None)(
+        page.find_element(By.ID, "scenario-panel")), 10, "the Scenario panel")
+    # The conveyor's virtual time stands until advanced; its events are listed by name.
+    wait_for(lambda: "jam_alarm" in panel.text, 10, "the conveyor's events in the panel")
+    subprocess.run([str(BIN / "finsd"), "ctl", "--socket", str(finsd.control), "scenario",
+                    "advance", "4"], check=True, capture_output=True, timeout=20)
+    wait_for(lambda: re.search(r"time s\s*4(\.0)?\b", panel.text), 10, "time s = 4 in the panel")
+    screenshot(page, "page-scenario")
