@@ -23,7 +23,7 @@ std::optional<std::string> PlcPoller::write(const Tag& tag, const Encoded& value
     std::vector<std::uint8_t> data;
     MemoryAddress start = tag.read_start;
     std::uint16_t count = static_cast<std::uint16_t>(tag.words);
-    if (tag.type == TagType::boolean) {
+    if (tag.type == TagType::bits) {
         start = *to_memory_address(tag.address, Access::bit);
         count = 1;
         data.push_back(value.bit ? 1 : 0);

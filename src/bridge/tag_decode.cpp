@@ -17,7 +17,7 @@ std::uint16_t word_at(Bytes data, std::size_t index) {
 
 void decode_words(const Tag& tag, Bytes data, std::size_t offset, TagSample& s) {
     s.error = {};
-    if (tag.type == TagType::boolean) {
+    if (tag.type == TagType::bits) {
         s.value.words[0] =
             static_cast<std::uint16_t>((word_at(data, offset) >> tag.address.bit.value_or(0)) & 1);
         return;
@@ -46,7 +46,7 @@ void decode_items(const Tag& tag, Bytes data, const std::uint16_t* item_offsets,
         const auto at = item_offsets[first + k];
         s.value.words[k] = static_cast<std::uint16_t>((data[at] << 8) | data[at + 1u]);
     }
-    if (tag.type == TagType::boolean)
+    if (tag.type == TagType::bits)
         s.value.words[0] = (s.value.words[0] >> tag.address.bit.value_or(0)) & 1;
 }
 
