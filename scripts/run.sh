@@ -6,5 +6,5 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 "$root/scripts/deps.sh"
-"$root/scripts/build.sh" release finsd fins fins_load fins_micro
+"$root/scripts/build.sh" release finsd fins fins-bridge fins_load fins_micro
 exec "$root/build/bin/finsd" "$@"  # defaults: 127.0.0.1, port 9600, profile CJ2H

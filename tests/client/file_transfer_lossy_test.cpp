@@ -36,8 +36,8 @@ void put_through_faults(std::uint32_t seed, bool replace) {
     ClientOptions options;
     options.port = proxy.port();
     options.timeout = 50ms;
-    options.retries = 15;  // the most W596 allows: a chunk lost 16 times fails
-    options.sid_quarantine = 250ms;
+    options.retries = 15;             // the most W596 allows: a chunk lost 16 times fails
+    options.sid_quarantine = 1000ms;  // margin for starved threads on a loaded machine
     auto client = Client::connect(options);
     ASSERT_TRUE(client) << client.error().message();
     const auto name = *FileName::from("LOSSY.BIN");

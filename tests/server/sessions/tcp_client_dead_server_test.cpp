@@ -26,6 +26,7 @@
 
 #include "plc/plc.hpp"
 #include "server/frame_builder.hpp"
+#include "server/sessions/io_thread.hpp"
 #include "server/sessions/server.hpp"
 #include "transport/asio.hpp"
 
@@ -98,16 +99,11 @@ class SilentServer {
     std::thread thread_;
 };
 
-struct Node {
+struct Node : IoThread {
     Harness plc;
-    asio::io_context io{1};
     std::unique_ptr<server::Server> server;
-    std::thread thread;
 
-    ~Node() {
-        io.stop();
-        if (thread.joinable()) thread.join();
-    }
+    ~Node() { stop(); }
     void start(std::uint16_t remote_port) {
         server::ServerOptions o;
         o.port = 0;
@@ -119,35 +115,11 @@ struct Node {
         auto started = server::Server::start(io, plc.plc, o);
         ASSERT_TRUE(started.has_value());
         server = std::move(*started);
-        thread = std::thread([this] { io.run(); });
-    }
-    template <typename F>
-    auto on_io(F f) {
-        std::packaged_task<decltype(f())()> task(std::move(f));
-        auto result = task.get_future();
-        asio::post(io, [&task] { task(); });
-        EXPECT_EQ(result.wait_for(std::chrono::seconds(10)), std::future_status::ready);
-        return result.get();
+        start_thread();
     }
     const server::TcpClient& client() { return *server->tcp_clients()[0]; }
-    // Bounded wait until `done` holds on the I/O thread.
-    template <typename F>
-    bool wait(F done) {
-        for (int i = 0; i < 500; ++i) {
-            if (on_io(done)) return true;
-            std::this_thread::sleep_for(std::chrono::milliseconds(10));
-        }
-        return false;
-    }
     server::InstructionResult run(server::InstructionRequest request) {
-        auto done = std::make_shared<std::promise<server::InstructionResult>>();
-        auto result = done->get_future();
-        asio::post(io, [this, request, done] {
-            server->instructions().start(
-                request, [done](const server::InstructionResult& r) { done->set_value(r); });
-        });
-        EXPECT_EQ(result.wait_for(std::chrono::seconds(10)), std::future_status::ready);
-        return result.get();
+        return IoThread::run(*server, std::move(request));
     }
 };
 

@@ -14,6 +14,7 @@
 #include <boost/asio/post.hpp>
 
 #include "plc/plc.hpp"
+#include "server/sessions/io_thread.hpp"
 #include "server/sessions/server.hpp"
 #include "server/sessions/tcp_peer.hpp"
 #include "transport/asio.hpp"
@@ -26,18 +27,13 @@ using server::InstructionRequest;
 using server::InstructionResult;
 
 // Nodes on one I/O thread; every call into them is posted there.
-struct Nodes {
+struct Nodes : IoThread {
     Harness a_plc;
     Harness b_plc;
-    asio::io_context io{1};
     std::unique_ptr<server::Server> a;
     std::unique_ptr<server::Server> b;
-    std::thread thread;
 
-    ~Nodes() {
-        io.stop();
-        if (thread.joinable()) thread.join();
-    }
+    ~Nodes() { stop(); }
     // B: node 5, FINS/TCP only. A: node 1, FINS/UDP off, a client connection to
     // `remote_node` at B's port, allowed `max_connections` FINS/TCP connections.
     void start(std::uint8_t remote_node = 5, std::size_t max_connections = 16) {
@@ -59,35 +55,15 @@ struct Nodes {
         auto a_started = server::Server::start(io, a_plc.plc, oa);
         ASSERT_TRUE(a_started.has_value());
         a = std::move(*a_started);
-        thread = std::thread([this] { io.run(); });
-    }
-    template <typename F>
-    auto on_io(F f) {
-        std::packaged_task<decltype(f())()> task(std::move(f));
-        auto result = task.get_future();
-        asio::post(io, [&task] { task(); });
-        EXPECT_EQ(result.wait_for(std::chrono::seconds(10)), std::future_status::ready);
-        return result.get();
+        start_thread();
     }
     // Bounded wait until A's client connection is up (or is not, `up` false).
     bool wait_client(bool up) {
-        for (int i = 0; i < 500; ++i) {
-            if (on_io([this] { return a->tcp_clients()[0]->established(); }) == up) return true;
-            std::this_thread::sleep_for(std::chrono::milliseconds(10));
-        }
-        return false;
+        return wait([this, up] { return a->tcp_clients()[0]->established() == up; });
     }
     // Runs `request` on A (on B with `on_b`).
     InstructionResult run(InstructionRequest request, bool on_b = false) {
-        auto done = std::make_shared<std::promise<InstructionResult>>();
-        auto result = done->get_future();
-        asio::post(io, [this, request, done, on_b] {
-            (on_b ? b : a)->instructions().start(request, [done](const InstructionResult& r) {
-                done->set_value(r);
-            });
-        });
-        EXPECT_EQ(result.wait_for(std::chrono::seconds(10)), std::future_status::ready);
-        return result.get();
+        return IoThread::run(on_b ? *b : *a, std::move(request));
     }
 };
 
