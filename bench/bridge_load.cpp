@@ -30,6 +30,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "bridge/bridge_processes.hpp"
 #include "fins/commands/memory_area.hpp"
 #include "fins/frame.hpp"
 #include "integration/process.hpp"
@@ -39,17 +40,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using nlohmann::json;
 
-std::uint16_t free_port() {
-    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t len = sizeof a;
-    ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
-    ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
-    ::close(fd);
-    return ntohs(a.sin_port);
-}
+using fins::test::bridge::free_tcp_port;
 
 std::string unit_ip(std::size_t i) {
     return fmt::format("127.0.{}.{}", 40 + i / 250, 1 + i % 250);
@@ -164,7 +155,7 @@ int main(int argc, char** argv) {
         return 1;
     }
 
-    const std::uint16_t mqtt_port = free_port();
+    const std::uint16_t mqtt_port = free_tcp_port();
     std::ofstream(dir / "mosquitto.conf") << fmt::format(
         "log_dest none\npersistence false\nmax_queued_messages 100000\nlistener {} 127.0.0.1\n"
         "allow_anonymous true\n",

@@ -39,10 +39,9 @@ Bridge::Bridge(asio::io_context& io, const BridgeConfig& config,
     std::random_device seed;
     std::size_t index = 0;
     for (const auto& p : config_.plcs) {
-        // Golden-ratio phases: any number of PLCs spreads evenly over the interval.
-        const double phase = std::fmod(static_cast<double>(index++) * 0.6180339887498949, 1.0);
-        pollers_.emplace(p.name, std::make_unique<PlcPoller>(
-                                     io_, p, phase, *this, (std::uint64_t{seed()} << 32) | seed()));
+        pollers_.emplace(p.name,
+                         std::make_unique<PlcPoller>(io_, p, spread_phase(index++), *this,
+                                                     (std::uint64_t{seed()} << 32) | seed()));
     }
     ownership_->on_change([this] { reconcile(); });
 }

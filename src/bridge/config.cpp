@@ -356,7 +356,7 @@ class Loader {
     // Chooses how the tag is read and checks it against the table and the model.
     void resolve(const toml::node& at, Tag& tag) const {
         const Address& a = tag.address;
-        const bool is_bool = tag.type == TagType::boolean;
+        const bool is_bool = tag.type == TagType::bits;
         if (a.bit && !is_bool)
             fail(at, fmt::format("'{}' names a bit: its type must be bool", tag.address_text));
         tag.words = tag_words(tag.type, tag.length);

@@ -50,7 +50,10 @@ void JsonPayload::values(const GroupSample& s, const Sink& out) {
 }
 
 void JsonPayload::status(const PlcStatus& st, const Sink& out) {
-    nlohmann::json j{{"state", st.online ? "online" : "offline"}, {"ts", st.ts_ms}};
+    // The owner: a retained "online" outlives a bridge killed with -9, and is current only
+    // while {prefix}/$bridge/{instance}/status says online too (docs/bridge.md).
+    nlohmann::json j{
+        {"state", st.online ? "online" : "offline"}, {"ts", st.ts_ms}, {"instance", instance_}};
     if (!st.last_error.empty()) j["error"] = st.last_error;
     out({fmt::format("{}/{}/status", prefix_, st.plc->name), j.dump(), 1, true});
 }

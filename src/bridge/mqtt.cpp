@@ -3,10 +3,11 @@
 #include <mosquitto.h>
 
 #include <algorithm>
-#include <cmath>
 #include <random>
 
 #include <spdlog/spdlog.h>
+
+#include "bridge/poll_schedule.hpp"
 
 namespace fins::bridge {
 
@@ -85,9 +86,9 @@ bool MqttClient::wait(std::chrono::milliseconds d) {
 }
 
 void MqttClient::loop() {
-    std::mt19937_64 random(std::random_device{}());
+    Backoff backoff(config_.backoff_min, config_.backoff_max,
+                    (std::uint64_t{std::random_device{}()} << 32) | std::random_device{}());
     std::size_t broker = 0;
-    unsigned attempt = 0;
     const auto closing = [this] {
         std::lock_guard lock(mutex_);
         return closing_;
@@ -129,16 +130,11 @@ void MqttClient::loop() {
         if (accepted_ && handlers_.disconnected) handlers_.disconnected();
         if (closing()) return;
         if (accepted_) {
-            attempt = 0;  // a lost session: the same broker first
+            backoff.reset();  // a lost session: the same broker first
         } else {
             ++broker;  // refused or unreachable: the next one
         }
-        const double cap = std::min<double>(static_cast<double>(config_.backoff_max.count()),
-                                            static_cast<double>(config_.backoff_min.count()) *
-                                                std::pow(2.0, std::min(attempt, 30u)));
-        ++attempt;
-        std::uniform_real_distribution<double> jitter(0.0, cap);
-        if (!wait(std::chrono::milliseconds(static_cast<std::int64_t>(jitter(random))))) return;
+        if (!wait(backoff.next())) return;
     }
 }
 

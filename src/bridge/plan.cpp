@@ -57,10 +57,20 @@ Plan plan_group(std::span<const Tag> tags, std::size_t gap_words) {
         runs.push_back({t.read_start.area_code, first, end, {i}});
     }
 
-    // A run of one tag of at most two words is a scattered point.
+    // A run of one tag of at most two words is a scattered point, and so is a run of one
+    // word (the bits of one word: CIO0.00-0.15) and every flag: they share 01 04 frames
+    // instead of taking a frame each.
+    struct Point {
+        MemoryAddress start;      // a flag: its element
+        std::uint32_t words = 0;  // 0: a flag (one element)
+        std::vector<std::size_t> tags;
+    };
+    std::vector<Point> points;
+    for (std::size_t i : scattered)
+        points.push_back({tags[i].read_start, 0, {i}});
     for (auto& r : runs) {
-        if (r.tags.size() == 1 && r.end - r.first <= 2) {
-            scattered.push_back(r.tags.front());
+        if ((r.tags.size() == 1 && r.end - r.first <= 2) || r.end - r.first == 1) {
+            points.push_back({word_at(r.code, r.first), r.end - r.first, r.tags});
             continue;
         }
         PlannedFrame f;
@@ -74,33 +84,43 @@ Plan plan_group(std::span<const Tag> tags, std::size_t gap_words) {
         plan.frames.push_back(std::move(f));
     }
 
-    // Scattered points in file order, packed 167 elements a frame.
-    std::sort(scattered.begin(), scattered.end());
+    // Scattered points in file order (of their first tag), packed 167 elements a frame.
+    std::sort(points.begin(), points.end(), [](const Point& x, const Point& y) {
+        return *std::min_element(x.tags.begin(), x.tags.end()) <
+               *std::min_element(y.tags.begin(), y.tags.end());
+    });
     std::size_t at = 0;
-    while (at < scattered.size()) {
+    while (at < points.size()) {
         PlannedFrame f;
         f.kind = PlannedFrame::Kind::multiple_read;
         const auto index = static_cast<std::uint16_t>(plan.frames.size());
-        while (at < scattered.size()) {
-            const Tag& t = tags[scattered[at]];
-            const std::size_t n = t.flag ? 1 : t.words;
+        std::size_t in_frame = 0;
+        while (at < points.size()) {
+            const Point& p = points[at];
+            const std::size_t n = p.words == 0 ? 1 : p.words;
             if (f.items.size() + n > max_multiple_read_elements) break;
-            plan.slots[scattered[at]] = {index, static_cast<std::uint16_t>(f.items.size())};
-            for (std::size_t k = 0; k < n; ++k)
-                f.items.push_back(word_at(t.read_start.area_code,
-                                          t.read_start.word + static_cast<std::uint32_t>(k)));
-            if (t.flag) f.items.back() = t.read_start;
-            f.tags.push_back(scattered[at]);
+            for (std::size_t i : p.tags)
+                plan.slots[i] = {index,
+                                 static_cast<std::uint16_t>(
+                                     f.items.size() + tags[i].read_start.word -
+                                     (p.words == 0 ? tags[i].read_start.word : p.start.word))};
+            if (p.words == 0) f.items.push_back(p.start);
+            for (std::uint32_t k = 0; k < p.words; ++k)
+                f.items.push_back(word_at(p.start.area_code, p.start.word + k));
+            f.tags.insert(f.tags.end(), p.tags.begin(), p.tags.end());
             ++at;
+            ++in_frame;
         }
-        if (f.tags.size() == 1 && !tags[f.tags.front()].flag) {
-            // One word tag: a plain read says the same in a shorter answer.
-            const Tag& t = tags[f.tags.front()];
+        if (in_frame == 1 && points[at - 1].words != 0) {
+            // One word point: a plain read says the same in a shorter answer.
+            const Point& p = points[at - 1];
             f.kind = PlannedFrame::Kind::read;
-            f.start = t.read_start;
-            f.count = static_cast<std::uint16_t>(t.words);
+            f.start = p.start;
+            f.count = static_cast<std::uint16_t>(p.words);
             f.items.clear();
-            plan.slots[f.tags.front()] = {index, 0};
+            for (std::size_t i : p.tags)
+                plan.slots[i] = {
+                    index, static_cast<std::uint16_t>(tags[i].read_start.word - p.start.word)};
         }
         plan.frames.push_back(std::move(f));
     }

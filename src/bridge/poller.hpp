@@ -9,6 +9,9 @@
 // - Window: at most Plc::window frames in flight; the rest of a cycle waits in a queue
 //   bounded by the group's frame count (one cycle per group at a time) plus
 //   max_pending_writes writes.
+// - Answers (request_window.hpp): matched by service ID, source node and command code; a
+//   SID is not reused for 2 x timeout after its frame was answered or given up, so a late
+//   or duplicated answer never completes another request.
 // - Timeouts: a frame unanswered after Plc::timeout is sent again with a new service ID
 //   (Plc::retries times); then it fails with ClientError::timeout and the PLC is offline.
 // - Offline: every queued frame fails at once, writes are refused, the status says
@@ -23,7 +26,6 @@
 #include <deque>
 #include <memory>
 #include <optional>
-#include <random>
 #include <string>
 #include <vector>
 
@@ -35,6 +37,8 @@
 #include "bridge/config.hpp"
 #include "bridge/payload.hpp"
 #include "bridge/plan.hpp"
+#include "bridge/poll_schedule.hpp"
+#include "bridge/request_window.hpp"
 #include "fins/frame.hpp"
 #include "transport/asio.hpp"
 
@@ -90,17 +94,6 @@ class PlcPoller {
   private:
     enum class State : std::uint8_t { stopped, connecting, online, offline };
     struct GroupState;
-    struct WriteOp;
-    struct Request {
-        enum class Kind : std::uint8_t { group_frame, write, read_back, probe, handshake };
-        Kind kind = Kind::group_frame;
-        std::size_t group = 0;
-        std::size_t frame = 0;
-        WriteOp* op = nullptr;
-        std::uint8_t service_id = 0;
-        unsigned attempts = 0;
-        std::chrono::steady_clock::time_point deadline{};
-    };
 
     void open();
     void tcp_connect();
@@ -117,7 +110,8 @@ class PlcPoller {
     void on_timeout();
     void complete(Request& r, const ResponseView* response, std::error_code error);
     void finish_group(std::size_t group);
-    void finish_write(WriteOp& op, std::error_code error, const ResponseView* response);
+    void write_answered(Request& r, const ResponseView* response, std::error_code failure);
+    void finish_write(PendingWrite& op, std::error_code error, const ResponseView* response);
     void go_online();
     void go_offline(std::error_code why);
     void close_socket();
@@ -128,7 +122,6 @@ class PlcPoller {
     const Plc& plc_;
     double phase_;
     PollerEvents& events_;
-    std::mt19937_64 random_;
     State state_ = State::stopped;
     bool running_ = false;
     std::uint64_t generation_ = 0;         // handlers of an older start/connection return early
@@ -150,12 +143,12 @@ class PlcPoller {
 
     std::vector<std::unique_ptr<GroupState>> groups_;
     std::deque<Request> ready_;
-    std::vector<Request> in_flight_;
-    std::deque<std::unique_ptr<WriteOp>> writes_;
-    std::uint8_t next_service_id_ = 0;
+    RequestWindow window_;
+    std::vector<Request> expired_;  // on_timeout's scratch
+    std::deque<std::unique_ptr<PendingWrite>> writes_;
     asio::steady_timer timeout_timer_;
     asio::steady_timer backoff_timer_;
-    unsigned backoff_attempt_ = 0;
+    Backoff backoff_;
     std::string last_error_;
     PollerStats stats_;
 };

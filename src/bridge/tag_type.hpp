@@ -1,33 +1,26 @@
-// The value types a bridge tag can have: the names of `fins --as` (int16 ... string) plus
-// bool for a single bit or a T/C/TK flag. Words are converted with libfins' values.hpp
-// (Omron word order, least significant word first), the one place that knows it.
+// The value types a bridge tag can have are the value formats of src/typed (`fins --as`,
+// the web API's `as`): int16 ... bcd32, string, and bool (Format::bits) for a single bit
+// or a T/C/TK flag. Names, sizes, ranges and the word <-> JSON conversions live there;
+// this adds what only the bridge has: a tag's value as kept between polls (with a
+// string's text) and a write value checked against the tag's min/max.
 #pragma once
 
 #include <array>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
-#include <span>
 #include <string>
 #include <string_view>
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "typed/value_format.hpp"
+
 namespace fins::bridge {
 
-enum class TagType : std::uint8_t {
-    boolean,  // "bool": a bit (CIO0.00) or a completion/task flag (T5, TK2)
-    int16,
-    uint16,
-    int32,
-    uint32,
-    float32,  // "float"
-    float64,  // "double"
-    bcd,      // one word, 0-9999
-    bcd32,    // two words, 0-99999999
-    string,   // `length` characters, two a word
-};
+using TagType = typed::Format;
 
+// The types a tag may have (every format but hex): "bool" for bits.
 std::optional<TagType> parse_tag_type(std::string_view name);
 std::string_view tag_type_name(TagType t);
 // "bool, int16, ..." for error messages.
@@ -43,7 +36,7 @@ struct TagValue {
     bool operator==(const TagValue&) const = default;
 };
 
-// The value as a double (for deadbands); strings give 0.
+// The value as a double (for deadbands); strings and non-BCD words give 0.
 double numeric(TagType t, const TagValue& v);
 // Appends the JSON form of the value (true, 12, 1.5, "abc") to out.
 void append_json(std::string& out, TagType t, const TagValue& v);

@@ -1,10 +1,13 @@
 #include "typed/value_format.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <iterator>
+#include <limits>
 #include <span>
 
-#include <fmt/core.h>
+#include <fmt/format.h>
 
 #include "fins/values.hpp"
 
@@ -21,8 +24,8 @@ struct FormatRow {
 constexpr FormatRow formats[] = {
     {Format::int16, "int16", 1},   {Format::uint16, "uint16", 1}, {Format::int32, "int32", 2},
     {Format::uint32, "uint32", 2}, {Format::float32, "float", 2}, {Format::float64, "double", 4},
-    {Format::bcd, "bcd", 1},       {Format::string, "string", 1}, {Format::bits, "bits", 0},
-    {Format::hex, "hex", 1},
+    {Format::bcd, "bcd", 1},       {Format::bcd32, "bcd32", 2},   {Format::string, "string", 1},
+    {Format::bits, "bits", 0},     {Format::hex, "hex", 1},
 };
 
 template <class T>
@@ -141,6 +144,12 @@ Result<std::vector<Printed>> print_words(Format f, const std::vector<std::uint16
                 out.push_back(number(*v));
                 break;
             }
+            case Format::bcd32: {
+                auto v = words_to_bcd32(w);
+                if (!v) return Unexpected(v.error());
+                out.push_back(number(*v));
+                break;
+            }
             case Format::string:
             case Format::bits:
                 break;
@@ -209,6 +218,13 @@ std::variant<std::vector<std::uint16_t>, ParseError> parse_words(
                 append(out, *w);
                 break;
             }
+            case Format::bcd32: {
+                auto x = parse_integer<std::uint32_t>(v);
+                auto w = x ? bcd32_to_words(*x) : Result<std::array<std::uint16_t, 2>>{};
+                if (!x || !w) return ParseError{fmt::format("'{}' is not BCD 0-99999999", v)};
+                append(out, *w);
+                break;
+            }
             case Format::bits: {
                 auto b = parse_bit(v);
                 if (!b) return ParseError{fmt::format("'{}' is not a bit (0/1/on/off)", v)};
@@ -220,6 +236,172 @@ std::variant<std::vector<std::uint16_t>, ParseError> parse_words(
         }
     }
     return out;
+}
+
+std::optional<std::pair<double, double>> integer_range(Format f) noexcept {
+    switch (f) {
+        case Format::int16:
+            return std::pair{-32768.0, 32767.0};
+        case Format::uint16:
+        case Format::hex:
+            return std::pair{0.0, 65535.0};
+        case Format::int32:
+            return std::pair{-2147483648.0, 2147483647.0};
+        case Format::uint32:
+            return std::pair{0.0, 4294967295.0};
+        case Format::bcd:
+            return std::pair{0.0, 9999.0};
+        case Format::bcd32:
+            return std::pair{0.0, 99999999.0};
+        case Format::bits:
+            return std::pair{0.0, 1.0};
+        case Format::float32:
+        case Format::float64:
+        case Format::string:
+            break;
+    }
+    return std::nullopt;
+}
+
+std::optional<double> to_number(Format f, Words w) noexcept {
+    const auto as = [](auto r) -> std::optional<double> {
+        if (!r) return std::nullopt;
+        return static_cast<double>(*r);
+    };
+    switch (f) {
+        case Format::bits:
+            return w[0] != 0 ? 1.0 : 0.0;
+        case Format::int16:
+            return as(words_to_int16(w.first(1)));
+        case Format::uint16:
+        case Format::hex:
+            return w[0];
+        case Format::int32:
+            return as(words_to_int32(w.first(2)));
+        case Format::uint32:
+            return as(words_to_uint32(w.first(2)));
+        case Format::float32:
+            return as(words_to_float(w.first(2)));
+        case Format::float64:
+            return as(words_to_double(w.first(4)));
+        case Format::bcd:
+            return as(words_to_bcd16(w.first(1)));
+        case Format::bcd32:
+            return as(words_to_bcd32(w.first(2)));
+        case Format::string:
+            break;
+    }
+    return std::nullopt;
+}
+
+void append_json(std::string& out, Format f, Words w) {
+    auto it = std::back_inserter(out);
+    switch (f) {
+        case Format::bits:
+            out += w[0] != 0 ? "true" : "false";
+            return;
+        case Format::int16:
+            fmt::format_to(it, "{}", static_cast<std::int16_t>(w[0]));
+            return;
+        case Format::uint16:
+        case Format::hex:
+            fmt::format_to(it, "{}", w[0]);
+            return;
+        case Format::int32:
+            fmt::format_to(it, "{}", words_to_int32(w.first(2)).value_or(0));
+            return;
+        case Format::uint32:
+            fmt::format_to(it, "{}", words_to_uint32(w.first(2)).value_or(0));
+            return;
+        case Format::float32: {
+            const float v = words_to_float(w.first(2)).value_or(0);
+            // JSON has no NaN or infinity.
+            if (std::isfinite(v))
+                fmt::format_to(it, "{}", v);
+            else
+                out += "null";
+            return;
+        }
+        case Format::float64: {
+            const double v = words_to_double(w.first(4)).value_or(0);
+            if (std::isfinite(v))
+                fmt::format_to(it, "{}", v);
+            else
+                out += "null";
+            return;
+        }
+        case Format::bcd:
+        case Format::bcd32: {
+            const auto v = to_number(f, w);
+            if (v)
+                fmt::format_to(it, "{}", static_cast<std::uint32_t>(*v));
+            else
+                out += "null";
+            return;
+        }
+        case Format::string:
+            out += "null";
+            return;
+    }
+}
+
+std::optional<std::string> json_to_words(Format f, const nlohmann::json& value,
+                                         std::array<std::uint16_t, 4>& words) {
+    const auto name = f == Format::bits ? std::string_view("bool") : format_name(f);
+    const auto put = [&words](const auto& w) { std::copy(w.begin(), w.end(), words.begin()); };
+    if (f == Format::string) return "a string is not one fixed-size value";
+    if (f == Format::bits) {
+        if (value.is_boolean())
+            words[0] = value.get<bool>() ? 1 : 0;
+        else if (value.is_number_integer() &&
+                 (value.get<std::int64_t>() == 0 || value.get<std::int64_t>() == 1))
+            words[0] = static_cast<std::uint16_t>(value.get<std::int64_t>());
+        else
+            return std::string("bool needs true, false, 0 or 1");
+        return std::nullopt;
+    }
+    if (!value.is_number()) return fmt::format("{} needs a JSON number", name);
+    const double d = value.get<double>();
+    if (auto r = integer_range(f)) {
+        if (!value.is_number_integer())
+            return fmt::format("{} needs an integer, not {}", name, value.dump());
+        if (d < r->first || d > r->second)
+            return fmt::format("{} is out of range for {} ({} to {})", value.dump(), name, r->first,
+                               r->second);
+    } else if (f == Format::float32 && std::abs(d) > std::numeric_limits<float>::max()) {
+        return fmt::format("{} is out of range for float", value.dump());
+    }
+    switch (f) {
+        case Format::int16:
+            put(int16_to_words(value.get<std::int16_t>()));
+            break;
+        case Format::uint16:
+        case Format::hex:
+            put(uint16_to_words(value.get<std::uint16_t>()));
+            break;
+        case Format::int32:
+            put(int32_to_words(value.get<std::int32_t>()));
+            break;
+        case Format::uint32:
+            put(uint32_to_words(value.get<std::uint32_t>()));
+            break;
+        case Format::float32:
+            put(float_to_words(static_cast<float>(d)));
+            break;
+        case Format::float64:
+            put(double_to_words(d));
+            break;
+        case Format::bcd:
+            put(*bcd16_to_words(value.get<std::uint16_t>()));
+            break;
+        case Format::bcd32:
+            put(*bcd32_to_words(value.get<std::uint32_t>()));
+            break;
+        case Format::string:
+        case Format::bits:
+            break;
+    }
+    return std::nullopt;
 }
 
 }  // namespace fins::typed

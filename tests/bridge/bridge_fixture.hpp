@@ -22,6 +22,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "bridge/bridge_processes.hpp"
 #include "integration/finsd_run.hpp"
 
 namespace fins::bridge::test {
@@ -29,30 +30,13 @@ namespace fins::bridge::test {
 using fins::test::Child;
 using fins::test::ScratchDir;
 
-inline const std::string bridge_path = std::string(FINS_BIN_DIR) + "/fins-bridge";
-
-// A TCP port nobody listens on right now (bound to port 0 and released).
+using fins::test::bridge::bridge_path;
+using fins::test::bridge::Proc;
 inline std::uint16_t free_port() {
-    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t len = sizeof a;
-    ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
-    ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
-    ::close(fd);
-    return ntohs(a.sin_port);
+    return fins::test::bridge::free_tcp_port();
 }
-
 inline bool accepts(std::uint16_t port) {
-    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    a.sin_port = htons(port);
-    const bool ok = ::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
-    ::close(fd);
-    return ok;
+    return fins::test::bridge::tcp_connectable(port);
 }
 
 inline int shell(const std::string& command) {
@@ -87,8 +71,8 @@ class Mosquitto {
                 (extra.find("password_file") == std::string::npos ? "allow_anonymous true\n"
                                                                   : "allow_anonymous false\n") +
                 extra);
-        child_ =
-            std::make_unique<Child>(std::vector<std::string>{"/usr/sbin/mosquitto", "-c", conf});
+        child_ = std::make_unique<Proc>(std::vector<std::string>{"/usr/sbin/mosquitto", "-c", conf},
+                                        conf + ".log");
         const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
         while (std::chrono::steady_clock::now() < deadline && !accepts(port_))
             std::this_thread::sleep_for(std::chrono::milliseconds(20));
@@ -96,11 +80,11 @@ class Mosquitto {
     }
     [[nodiscard]] bool started() const { return started_; }
     [[nodiscard]] std::uint16_t port() const { return port_; }
-    void kill() { child_->terminate(SIGKILL), child_->wait(std::chrono::seconds(10)); }
+    void kill() { child_->kill(SIGKILL); }
 
   private:
     std::uint16_t port_;
-    std::unique_ptr<Child> child_;
+    std::unique_ptr<Proc> child_;
     bool started_ = false;
 };
 
@@ -218,16 +202,21 @@ class BridgeProcess {
         std::vector<std::string> argv{bridge_path, "--config",   file,  "--log-level",
                                       "warn",      "--instance", "test"};
         argv.insert(argv.end(), extra.begin(), extra.end());
-        child_ = std::make_unique<Child>(argv);
+        child_ = std::make_unique<Proc>(argv, file + ".log");
     }
-    fins::test::RunResult stop(int signal = SIGTERM) {
-        child_->terminate(signal);
-        return child_->wait(std::chrono::seconds(20));
+    // Stops it (SIGKILL after 20 s); its exit status and what it logged.
+    struct Stopped {
+        int exit_code = -1;  // 128 + signal when killed by one
+        std::string err;
+    };
+    Stopped stop(int signal = SIGTERM) {
+        const int status = child_->kill(signal, std::chrono::seconds(20));
+        return {status, child_->log()};
     }
-    Child& child() { return *child_; }
+    Proc& child() { return *child_; }
 
   private:
-    std::unique_ptr<Child> child_;
+    std::unique_ptr<Proc> child_;
 };
 
 inline std::string mqtt_section(std::uint16_t port, const std::string& extra = "") {

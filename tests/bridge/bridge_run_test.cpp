@@ -106,6 +106,30 @@ TEST(BridgeRun, PublishesStatusSnapshotAndThenOnlyChanges) {
     EXPECT_EQ(change->json()["values"]["far"], 77);
 }
 
+// kill -9: nothing can publish the PLC's status offline, so its retained "online" stays.
+// It names its owner, and the owner's retained status (the Will) says offline: together
+// they tell a consumer that nobody polls the PLC (docs/bridge.md, "Topics and payloads").
+TEST(BridgeRun, AKilledBridgesPlcStatusNamesItsOwnerWhoseStatusSaysOffline) {
+    Rig rig;
+    ASSERT_TRUE(rig.ready());
+    auto status =
+        rig.sub.wait_topic("t/press1/status", [](const json& j) { return j["state"] == "online"; });
+    ASSERT_TRUE(status);
+    EXPECT_EQ(status->json()["instance"], "test");
+    rig.bridge->stop(SIGKILL);
+    Subscriber later(rig.broker.port(), "t/#");
+    ASSERT_TRUE(later.connected());
+    auto owner = later.wait_topic("t/$bridge/test/status",
+                                  [](const json& j) { return j["state"] == "offline"; });
+    ASSERT_TRUE(owner);
+    EXPECT_TRUE(owner->retain);
+    auto stale = later.wait_topic("t/press1/status", [](const json&) { return true; });
+    ASSERT_TRUE(stale);
+    EXPECT_TRUE(stale->retain);
+    EXPECT_EQ(stale->json()["state"], "online");
+    EXPECT_EQ(stale->json()["instance"], "test");
+}
+
 TEST(BridgeRun, WritesAreCheckedExecutedOnceAndReadBack) {
     Rig rig;
     ASSERT_TRUE(rig.ready());

@@ -38,7 +38,7 @@ tags = [ { name = "speed", address = "D100", type = "int16" },
     const auto& g = c.plcs[0].groups[0];
     EXPECT_EQ(g.interval.count(), 100);
     ASSERT_EQ(g.tags.size(), 3u);
-    EXPECT_EQ(g.tags[1].type, TagType::boolean);
+    EXPECT_EQ(g.tags[1].type, TagType::bits);
     EXPECT_EQ(g.tags[1].read_start, (MemoryAddress{0xB0, 0, 0}));
     EXPECT_TRUE(g.tags[2].writable);
     EXPECT_EQ(g.tags[2].words, 2u);

@@ -89,9 +89,9 @@ TEST(TagType, WriteValuesAreTypeAndRangeChecked) {
     EXPECT_TRUE(encode_value(TagType::float32, 0, {0.0, 10.0}, 11, e));
     EXPECT_TRUE(encode_value(TagType::float32, 0, {0.0, 10.0}, -0.5, e));
     EXPECT_FALSE(encode_value(TagType::float32, 0, {0.0, 10.0}, 10, e));
-    EXPECT_FALSE(encode_value(TagType::boolean, 0, {}, true, e));
+    EXPECT_FALSE(encode_value(TagType::bits, 0, {}, true, e));
     EXPECT_TRUE(e.bit);
-    EXPECT_TRUE(encode_value(TagType::boolean, 0, {}, 2, e));
+    EXPECT_TRUE(encode_value(TagType::bits, 0, {}, 2, e));
     EXPECT_TRUE(encode_value(TagType::string, 4, {}, "abcde", e));
     EXPECT_TRUE(encode_value(TagType::string, 4, {}, 12, e));
     EXPECT_FALSE(encode_value(TagType::string, 4, {}, "abcd", e));

@@ -107,6 +107,30 @@ TEST(Plan, BitsOfOneWordShareTheRead) {
     EXPECT_EQ(p.slots[2].offset, 1);
 }
 
+TEST(Plan, TheBitsOfOneWordShareTheScatteredPointsFrame) {
+    // fins_bridge_load's group: 10 bits of CIO0 and two scattered words were three frames
+    // (01 01 x 1 word, 01 04); the word of bits is one more 01 04 element.
+    auto p = plan_of(tag("r0", "CIO0.00", "bool") + tag("r1", "CIO0.01", "bool") +
+                     tag("r9", "CIO0.09", "bool") + tag("x", "D1000", "int16") +
+                     tag("y", "D1100", "int16"));
+    ASSERT_EQ(p.frames.size(), 1u);
+    ASSERT_EQ(p.frames[0].kind, PlannedFrame::Kind::multiple_read);
+    ASSERT_EQ(p.frames[0].items.size(), 3u);
+    EXPECT_EQ(p.frames[0].items[0], (MemoryAddress{0xB0, 0, 0}));  // CIO word
+    // Every bit points at the one element of its word.
+    EXPECT_EQ(p.slots[0].offset, 0);
+    EXPECT_EQ(p.slots[1].offset, 0);
+    EXPECT_EQ(p.slots[2].offset, 0);
+    EXPECT_EQ(p.slots[3].offset, 1);
+    EXPECT_EQ(p.slots[4].offset, 2);
+    // The word of bits alone is still a plain read.
+    auto alone = plan_of(tag("r0", "CIO0.00", "bool") + tag("r1", "CIO0.01", "bool"));
+    ASSERT_EQ(alone.frames.size(), 1u);
+    EXPECT_EQ(alone.frames[0].kind, PlannedFrame::Kind::read);
+    EXPECT_EQ(alone.frames[0].count, 1);
+    EXPECT_EQ(alone.slots[1].offset, 0);
+}
+
 TEST(Plan, DescribeNamesEveryFrameAndTag) {
     const auto tags = tag("a", "D100", "int16") + tag("b", "D101", "int16") +
                       tag("c", "D9000", "int16") + tag("d", "T5", "bool");

@@ -37,11 +37,12 @@ nlohmann::json to_json(const MetricValue& v) {
 
 DataType datatype_of(TagType t) noexcept {
     switch (t) {
-        case TagType::boolean:
+        case TagType::bits:
             return pb::Boolean;
         case TagType::int16:
             return pb::Int16;
         case TagType::uint16:
+        case TagType::hex:  // not a tag type (parse_tag_type refuses it)
             return pb::UInt16;
         case TagType::int32:
             return pb::Int32;
@@ -64,11 +65,12 @@ DataType datatype_of(TagType t) noexcept {
 MetricValue to_metric_value(TagType t, const TagValue& v) {
     const std::span<const std::uint16_t> w{v.words};
     switch (t) {
-        case TagType::boolean:
+        case TagType::bits:
             return v.words[0] != 0;
         case TagType::int16:
             return std::int64_t{static_cast<std::int16_t>(v.words[0])};
         case TagType::uint16:
+        case TagType::hex:
             return std::uint64_t{v.words[0]};
         case TagType::int32:
             return std::int64_t{words_to_int32(w.first(2)).value_or(0)};

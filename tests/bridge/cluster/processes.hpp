@@ -1,8 +1,7 @@
 // Real parts for the Sparkplug and multi-instance tests: a mosquitto broker on a free loopback
-// port, fins-bridge processes (logs to a file, so a chatty child never blocks on a full pipe),
-// an MQTT recorder (libmosquitto) and a UDP relay in front of finsd that counts the requests
-// of each sender (which instance polls which PLC). Every wait is bounded; children die with
-// the test (PR_SET_PDEATHSIG) and are killed by their destructor.
+// port, an MQTT recorder (libmosquitto) and a UDP relay in front of finsd that counts the
+// requests of each sender (which instance polls which PLC). Child processes and ports are
+// bridge_processes.hpp's. Every wait is bounded.
 #pragma once
 
 #include <arpa/inet.h>
@@ -31,118 +30,11 @@
 #include <thread>
 #include <vector>
 
+#include "bridge/bridge_processes.hpp"
+
 namespace fins::test::bridge {
 
 using namespace std::chrono_literals;
-
-inline const std::string bridge_path = std::string(FINS_BIN_DIR) + "/fins-bridge";
-inline const std::string finsd_exe = std::string(FINS_BIN_DIR) + "/finsd";
-
-inline bool have_program(const std::string& path) {
-    return ::access(path.c_str(), X_OK) == 0;
-}
-inline std::string mosquitto_path() {
-    for (const char* p : {"/usr/sbin/mosquitto", "/usr/bin/mosquitto"})
-        if (have_program(p)) return p;
-    return {};
-}
-
-// A loopback port that was free a moment ago (the kernel's choice).
-inline std::uint16_t free_tcp_port() {
-    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    a.sin_port = 0;
-    socklen_t len = sizeof a;
-    if (::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0 ||
-        ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) != 0) {
-        ::close(fd);
-        return 0;
-    }
-    ::close(fd);
-    return ntohs(a.sin_port);
-}
-
-inline bool tcp_connectable(std::uint16_t port) {
-    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    a.sin_port = htons(port);
-    const bool ok = ::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
-    ::close(fd);
-    return ok;
-}
-
-// A child process whose stdout and stderr go to `log`.
-class Proc {
-  public:
-    Proc(const std::vector<std::string>& argv, const std::filesystem::path& log) : log_(log) {
-        const pid_t parent = ::getpid();
-        pid_ = ::fork();
-        if (pid_ == 0) {
-            if (::prctl(PR_SET_PDEATHSIG, SIGKILL) != 0 || ::getppid() != parent) ::_exit(127);
-            const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-            if (fd >= 0) {
-                ::dup2(fd, 1);
-                ::dup2(fd, 2);
-                ::close(fd);
-            }
-            std::vector<char*> args;
-            for (const auto& a : argv)
-                args.push_back(const_cast<char*>(a.c_str()));
-            args.push_back(nullptr);
-            ::execv(args[0], args.data());
-            ::_exit(127);
-        }
-    }
-    ~Proc() { kill(SIGKILL); }
-    Proc(const Proc&) = delete;
-    Proc& operator=(const Proc&) = delete;
-
-    // Sends `sig` and reaps the child (bounded: SIGKILL after `timeout`). The exit status.
-    int kill(int sig, std::chrono::milliseconds timeout = 10s) {
-        if (pid_ <= 0 || reaped_) return status_;
-        ::kill(pid_, sig);
-        const auto deadline = std::chrono::steady_clock::now() + timeout;
-        int st = 0;
-        while (::waitpid(pid_, &st, WNOHANG) == 0) {
-            if (std::chrono::steady_clock::now() > deadline) {
-                ::kill(pid_, SIGKILL);
-                ::waitpid(pid_, &st, 0);
-                break;
-            }
-            std::this_thread::sleep_for(10ms);
-        }
-        reaped_ = true;
-        status_ = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
-        return status_;
-    }
-    [[nodiscard]] pid_t pid() const { return pid_; }
-    bool running() {
-        if (pid_ <= 0 || reaped_) return false;
-        int st = 0;
-        if (::waitpid(pid_, &st, WNOHANG) == pid_) {
-            reaped_ = true;
-            status_ = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
-            return false;
-        }
-        return true;
-    }
-    std::string log() const {
-        std::ifstream in(log_);
-        std::stringstream s;
-        s << in.rdbuf();
-        return s.str();
-    }
-
-  private:
-    std::filesystem::path log_;
-    pid_t pid_ = -1;
-    bool reaped_ = false;
-    int status_ = -1;
-};
 
 // mosquitto on 127.0.0.1:<free port>, anonymous, no persistence.
 class Mosquitto {

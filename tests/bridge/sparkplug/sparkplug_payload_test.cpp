@@ -42,7 +42,7 @@ TEST(SparkplugPayload, TagValuesBecomeMetricValuesOfTheirDatatype) {
     v.words = {0x12AB, 0, 0, 0};  // not BCD: no number at all
     EXPECT_TRUE(std::holds_alternative<std::monostate>(sp::to_metric_value(fb::TagType::bcd, v)));
     EXPECT_EQ(sp::datatype_of(fb::TagType::float64), pb::Double);
-    EXPECT_EQ(sp::datatype_of(fb::TagType::boolean), pb::Boolean);
+    EXPECT_EQ(sp::datatype_of(fb::TagType::bits), pb::Boolean);
 }
 
 TEST(SparkplugPayload, BirthThenDataOfAPolledGroup) {

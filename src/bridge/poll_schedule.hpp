@@ -1,0 +1,68 @@
+// When a poller acts: the drift-free tick grid of a group, the start phases spread over
+// the interval, and the back-off with full jitter before an offline PLC (or a lost
+// broker) is tried again. Pure: the time is always passed in, so the tests use an
+// invented clock.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <random>
+
+namespace fins::bridge {
+
+// Tick k of a group is at start + phase x interval + k x interval, whatever the ticks
+// before it cost: lateness never accumulates. A tick that comes when the grid point
+// after it has already passed skips the missed points and counts them.
+class TickGrid {
+  public:
+    using Clock = std::chrono::steady_clock;
+    TickGrid() = default;
+    TickGrid(Clock::time_point start, Clock::duration interval, double phase) noexcept
+        : interval_(interval),
+          next_(start + std::chrono::duration_cast<Clock::duration>(interval * phase)) {}
+
+    // The time the next tick is due.
+    [[nodiscard]] Clock::time_point next() const noexcept { return next_; }
+    // The tick due at next() runs at `now`: moves next() to the first grid point after
+    // `now` and returns how many grid points were skipped (overruns).
+    std::uint64_t advance(Clock::time_point now) noexcept {
+        next_ += interval_;
+        if (next_ > now) return 0;
+        const auto missed = (now - next_) / interval_ + 1;
+        next_ += interval_ * missed;
+        return static_cast<std::uint64_t>(missed);
+    }
+
+  private:
+    Clock::duration interval_{1};
+    Clock::time_point next_{};
+};
+
+// The start phase in [0, 1) of the index-th poller: golden-ratio steps, so that any
+// number of pollers spreads evenly over the interval (no two within 1/n of each other's
+// neighbours by more than a factor of ~2.6, whatever n is).
+double spread_phase(std::size_t index) noexcept;
+
+// Full jitter: the n-th retry (n = 0, 1, ...) waits uniform(0, min(max, min x 2^n)), so
+// that a thousand PLCs (or bridges) coming back do not retry in step.
+class Backoff {
+  public:
+    Backoff(std::chrono::milliseconds min, std::chrono::milliseconds max,
+            std::uint64_t seed) noexcept
+        : min_(min), max_(max), random_(seed) {}
+    // The wait before the next try; each call counts one more failed try.
+    std::chrono::milliseconds next();
+    // The upper bound of the wait after `attempt` failed tries.
+    [[nodiscard]] std::chrono::milliseconds cap(unsigned attempt) const noexcept;
+    void reset() noexcept { attempt_ = 0; }
+    [[nodiscard]] unsigned attempt() const noexcept { return attempt_; }
+
+  private:
+    std::chrono::milliseconds min_;
+    std::chrono::milliseconds max_;
+    std::mt19937_64 random_;
+    unsigned attempt_ = 0;
+};
+
+}  // namespace fins::bridge
