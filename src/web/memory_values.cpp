@@ -29,10 +29,11 @@ ApiResult<ValueQuery> classify(std::string_view address, std::string_view as, bo
     if (!start) return tl::unexpected(bad(fmt::format("{}: {}", address, start.error().message())));
     auto format = typed::parse_format(q.as);
     if (!format)
-        return tl::unexpected(bad(fmt::format(
-            "as={}: not a format (uint16, int16, uint32, int32, float, double, bcd, hex, bits, "
-            "ascii, bool)",
-            q.as)));
+        return tl::unexpected(
+            bad(fmt::format("as={}: not a format (uint16, int16, uint32, int32, float, double, "
+                            "bcd, bcd32, hex, bits, "
+                            "ascii, bool)",
+                            q.as)));
     q.start = *start;
     q.format = *format;
     const Format f = *format;
