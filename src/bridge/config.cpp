@@ -2,6 +2,7 @@
 // carrying "file:line:col: message" and turned into the error result at the top: the
 // loader is not on any hot path and this keeps every check one line.
 #include "bridge/config.hpp"
+#include "bridge/config_loader.hpp"
 
 #include <unistd.h>
 
@@ -21,429 +22,222 @@
 
 namespace fins::bridge {
 
-namespace {
+namespace detail {
 
-struct Failure {
-    std::string message;
-};
-
-class Loader {
-  public:
-    explicit Loader(std::string source) : source_(std::move(source)) {}
-
-    [[noreturn]] void fail(const toml::source_region& where, const std::string& message) const {
-        throw Failure{
-            fmt::format("{}:{}:{}: {}", source_, where.begin.line, where.begin.column, message)};
+BridgeConfig Loader::load(const toml::table& root, const std::string& instance) {
+    only(root, "the file", {"bridge", "mqtt", "write", "plc"});
+    BridgeConfig c;
+    c.source = source_;
+    if (const auto* n = root.get("bridge")) {
+        const auto& t = table(*n, "[bridge]");
+        only(t, "[bridge]", {"instance", "failover_s", "payload", "stats_s", "sparkplug_group"});
+        c.sparkplug_group = text_or(t, "sparkplug_group", "");
+        if (!c.sparkplug_group.empty() && !valid_name(c.sparkplug_group))
+            fail(*t.get("sparkplug_group"), "sparkplug_group must be [A-Za-z0-9_-]+");
+        c.instance = text_or(t, "instance", "");
+        if (!c.instance.empty() && !valid_name(c.instance))
+            fail(*t.get("instance"), "instance must be [A-Za-z0-9_-]+");
+        duration(t, "failover_s", 1, 3600, c.failover);
+        duration(t, "stats_s", 1, 3600, c.stats);
+        c.payload = text_or(t, "payload", "json");
+        if (c.payload != "json" && c.payload != "sparkplug")
+            fail(*t.get("payload"), "payload must be \"json\" or \"sparkplug\"");
     }
-    [[noreturn]] void fail(const toml::node& n, const std::string& message) const {
-        fail(n.source(), message);
+    if (!instance.empty()) c.instance = instance;
+    if (c.instance.empty()) {
+        char host[256] = {};
+        ::gethostname(host, sizeof host - 1);
+        c.instance = host;
+        std::replace_if(
+            c.instance.begin(), c.instance.end(),
+            [](char ch) { return !valid_name(std::string_view(&ch, 1)); }, '-');
     }
-
-    // Every key of `t` must be one of `known`; the first other one is the error.
-    void only(const toml::table& t, std::string_view where,
-              std::initializer_list<std::string_view> known) const {
-        for (auto&& [k, v] : t)
-            if (std::find(known.begin(), known.end(), k.str()) == known.end())
-                fail(k.source(), fmt::format("unknown key '{}' in {}", k.str(), where));
+    if (const auto* n = root.get("mqtt")) mqtt(table(*n, "[mqtt]"), c.mqtt);
+    if (c.mqtt.brokers.empty()) c.mqtt.brokers.push_back({"127.0.0.1", 1883});
+    if (c.mqtt.client_id.empty()) c.mqtt.client_id = "fins-bridge-" + c.instance;
+    if (c.sparkplug_group.empty()) {
+        // Sparkplug's group_id: the topic prefix, with what a Sparkplug ID may not hold
+        // ('/', '+', '#') made '-'.
+        c.sparkplug_group = c.mqtt.topic_prefix;
+        std::replace_if(
+            c.sparkplug_group.begin(), c.sparkplug_group.end(),
+            [](char ch) { return !valid_name(std::string_view(&ch, 1)); }, '-');
     }
-
-    const toml::table& table(const toml::node& n, std::string_view what) const {
-        const auto* t = n.as_table();
-        if (t == nullptr) fail(n, fmt::format("{} must be a table", what));
-        return *t;
+    if (const auto* n = root.get("write")) {
+        const auto& t = table(*n, "[write]");
+        only(t, "[write]", {"ttl_s", "id_memory"});
+        if (auto v = integer(t, "ttl_s", 1, 86400)) c.write.ttl = std::chrono::seconds(*v);
+        if (auto v = integer(t, "id_memory", 1, 1000000))
+            c.write.id_memory = static_cast<std::size_t>(*v);
     }
-
-    std::optional<std::string> text(const toml::table& t, std::string_view key) const {
-        const auto* n = t.get(key);
-        if (n == nullptr) return std::nullopt;
-        const auto* s = n->as_string();
-        if (s == nullptr) fail(*n, fmt::format("{} must be a string", key));
-        return s->get();
-    }
-    std::string text_or(const toml::table& t, std::string_view key, std::string fallback) const {
-        auto v = text(t, key);
-        return v ? *v : std::move(fallback);
-    }
-    std::string required_text(const toml::table& t, std::string_view key,
-                              std::string_view where) const {
-        auto v = text(t, key);
-        if (!v) fail(t.source(), fmt::format("{} needs '{}'", where, key));
-        return *v;
-    }
-    std::optional<std::int64_t> integer(const toml::table& t, std::string_view key, std::int64_t lo,
-                                        std::int64_t hi) const {
-        const auto* n = t.get(key);
-        if (n == nullptr) return std::nullopt;
-        const auto* i = n->as_integer();
-        if (i == nullptr) fail(*n, fmt::format("{} must be an integer", key));
-        if (i->get() < lo || i->get() > hi)
-            fail(*n, fmt::format("{} must be {} to {}", key, lo, hi));
-        return i->get();
-    }
-    std::optional<double> number(const toml::table& t, std::string_view key) const {
-        const auto* n = t.get(key);
-        if (n == nullptr) return std::nullopt;
-        if (const auto* f = n->as_floating_point()) return f->get();
-        if (const auto* i = n->as_integer()) return static_cast<double>(i->get());
-        fail(*n, fmt::format("{} must be a number", key));
-    }
-    std::optional<bool> boolean(const toml::table& t, std::string_view key) const {
-        const auto* n = t.get(key);
-        if (n == nullptr) return std::nullopt;
-        const auto* b = n->as_boolean();
-        if (b == nullptr) fail(*n, fmt::format("{} must be true or false", key));
-        return b->get();
-    }
-    std::string name(const toml::table& t, std::string_view where) const {
-        auto v = required_text(t, "name", where);
-        if (!valid_name(v))
-            fail(*t.get("name"), fmt::format("name '{}' must be [A-Za-z0-9_-]+", v));
-        return v;
-    }
-    template <class Rep, class Period>
-    void duration(const toml::table& t, std::string_view key, std::int64_t lo, std::int64_t hi,
-                  std::chrono::duration<Rep, Period>& out) const {
-        if (auto v = integer(t, key, lo, hi)) out = std::chrono::duration<Rep, Period>(*v);
-    }
-
-    BridgeConfig load(const toml::table& root, const std::string& instance) {
-        only(root, "the file", {"bridge", "mqtt", "write", "plc"});
-        BridgeConfig c;
-        c.source = source_;
-        if (const auto* n = root.get("bridge")) {
-            const auto& t = table(*n, "[bridge]");
-            only(t, "[bridge]",
-                 {"instance", "failover_s", "payload", "stats_s", "sparkplug_group"});
-            c.sparkplug_group = text_or(t, "sparkplug_group", "");
-            if (!c.sparkplug_group.empty() && !valid_name(c.sparkplug_group))
-                fail(*t.get("sparkplug_group"), "sparkplug_group must be [A-Za-z0-9_-]+");
-            c.instance = text_or(t, "instance", "");
-            if (!c.instance.empty() && !valid_name(c.instance))
-                fail(*t.get("instance"), "instance must be [A-Za-z0-9_-]+");
-            duration(t, "failover_s", 1, 3600, c.failover);
-            duration(t, "stats_s", 1, 3600, c.stats);
-            c.payload = text_or(t, "payload", "json");
-            if (c.payload != "json" && c.payload != "sparkplug")
-                fail(*t.get("payload"), "payload must be \"json\" or \"sparkplug\"");
-        }
-        if (!instance.empty()) c.instance = instance;
-        if (c.instance.empty()) {
-            char host[256] = {};
-            ::gethostname(host, sizeof host - 1);
-            c.instance = host;
-            std::replace_if(
-                c.instance.begin(), c.instance.end(),
-                [](char ch) { return !valid_name(std::string_view(&ch, 1)); }, '-');
-        }
-        if (const auto* n = root.get("mqtt")) mqtt(table(*n, "[mqtt]"), c.mqtt);
-        if (c.mqtt.brokers.empty()) c.mqtt.brokers.push_back({"127.0.0.1", 1883});
-        if (c.mqtt.client_id.empty()) c.mqtt.client_id = "fins-bridge-" + c.instance;
-        if (c.sparkplug_group.empty()) {
-            // Sparkplug's group_id: the topic prefix, with what a Sparkplug ID may not hold
-            // ('/', '+', '#') made '-'.
-            c.sparkplug_group = c.mqtt.topic_prefix;
-            std::replace_if(
-                c.sparkplug_group.begin(), c.sparkplug_group.end(),
-                [](char ch) { return !valid_name(std::string_view(&ch, 1)); }, '-');
-        }
-        if (const auto* n = root.get("write")) {
-            const auto& t = table(*n, "[write]");
-            only(t, "[write]", {"ttl_s", "id_memory"});
-            if (auto v = integer(t, "ttl_s", 1, 86400)) c.write.ttl = std::chrono::seconds(*v);
-            if (auto v = integer(t, "id_memory", 1, 1000000))
-                c.write.id_memory = static_cast<std::size_t>(*v);
-        }
-        if (const auto* n = root.get("plc")) {
-            const auto* list = n->as_array();
-            if (list == nullptr) fail(*n, "plc must be an array of tables: [[plc]]");
-            std::set<std::string> names;
-            for (const auto& p : *list) {
-                c.plcs.push_back(plc(table(p, "[[plc]]")));
-                if (!names.insert(c.plcs.back().name).second)
-                    fail(*p.as_table()->get("name"),
-                         fmt::format("duplicate PLC name '{}'", c.plcs.back().name));
-            }
-        }
-        if (c.plcs.empty()) fail(root.source(), "no [[plc]]: nothing to poll");
-        return c;
-    }
-
-  private:
-    void mqtt(const toml::table& t, Mqtt& m) {
-        only(t, "[mqtt]",
-             {"host", "port", "hosts", "client_id", "username", "password", "ca_file", "cert_file",
-              "key_file", "tls_insecure", "keepalive_s", "topic_prefix", "qos", "queue_limit",
-              "backoff_min_ms", "backoff_max_ms"});
-        std::uint16_t port = 1883;
-        if (auto v = integer(t, "port", 1, 65535)) port = static_cast<std::uint16_t>(*v);
-        if (auto h = text(t, "host")) m.brokers.push_back({*h, port});
-        if (const auto* n = t.get("hosts")) {
-            const auto* list = n->as_array();
-            if (list == nullptr || list->empty())
-                fail(*n, "hosts must be a list of \"host[:port]\"");
-            for (const auto& e : *list) {
-                const auto* s = e.as_string();
-                if (s == nullptr) fail(e, "hosts must be a list of \"host[:port]\"");
-                std::string h = s->get();
-                Broker b{h, port};
-                if (auto colon = h.rfind(':'); colon != std::string::npos) {
-                    unsigned p = 0;
-                    auto tail = std::string_view(h).substr(colon + 1);
-                    auto [end, ec] = std::from_chars(tail.data(), tail.data() + tail.size(), p);
-                    if (ec != std::errc{} || end != tail.data() + tail.size() || p == 0 ||
-                        p > 65535)
-                        fail(e, fmt::format("'{}': bad port", h));
-                    b = {h.substr(0, colon), static_cast<std::uint16_t>(p)};
-                }
-                if (b.host.empty()) fail(e, "empty host name");
-                m.brokers.push_back(b);
-            }
-        }
-        m.client_id = text_or(t, "client_id", "");
-        m.username = text_or(t, "username", "");
-        m.password = text_or(t, "password", "");
-        m.ca_file = text_or(t, "ca_file", "");
-        m.cert_file = text_or(t, "cert_file", "");
-        m.key_file = text_or(t, "key_file", "");
-        if ((m.cert_file.empty()) != (m.key_file.empty()))
-            fail(t.source(), "cert_file and key_file go together");
-        if (!m.cert_file.empty() && m.ca_file.empty())
-            fail(t.source(), "a client certificate needs ca_file (TLS)");
-        m.tls_insecure = boolean(t, "tls_insecure").value_or(false);
-        duration(t, "keepalive_s", 5, 65535, m.keepalive);
-        m.topic_prefix = text_or(t, "topic_prefix", "finskit");
-        if (m.topic_prefix.empty() || m.topic_prefix.find_first_of("+#") != std::string::npos ||
-            m.topic_prefix.back() == '/')
-            fail(*t.get("topic_prefix"),
-                 "topic_prefix must be non-empty, without + # or a final /");
-        if (auto v = integer(t, "qos", 0, 1)) m.qos = static_cast<int>(*v);
-        if (auto v = integer(t, "queue_limit", 10, 10000000))
-            m.queue_limit = static_cast<std::size_t>(*v);
-        duration(t, "backoff_min_ms", 10, 600000, m.backoff_min);
-        duration(t, "backoff_max_ms", 10, 3600000, m.backoff_max);
-    }
-
-    Plc plc(const toml::table& t) {
-        only(t, "[[plc]]",
-             {"name", "host", "port", "transport", "dest", "model", "timeout_ms", "retries",
-              "window", "backoff_min_ms", "backoff_max_ms", "group"});
-        Plc p;
-        p.name = name(t, "[[plc]]");
-        p.host = required_text(t, "host", fmt::format("plc '{}'", p.name));
-        if (auto v = integer(t, "port", 1, 65535)) p.port = static_cast<std::uint16_t>(*v);
-        if (auto tr = text(t, "transport")) {
-            if (*tr == "udp")
-                p.transport = Transport::udp;
-            else if (*tr == "tcp")
-                p.transport = Transport::tcp;
-            else
-                fail(*t.get("transport"), "transport must be \"udp\" or \"tcp\"");
-        }
-        if (auto d = text(t, "dest")) p.dest = node_address(*t.get("dest"), *d);
-        p.model = text_or(t, "model", "cj2h");
-        profile_ = plc::find_profile(p.model);
-        if (profile_ == nullptr) fail(*t.get("model"), fmt::format("unknown model '{}'", p.model));
-        duration(t, "timeout_ms", 10, 60000, p.timeout);
-        if (auto v = integer(t, "retries", 0, 10)) p.retries = static_cast<unsigned>(*v);
-        if (auto v = integer(t, "window", 1, 64)) p.window = static_cast<std::size_t>(*v);
-        duration(t, "backoff_min_ms", 10, 600000, p.backoff_min);
-        duration(t, "backoff_max_ms", 10, 3600000, p.backoff_max);
-        if (p.backoff_max < p.backoff_min) fail(t.source(), "backoff_max_ms below backoff_min_ms");
-        const auto* g = t.get("group");
-        if (g == nullptr) fail(t.source(), fmt::format("plc '{}' has no [[plc.group]]", p.name));
-        const auto* list = g->as_array();
-        if (list == nullptr) fail(*g, "group must be an array of tables: [[plc.group]]");
-        std::set<std::string> names;
-        std::set<std::string> tag_names;  // write commands name a tag per PLC: unique per PLC
-        for (const auto& e : *list) {
-            p.groups.push_back(group(table(e, "[[plc.group]]"), tag_names));
-            if (!names.insert(p.groups.back().name).second)
-                fail(*e.as_table()->get("name"),
-                     fmt::format("duplicate group name '{}'", p.groups.back().name));
-        }
-        return p;
-    }
-
-    NodeAddress node_address(const toml::node& n, const std::string& s) const {
-        unsigned v[3] = {};
-        std::size_t at = 0;
-        for (int i = 0; i < 3; ++i) {
-            auto [end, ec] = std::from_chars(s.data() + at, s.data() + s.size(), v[i]);
-            if (ec != std::errc{}) fail(n, fmt::format("dest '{}' must be \"net.node.unit\"", s));
-            at = static_cast<std::size_t>(end - s.data());
-            if (i < 2) {
-                if (at >= s.size() || s[at] != '.')
-                    fail(n, fmt::format("dest '{}' must be \"net.node.unit\"", s));
-                ++at;
-            }
-        }
-        if (at != s.size()) fail(n, fmt::format("dest '{}' must be \"net.node.unit\"", s));
-        if (v[0] > 127) fail(n, "dest network must be 0-127");
-        if (v[1] > 254) fail(n, "dest node must be 0-254");
-        if (v[2] > 255) fail(n, "dest unit must be 0-255");
-        return {static_cast<std::uint8_t>(v[0]), static_cast<std::uint8_t>(v[1]),
-                static_cast<std::uint8_t>(v[2])};
-    }
-
-    Group group(const toml::table& t, std::set<std::string>& tag_names) {
-        only(t, "[[plc.group]]",
-             {"name", "interval_ms", "publish", "deadband", "integrity_s", "gap_words", "tags"});
-        Group g;
-        g.name = name(t, "[[plc.group]]");
-        if (g.name == "status" || g.name == "write" || g.name == "$bridge")
-            fail(*t.get("name"), fmt::format("group name '{}' is reserved (a topic)", g.name));
-        duration(t, "interval_ms", 10, 3600000, g.interval);
-        if (auto p = text(t, "publish")) {
-            if (*p == "change")
-                g.publish = Publish::change;
-            else if (*p == "always")
-                g.publish = Publish::always;
-            else
-                fail(*t.get("publish"), "publish must be \"change\" or \"always\"");
-        }
-        if (auto d = number(t, "deadband")) {
-            if (*d < 0) fail(*t.get("deadband"), "deadband must not be negative");
-            g.deadband = *d;
-        }
-        duration(t, "integrity_s", 1, 86400, g.integrity);
-        if (auto v = integer(t, "gap_words", 0, max_read_words))
-            g.gap_words = static_cast<std::size_t>(*v);
-        const auto* n = t.get("tags");
-        if (n == nullptr) fail(t.source(), fmt::format("group '{}' has no tags", g.name));
+    if (const auto* n = root.get("plc")) {
         const auto* list = n->as_array();
-        if (list == nullptr || list->empty()) fail(*n, "tags must be a non-empty list of tables");
+        if (list == nullptr) fail(*n, "plc must be an array of tables: [[plc]]");
+        std::set<std::string> names;
+        for (const auto& p : *list) {
+            c.plcs.push_back(plc(table(p, "[[plc]]")));
+            if (!names.insert(c.plcs.back().name).second)
+                fail(*p.as_table()->get("name"),
+                     fmt::format("duplicate PLC name '{}'", c.plcs.back().name));
+        }
+    }
+    if (c.plcs.empty()) fail(root.source(), "no [[plc]]: nothing to poll");
+    return c;
+}
+
+void Loader::mqtt(const toml::table& t, Mqtt& m) {
+    only(t, "[mqtt]",
+         {"host", "port", "hosts", "client_id", "username", "password", "ca_file", "cert_file",
+          "key_file", "tls_insecure", "keepalive_s", "topic_prefix", "qos", "queue_limit",
+          "backoff_min_ms", "backoff_max_ms"});
+    std::uint16_t port = 1883;
+    if (auto v = integer(t, "port", 1, 65535)) port = static_cast<std::uint16_t>(*v);
+    if (auto h = text(t, "host")) m.brokers.push_back({*h, port});
+    if (const auto* n = t.get("hosts")) {
+        const auto* list = n->as_array();
+        if (list == nullptr || list->empty()) fail(*n, "hosts must be a list of \"host[:port]\"");
         for (const auto& e : *list) {
-            g.tags.push_back(tag(table(e, "a tag")));
-            if (!tag_names.insert(g.tags.back().name).second)
-                fail(*e.as_table()->get("name"),
-                     fmt::format("duplicate tag name '{}' in this PLC", g.tags.back().name));
-        }
-        return g;
-    }
-
-    Tag tag(const toml::table& t) {
-        only(t, "a tag",
-             {"name", "address", "type", "writable", "deadband", "min", "max", "length"});
-        Tag tag;
-        tag.name = name(t, "a tag");
-        tag.address_text = required_text(t, "address", fmt::format("tag '{}'", tag.name));
-        const auto& at = *t.get("address");
-        auto a = parse_address(tag.address_text);
-        if (!a) fail(at, fmt::format("address '{}': {}", tag.address_text, a.error().message()));
-        tag.address = *a;
-        const auto type_text = required_text(t, "type", fmt::format("tag '{}'", tag.name));
-        auto type = parse_tag_type(type_text);
-        if (!type)
-            fail(*t.get("type"), fmt::format("type '{}' is not {}", type_text, tag_type_names()));
-        tag.type = *type;
-        if (auto len = integer(t, "length", 1, 65535)) {
-            if (tag.type != TagType::string) fail(*t.get("length"), "length is for string tags");
-            tag.length = static_cast<std::size_t>(*len);
-        } else if (tag.type == TagType::string) {
-            fail(t.source(), fmt::format("string tag '{}' needs length (characters)", tag.name));
-        }
-        tag.writable = boolean(t, "writable").value_or(false);
-        if (auto d = number(t, "deadband")) {
-            if (*d < 0) fail(*t.get("deadband"), "deadband must not be negative");
-            tag.deadband = *d;
-        }
-        tag.range.min = number(t, "min");
-        tag.range.max = number(t, "max");
-        resolve(at, tag);
-        return tag;
-    }
-
-    // Chooses how the tag is read and checks it against the table and the model.
-    void resolve(const toml::node& at, Tag& tag) const {
-        const Address& a = tag.address;
-        const bool is_bool = tag.type == TagType::bits;
-        if (a.bit && !is_bool)
-            fail(at, fmt::format("'{}' names a bit: its type must be bool", tag.address_text));
-        tag.words = tag_words(tag.type, tag.length);
-        Address word = a;
-        word.bit.reset();
-        auto w = to_memory_address(word, Access::word);
-        const bool flag_area =
-            a.area == Area::timer || a.area == Area::counter || a.area == Area::task_flag;
-        if (is_bool && !a.bit) {
-            // T5, C3, TK2: the completion / task flag, a 1-byte element.
-            if (!flag_area)
-                fail(at, fmt::format("a bool needs a bit ('{}.00') or a T/C/TK flag",
-                                     tag.address_text));
-            auto f = to_memory_address(a, Access::bit);
-            if (!f) fail(at, fmt::format("'{}': {}", tag.address_text, f.error().message()));
-            tag.flag = true;
-            tag.read_start = *f;
-            tag.words = 1;
-            check_model(at, tag, *f, 1);
-            return;
-        }
-        if (!w) fail(at, fmt::format("'{}': {}", tag.address_text, w.error().message()));
-        if (element_size(w->area_code) != 2)
-            fail(at, fmt::format("'{}': area code {:02X} has no 2-byte words to read",
-                                 tag.address_text, w->area_code));
-        if (tag.words > max_read_words)
-            fail(at, fmt::format("tag '{}' needs {} words: more than one frame ({} words)",
-                                 tag.name, tag.words, max_read_words));
-        tag.read_start = *w;
-        check_model(at, tag, *w, tag.words);
-        if (tag.writable && is_bool) {
-            if (!to_memory_address(a, Access::bit))
-                fail(at, fmt::format("'{}' cannot be written as a bit", tag.address_text));
+            const auto* s = e.as_string();
+            if (s == nullptr) fail(e, "hosts must be a list of \"host[:port]\"");
+            std::string h = s->get();
+            Broker b{h, port};
+            if (auto colon = h.rfind(':'); colon != std::string::npos) {
+                unsigned p = 0;
+                auto tail = std::string_view(h).substr(colon + 1);
+                auto [end, ec] = std::from_chars(tail.data(), tail.data() + tail.size(), p);
+                if (ec != std::errc{} || end != tail.data() + tail.size() || p == 0 || p > 65535)
+                    fail(e, fmt::format("'{}': bad port", h));
+                b = {h.substr(0, colon), static_cast<std::uint16_t>(p)};
+            }
+            if (b.host.empty()) fail(e, "empty host name");
+            m.brokers.push_back(b);
         }
     }
+    m.client_id = text_or(t, "client_id", "");
+    m.username = text_or(t, "username", "");
+    m.password = text_or(t, "password", "");
+    m.ca_file = text_or(t, "ca_file", "");
+    m.cert_file = text_or(t, "cert_file", "");
+    m.key_file = text_or(t, "key_file", "");
+    if ((m.cert_file.empty()) != (m.key_file.empty()))
+        fail(t.source(), "cert_file and key_file go together");
+    if (!m.cert_file.empty() && m.ca_file.empty())
+        fail(t.source(), "a client certificate needs ca_file (TLS)");
+    m.tls_insecure = boolean(t, "tls_insecure").value_or(false);
+    duration(t, "keepalive_s", 5, 65535, m.keepalive);
+    m.topic_prefix = text_or(t, "topic_prefix", "finskit");
+    if (m.topic_prefix.empty() || m.topic_prefix.find_first_of("+#") != std::string::npos ||
+        m.topic_prefix.back() == '/')
+        fail(*t.get("topic_prefix"), "topic_prefix must be non-empty, without + # or a final /");
+    if (auto v = integer(t, "qos", 0, 1)) m.qos = static_cast<int>(*v);
+    if (auto v = integer(t, "queue_limit", 10, 10000000))
+        m.queue_limit = static_cast<std::size_t>(*v);
+    duration(t, "backoff_min_ms", 10, 600000, m.backoff_min);
+    duration(t, "backoff_max_ms", 10, 3600000, m.backoff_max);
+}
 
-    // The words [start, start+count) exist in this model and one segment of the table.
-    void check_model(const toml::node& at, const Tag& tag, MemoryAddress start,
-                     std::size_t count) const {
-        const auto* seg = find_segment(start.area_code, start.word);
-        const auto last = static_cast<std::size_t>(start.word) + count - 1;
-        if (seg == nullptr || last > seg->last_word)
-            fail(at, fmt::format("tag '{}' ({} x {}) does not fit in its area", tag.name,
-                                 tag.address_text, count));
-        if (!profile_->accepts(*seg))
-            fail(at, fmt::format("'{}': the model {} has no {}", tag.address_text, profile_->name,
-                                 seg->name));
-        const std::size_t index = seg->region_offset + (last - seg->first_word);
-        if (auto size = region_size(*seg); index >= size)
-            fail(at, fmt::format("'{}' x {} is beyond the {} of the model {} ({} words)",
-                                 tag.address_text, count, seg->name, profile_->name, size));
-        if (tag.writable && !seg->allows(use_write))
-            fail(at,
-                 fmt::format("tag '{}': {} cannot be written (W342 5-3-3)", tag.name, seg->name));
-        if (tag.writable && start.word < seg->writable_from)
-            fail(at, fmt::format("tag '{}': {} is read-only", tag.name, tag.address_text));
+Plc Loader::plc(const toml::table& t) {
+    only(t, "[[plc]]",
+         {"name", "host", "port", "transport", "dest", "model", "timeout_ms", "retries", "window",
+          "backoff_min_ms", "backoff_max_ms", "group"});
+    Plc p;
+    p.name = name(t, "[[plc]]");
+    p.host = required_text(t, "host", fmt::format("plc '{}'", p.name));
+    if (auto v = integer(t, "port", 1, 65535)) p.port = static_cast<std::uint16_t>(*v);
+    if (auto tr = text(t, "transport")) {
+        if (*tr == "udp")
+            p.transport = Transport::udp;
+        else if (*tr == "tcp")
+            p.transport = Transport::tcp;
+        else
+            fail(*t.get("transport"), "transport must be \"udp\" or \"tcp\"");
     }
+    if (auto d = text(t, "dest")) p.dest = node_address(*t.get("dest"), *d);
+    p.model = text_or(t, "model", "cj2h");
+    profile_ = plc::find_profile(p.model);
+    if (profile_ == nullptr) fail(*t.get("model"), fmt::format("unknown model '{}'", p.model));
+    duration(t, "timeout_ms", 10, 60000, p.timeout);
+    if (auto v = integer(t, "retries", 0, 10)) p.retries = static_cast<unsigned>(*v);
+    if (auto v = integer(t, "window", 1, 64)) p.window = static_cast<std::size_t>(*v);
+    duration(t, "backoff_min_ms", 10, 600000, p.backoff_min);
+    duration(t, "backoff_max_ms", 10, 3600000, p.backoff_max);
+    if (p.backoff_max < p.backoff_min) fail(t.source(), "backoff_max_ms below backoff_min_ms");
+    const auto* g = t.get("group");
+    if (g == nullptr) fail(t.source(), fmt::format("plc '{}' has no [[plc.group]]", p.name));
+    const auto* list = g->as_array();
+    if (list == nullptr) fail(*g, "group must be an array of tables: [[plc.group]]");
+    std::set<std::string> names;
+    std::set<std::string> tag_names;  // write commands name a tag per PLC: unique per PLC
+    for (const auto& e : *list) {
+        p.groups.push_back(group(table(e, "[[plc.group]]"), tag_names));
+        if (!names.insert(p.groups.back().name).second)
+            fail(*e.as_table()->get("name"),
+                 fmt::format("duplicate group name '{}'", p.groups.back().name));
+    }
+    return p;
+}
 
-    std::size_t region_size(const MemoryAreaSegment& seg) const {
-        const auto& p = *profile_;
-        switch (seg.region) {
-            case Region::cio:
-                return p.cio_words;
-            case Region::work:
-                return p.work_words;
-            case Region::holding:
-                return p.holding_words;
-            case Region::auxiliary:
-                return p.auxiliary_words;
-            case Region::timer_counter:
-                return 4096 + p.counters;
-            case Region::dm:
-                return p.dm_words;
-            case Region::em:
-                return seg.em_bank < p.em_banks ? p.em_bank_words : 0;
-            case Region::em_current:
-                return p.em_banks > 0 ? p.em_bank_words : 0;
-            default:
-                return 0x10000;  // the table's own bounds apply
+NodeAddress Loader::node_address(const toml::node& n, const std::string& s) const {
+    unsigned v[3] = {};
+    std::size_t at = 0;
+    for (int i = 0; i < 3; ++i) {
+        auto [end, ec] = std::from_chars(s.data() + at, s.data() + s.size(), v[i]);
+        if (ec != std::errc{}) fail(n, fmt::format("dest '{}' must be \"net.node.unit\"", s));
+        at = static_cast<std::size_t>(end - s.data());
+        if (i < 2) {
+            if (at >= s.size() || s[at] != '.')
+                fail(n, fmt::format("dest '{}' must be \"net.node.unit\"", s));
+            ++at;
         }
     }
+    if (at != s.size()) fail(n, fmt::format("dest '{}' must be \"net.node.unit\"", s));
+    if (v[0] > 127) fail(n, "dest network must be 0-127");
+    if (v[1] > 254) fail(n, "dest node must be 0-254");
+    if (v[2] > 255) fail(n, "dest unit must be 0-255");
+    return {static_cast<std::uint8_t>(v[0]), static_cast<std::uint8_t>(v[1]),
+            static_cast<std::uint8_t>(v[2])};
+}
 
-    std::string source_;
-    const plc::Profile* profile_ = nullptr;
-};
+Group Loader::group(const toml::table& t, std::set<std::string>& tag_names) {
+    only(t, "[[plc.group]]",
+         {"name", "interval_ms", "publish", "deadband", "integrity_s", "gap_words", "tags"});
+    Group g;
+    g.name = name(t, "[[plc.group]]");
+    if (g.name == "status" || g.name == "write" || g.name == "$bridge")
+        fail(*t.get("name"), fmt::format("group name '{}' is reserved (a topic)", g.name));
+    duration(t, "interval_ms", 10, 3600000, g.interval);
+    if (auto p = text(t, "publish")) {
+        if (*p == "change")
+            g.publish = Publish::change;
+        else if (*p == "always")
+            g.publish = Publish::always;
+        else
+            fail(*t.get("publish"), "publish must be \"change\" or \"always\"");
+    }
+    if (auto d = number(t, "deadband")) {
+        if (*d < 0) fail(*t.get("deadband"), "deadband must not be negative");
+        g.deadband = *d;
+    }
+    duration(t, "integrity_s", 1, 86400, g.integrity);
+    if (auto v = integer(t, "gap_words", 0, max_read_words))
+        g.gap_words = static_cast<std::size_t>(*v);
+    const auto* n = t.get("tags");
+    if (n == nullptr) fail(t.source(), fmt::format("group '{}' has no tags", g.name));
+    const auto* list = n->as_array();
+    if (list == nullptr || list->empty()) fail(*n, "tags must be a non-empty list of tables");
+    for (const auto& e : *list) {
+        g.tags.push_back(tag(table(e, "a tag")));
+        if (!tag_names.insert(g.tags.back().name).second)
+            fail(*e.as_table()->get("name"),
+                 fmt::format("duplicate tag name '{}' in this PLC", g.tags.back().name));
+    }
+    return g;
+}
 
-}  // namespace
+}  // namespace detail
+
+using detail::Failure;
+using detail::Loader;
 
 bool valid_name(std::string_view name) {
     if (name.empty()) return false;
