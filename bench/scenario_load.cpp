@@ -1,12 +1,14 @@
-// fins_scenario_load: finsd's FINS request rate with scenarios ticking on its I/O thread,
-// as a ratio of the rate without (issue 19, docs/benchmarks.md "Scenario ticks").
+// fins_scenario_load: finsd's FINS request rate with scenarios ticking, as a ratio of the
+// rate without (issue 19, docs/benchmarks.md "Scenario ticks").
 //
-// finsd serves a plant of CPU Units on one I/O thread, and every unit's scenario ticks on
-// that thread too (src/cli/finsd/serve_plant.cpp). This bench builds the same thread: a
+// finsd serves a plant of CPU Units on one I/O thread; every unit's scenario tick is
+// handed over between that thread (the words in and out) and finsd's scenario thread (the
+// tags computed), src/server/scenario/scenario_worker.hpp. This bench builds the same: a
 // Server for one CJ2H (the unit the generator polls) plus --units CPU Units (that one
 // included) each running the fins_scenario_tick scenario of --tags tags in real time at
 // --tick-ms, each with its own ScenarioRunner and timer, as finsd runs them (their ticks in
-// --groups phase groups spread over the period, finsd's ScenarioRunner::phase_of). The generator
+// --groups phase groups spread over the period, finsd's ScenarioRunner::phase_of), and one
+// ScenarioWorker (--no-worker: every tick computed on the I/O thread). The generator
 // (this process's main thread, blocking sockets, as fins_load) keeps 1 or 32 1-word reads
 // of D0 in flight over FINS/UDP and FINS/TCP; each round measures the rate with every
 // scenario paused and with every scenario running (alternating which goes first), and the
@@ -158,10 +160,16 @@ int main(int argc, char** argv) {
                    "all at once)")
         ->check(CLI::Range(1u, 100000u))
         ->capture_default_str();
+    bool use_worker = true;
+    app.add_flag("!--no-worker", use_worker,
+                 "Compute the ticks on the I/O thread (finsd before its scenario thread)");
     CLI11_PARSE(app, argc, argv);
     spdlog::set_level(spdlog::level::warn);
 
     asio::io_context io{1};
+    // finsd's scenario thread (--no-worker: every tick on the I/O thread, as before).
+    std::unique_ptr<fins::server::ScenarioWorker> worker;
+    if (use_worker) worker = std::make_unique<fins::server::ScenarioWorker>(io);
     std::vector<std::unique_ptr<fins::plc::Plc>> plcs;
     std::vector<std::unique_ptr<fins::server::ScenarioRunner>> runners;
     for (unsigned u = 0; u < units; ++u) {
@@ -179,7 +187,7 @@ int main(int argc, char** argv) {
                 return fins::server::ScenarioRunner::Compiled(
                     tl::unexpected(std::string("no file")));
             },
-            "bench"));
+            "bench", worker.get()));
     }
     fins::server::ServerOptions options;
     options.port = 0;

@@ -5,18 +5,21 @@
 
 namespace fins::cli::finsd {
 
-std::unique_ptr<server::ScenarioRunner> run_scenario(asio::io_context& io,
-                                                     const std::optional<ScenarioConfig>& config,
-                                                     std::unique_ptr<scenario::Scenario> compiled,
-                                                     plc::Plc& plc, std::optional<double> phase) {
+std::unique_ptr<server::ScenarioRunner> run_scenario(
+    asio::io_context& io, const std::optional<ScenarioConfig>& config,
+    std::unique_ptr<scenario::Scenario> compiled, plc::Plc& plc, std::optional<double> phase,
+    std::unique_ptr<server::ScenarioWorker>& worker) {
     if (!config || !compiled) return nullptr;
+    // Virtual time ticks only when told (ctl advance), on this thread; a reload may turn
+    // it to real time, so every runner gets the worker.
+    if (!worker) worker = std::make_unique<server::ScenarioWorker>(io);
     auto reload = [where = *config, &plc]() -> server::ScenarioRunner::Compiled {
         auto fresh = reload_scenario(where);
         if (!fresh) return tl::unexpected(fresh.error());
         return compile_scenario(*fresh, plc);
     };
     auto runner = std::make_unique<server::ScenarioRunner>(
-        io, std::move(compiled), std::move(reload), config->reload_file.string());
+        io, std::move(compiled), std::move(reload), config->reload_file.string(), worker.get());
     runner->start(phase);
     return runner;
 }
