@@ -12,7 +12,8 @@
 // (this process's main thread, blocking sockets, as fins_load) keeps 1 or 32 1-word reads
 // of D0 in flight over FINS/UDP and FINS/TCP; each round measures the rate with every
 // scenario paused and with every scenario running (alternating which goes first), and the
-// median ratio running / paused is printed with the server thread's CPU share.
+// median ratio running / paused is printed with the server thread's CPU share, and with
+// one in flight the round trips' p50 and p99.
 //   fins_scenario_load --units 1000 --tags 100 --tick-ms 100 --seconds 1 --rounds 5
 #include <arpa/inet.h>
 #include <netinet/in.h>
@@ -98,16 +99,19 @@ int connect_to(bool tcp, std::uint16_t port) {
     return fd;
 }
 
-// Answers per second with `depth` requests outstanding for `seconds`.
+// Answers per second with `depth` requests outstanding for `seconds`; with one in flight,
+// each answer's round trip in microseconds is appended to `round_trips`.
 double drive(int fd, bool tcp, const std::vector<std::uint8_t>& request, std::size_t answer,
-             unsigned depth, double seconds) {
+             unsigned depth, double seconds, std::vector<double>& round_trips) {
     std::vector<std::uint8_t> in(answer + 64);
     const auto start = Clock::now();
     const auto end =
         start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
     std::size_t sent = 0, answered = 0;
+    auto sent_at = start;
     auto send_one = [&] {
         ++sent;
+        sent_at = Clock::now();
         return ::send(fd, request.data(), request.size(), MSG_NOSIGNAL) > 0;
     };
     for (unsigned i = 0; i < depth; ++i)
@@ -118,6 +122,9 @@ double drive(int fd, bool tcp, const std::vector<std::uint8_t>& request, std::si
                             : ::recv(fd, in.data(), in.size(), 0) > 0;
         if (!ok) break;
         ++answered;
+        if (depth == 1)
+            round_trips.push_back(
+                std::chrono::duration<double, std::micro>(Clock::now() - sent_at).count());
         if (sending && Clock::now() < end) {
             if (!send_one()) break;
         } else {
@@ -131,6 +138,13 @@ double drive(int fd, bool tcp, const std::vector<std::uint8_t>& request, std::si
 double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
     return v[v.size() / 2];
+}
+
+double percentile(std::vector<double>& v, double p) {
+    if (v.empty()) return 0;
+    const auto at = static_cast<std::size_t>(p * static_cast<double>(v.size() - 1));
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(at), v.end());
+    return v[at];
 }
 
 }  // namespace
@@ -216,8 +230,8 @@ int main(int argc, char** argv) {
     };
 
     const std::size_t answer = fins::header_size + 2 + 2 + 2;  // header, cmd, end, 1 word
-    fmt::print("{} CPU Units x {} tags at {} ms on finsd's I/O thread, {} rounds of {} s\n", units,
-               tags, tick_ms, rounds, seconds);
+    fmt::print("{} CPU Units x {} tags at {} ms, computed on {}, {} rounds of {} s\n", units, tags,
+               tick_ms, worker ? "finsd's scenario thread" : "the I/O thread", rounds, seconds);
     for (const bool tcp : {false, true}) {
         for (const unsigned depth : {1u, 32u}) {
             const auto request = read_request(tcp);
@@ -228,12 +242,14 @@ int main(int argc, char** argv) {
             }
             const std::size_t size = answer + (tcp ? fins::tcp_header_size : 0);
             std::vector<double> with, without, ratios, cpu_with, cpu_without;
+            std::vector<double> trips_with, trips_without;
             for (unsigned round = 0; round < rounds; ++round) {
                 double w = 0, wo = 0;
                 for (const bool running : {round % 2 == 0, round % 2 != 0}) {
                     set_running(running);
                     const double before = fins_bench::cpu_seconds(server_thread);
-                    const double rate = drive(fd, tcp, request, size, depth, seconds);
+                    const double rate = drive(fd, tcp, request, size, depth, seconds,
+                                              running ? trips_with : trips_without);
                     const double cpu = (fins_bench::cpu_seconds(server_thread) - before) / seconds;
                     (running ? w : wo) = rate;
                     (running ? cpu_with : cpu_without).push_back(cpu * 100);
@@ -248,6 +264,13 @@ int main(int argc, char** argv) {
                 "req/s ({:.0f} % CPU) | ratio {:.3f}\n",
                 tcp ? "tcp" : "udp", depth, median(without), median(cpu_without), median(with),
                 median(cpu_with), median(ratios));
+            if (depth == 1)
+                fmt::print(
+                    "{} in-flight  1 round trip: paused p50 {:.0f} us p99 {:.0f} us | running "
+                    "p50 {:.0f} us p99 {:.0f} us\n",
+                    tcp ? "tcp" : "udp", percentile(trips_without, 0.5),
+                    percentile(trips_without, 0.99), percentile(trips_with, 0.5),
+                    percentile(trips_with, 0.99));
         }
     }
     set_running(true);

@@ -284,5 +284,37 @@ TEST(ScenarioRun, RealTimeTicksWithoutAdvance) {
     EXPECT_TRUE(scenario_status(socket)["paused"].get<bool>());
 }
 
+// compute = "thread" (finsd's scenario thread) and "io" (the I/O thread) run the same
+// scenario: time runs, and a client's write to a counter is where it goes on from,
+// whichever phase of a tick the write lands in (docs/scenarios.md "How writes reach
+// memory").
+TEST(ScenarioRun, ComputeOnTheScenarioThreadOrTheIoThreadAdoptsClientWrites) {
+    for (const char* where : {"thread", "io"}) {
+        SCOPED_TRACE(where);
+        ScratchDir dir(std::string("scenario-compute-") + where);
+        const auto file = dir.write(
+            "s.toml", std::string("[scenario]\ntick_ms = 10\ncompute = \"") + where +
+                          "\"\n[[scenario.signal]]\naddress = \"D8\"\nkind = "
+                          "\"counter\"\ninput = \"1\"\nrate = 100\n");
+        Finsd d({"--scenario", file});
+        ASSERT_TRUE(d.started()) << d.result().err;
+        auto c = d.client();
+        std::int16_t v = 0;
+        for (int i = 0; i < 200 && v < 5; ++i) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(25));
+            v = read_int16(*c, "D8");
+        }
+        ASSERT_GE(v, 5);
+        ASSERT_TRUE(c->write_words(addr("D8"), std::vector<std::uint16_t>{20000}).has_value());
+        for (int i = 0; i < 200 && (v < 20000 || v > 20000 + 5000); ++i) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(25));
+            v = read_int16(*c, "D8");
+        }
+        // Counting on from the client's 20000 (not from where it was before the write).
+        EXPECT_GT(v, 20000);
+        EXPECT_LT(v, 20000 + 5000);
+    }
+}
+
 }  // namespace
 }  // namespace fins::test
