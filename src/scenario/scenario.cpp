@@ -143,6 +143,7 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
     Compiler c{s, {}};
     // Tags first: their references are the ones expressions find by address.
     s.tags.resize(def.tags.size());
+    s.cold.resize(def.tags.size());
     for (std::size_t i = 0; i < def.tags.size(); ++i) {
         const TagDef& t = def.tags[i];
         auto address = parse_address(t.address.text);
@@ -158,22 +159,39 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
                              fmt::format("{} overlaps {} ({}), written by the entry at line {}",
                                          t.address.text, def.tags[j].address.text,
                                          value_type_name(def.tags[j].type), def.tags[j].pos.line));
-        s.tags[i].def = &t;
+        s.cold[i].def = &t;
         s.tags[i].reference = *r;
-        s.tags[i].p = TagParams{t.kind,
-                                t.repeat,
-                                t.value,
-                                t.min,
-                                t.max,
-                                t.period_s,
-                                t.phase_s,
-                                t.duty,
-                                t.step,
-                                t.rate,
-                                1 - std::exp(-def.tick_s / t.tau_s),
-                                t.noise,
-                                t.on_above,
-                                t.off_below};
+        TagParams& p = s.tags[i].p;
+        p.kind = t.kind;
+        p.repeat = t.repeat;
+        p.min = t.min;
+        p.max = t.max;
+        switch (t.kind) {
+            case SignalKind::constant:
+                p.value = t.value;
+                break;
+            case SignalKind::sine:
+            case SignalKind::square:
+            case SignalKind::triangle:
+            case SignalKind::sawtooth:
+            case SignalKind::ramp:
+                p.wave = {t.period_s, t.phase_s, t.duty};
+                break;
+            case SignalKind::random_walk:
+                p.step = t.step;
+                break;
+            case SignalKind::counter:
+                p.rate = t.rate;
+                break;
+            case SignalKind::lag:
+                p.lag = {1 - std::exp(-def.tick_s / t.tau_s), t.noise};
+                break;
+            case SignalKind::hysteresis:
+                p.band = {t.on_above, t.off_below};
+                break;
+            default:
+                break;
+        }
         if (t.kind == SignalKind::steps) {
             if (t.steps.empty())
                 return error(t.pos, "kind = \"steps\" needs steps = [[t, value], ...]");
@@ -196,7 +214,7 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
         if (samples > max_delay_samples)
             return error(t.pos, fmt::format("delay_s {} is {} ticks: at most {}", t.delay_s,
                                             samples, max_delay_samples));
-        s.tags[i].delay.assign(samples, std::nan(""));
+        s.cold[i].delay.assign(samples, std::nan(""));
         s.tags[i].has_delay = samples > 0;
         s.tags[i].state =
             t.initial.value_or(t.kind == SignalKind::random_walk ? (t.min + t.max) / 2 : 0.0);
@@ -310,7 +328,7 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
                              fmt::format("{} is not a tag of this scenario (no signal or link "
                                          "writes it)",
                                          e.address.text));
-            s.tags[static_cast<std::size_t>(es.tag)].faults.push_back(
+            s.cold[static_cast<std::size_t>(es.tag)].faults.push_back(
                 static_cast<std::uint32_t>(i));
             s.tags[static_cast<std::size_t>(es.tag)].has_faults = true;
         }

@@ -30,7 +30,8 @@ double Scenario::Impl::run(ProgramRef program) noexcept {
     return Expression::run(code.data() + program.at, program.size, *this);
 }
 
-double Scenario::Impl::compute(TagState& tag, bool& skip) noexcept {
+double Scenario::Impl::compute(std::uint32_t index, bool& skip) noexcept {
+    TagState& tag = tags[index];
     const TagParams& d = tag.p;
     skip = false;
     if (tag.has_when && !truth(run(tag.when))) {
@@ -51,17 +52,19 @@ double Scenario::Impl::compute(TagState& tag, bool& skip) noexcept {
             return d.value;
         case SignalKind::sine:
             return d.min + span / 2 +
-                   span / 2 * std::sin(2 * std::numbers::pi * (t + d.phase_s) / d.period_s);
+                   span / 2 *
+                       std::sin(2 * std::numbers::pi * (t + d.wave.phase_s) / d.wave.period_s);
         case SignalKind::square:
-            return fraction((t + d.phase_s) / d.period_s) < d.duty ? d.max : d.min;
+            return fraction((t + d.wave.phase_s) / d.wave.period_s) < d.wave.duty ? d.max : d.min;
         case SignalKind::triangle: {
-            const double f = fraction((t + d.phase_s) / d.period_s);
+            const double f = fraction((t + d.wave.phase_s) / d.wave.period_s);
             return f < 0.5 ? d.min + span * 2 * f : d.max - span * (2 * f - 1);
         }
         case SignalKind::sawtooth:
-            return d.min + span * fraction((t + d.phase_s) / d.period_s);
+            return d.min + span * fraction((t + d.wave.phase_s) / d.wave.period_s);
         case SignalKind::ramp: {
-            const double f = d.repeat ? fraction(t / d.period_s) : std::min(t / d.period_s, 1.0);
+            const double f =
+                d.repeat ? fraction(t / d.wave.period_s) : std::min(t / d.wave.period_s, 1.0);
             return d.min + span * f;
         }
         case SignalKind::random_walk:
@@ -69,7 +72,7 @@ double Scenario::Impl::compute(TagState& tag, bool& skip) noexcept {
             tag.state = std::clamp(tag.state + d.step * random.normal(), d.min, d.max);
             return tag.state;
         case SignalKind::steps: {
-            const TagDef& schedule = *tag.def;
+            const TagDef& schedule = *cold[index].def;
             const double at = schedule.repeat_s > 0 ? std::fmod(t, schedule.repeat_s) : t;
             double v = schedule.initial.value_or(schedule.steps.front().second);
             for (const auto& [when, value] : schedule.steps) {
@@ -97,24 +100,25 @@ double Scenario::Impl::compute(TagState& tag, bool& skip) noexcept {
         case SignalKind::lag: {
             adopt();
             const double setpoint = run(tag.input);
-            const double noise = d.noise > 0 ? d.noise * random.normal() : 0.0;
-            // lag_gain = 1 - exp(-tick_s / tau_s), computed once at compile.
-            if (std::isfinite(setpoint)) tag.state += (setpoint - tag.state) * d.lag_gain;
+            const double noise = d.lag.noise > 0 ? d.lag.noise * random.normal() : 0.0;
+            // gain = 1 - exp(-tick_s / tau_s), computed once at compile.
+            if (std::isfinite(setpoint)) tag.state += (setpoint - tag.state) * d.lag.gain;
             return tag.state + noise;
         }
         case SignalKind::hysteresis: {
             const double input = run(tag.input);
-            if (input >= d.on_above)
+            if (input >= d.band.on_above)
                 tag.previous_input = true;
-            else if (input <= d.off_below)
+            else if (input <= d.band.off_below)
                 tag.previous_input = false;
             return tag.previous_input ? 1.0 : 0.0;
         }
         case SignalKind::link: {
             double v = run(tag.input);
             if (tag.has_delay) {
-                std::swap(v, tag.delay[tag.delay_next]);
-                tag.delay_next = (tag.delay_next + 1) % tag.delay.size();
+                TagCold& c = cold[index];
+                std::swap(v, c.delay[c.delay_next]);
+                c.delay_next = (c.delay_next + 1) % c.delay.size();
             }
             return v;
         }
@@ -122,8 +126,8 @@ double Scenario::Impl::compute(TagState& tag, bool& skip) noexcept {
     return 0.0;
 }
 
-void Scenario::Impl::apply_faults(const TagState& tag, double& value) noexcept {
-    for (const auto e : tag.faults) {
+void Scenario::Impl::apply_faults(std::uint32_t index, double& value) noexcept {
+    for (const auto e : cold[index].faults) {
         EventState& event = events[e];
         if (!event.active) continue;
         const double v = event.def->value;
@@ -168,17 +172,17 @@ void Scenario::Impl::compute_tags() noexcept {
         if (k + ahead < count) {
             const char* next = reinterpret_cast<const char*>(&tags[order[k + ahead]]);
             __builtin_prefetch(next);
-            __builtin_prefetch(next + 64);
-            __builtin_prefetch(next + 128);
+            __builtin_prefetch(next + sizeof(TagState) - 1);
         }
-        TagState& tag = tags[order[k]];
+        const std::uint32_t index = order[k];
+        TagState& tag = tags[index];
         bool skip = false;
-        double value = compute(tag, skip);
+        double value = compute(index, skip);
         if (skip) {
             ++tick_skipped;
             continue;
         }
-        if (tag.has_faults) apply_faults(tag, value);
+        if (tag.has_faults) apply_faults(index, value);
         if (write(tag, value))
             ++tick_writes;
         else
