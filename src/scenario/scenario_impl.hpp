@@ -137,6 +137,9 @@ struct Scenario::Impl final : ExpressionContext {
     // `image_before` what begin_tick copied in, `image_forced` the forced masks.
     std::vector<ImageRun> runs;
     std::vector<std::uint16_t> image, image_before, image_forced;
+    // This tick's compute may run while the owning thread serves requests (begin_tick):
+    // keep image_before to tell a client's write from the tick's at end_tick.
+    bool concurrent = false;
     bool offloadable = false;  // every tag reference is in the image
     // What compute() counted, folded into writes/skipped by end_tick() (so that status()
     // on the owning thread never reads what a compute on another thread writes).

@@ -190,12 +190,22 @@ void Scenario::Impl::gather() noexcept {
         if (run.forced != nullptr)
             std::copy_n(run.forced, run.size, image_forced.data() + run.offset);
     }
-    std::copy(image.begin(), image.end(), image_before.begin());
+    if (concurrent) std::copy(image.begin(), image.end(), image_before.begin());
 }
 
 void Scenario::Impl::scatter() noexcept {
     for (const auto& run : runs) {
         const std::uint16_t* now = image.data() + run.offset;
+        if (!concurrent) {
+            // Nothing else ran since gather(): memory still holds what the image started
+            // from, and a word the tick changed differs from it.
+            for (std::uint32_t i = 0; i < run.size; ++i)
+                if (now[i] != run.memory[i])
+                    run.memory[i] = run.forced == nullptr
+                                        ? now[i]
+                                        : merge_forced(run.memory[i], now[i], run.forced[i]);
+            continue;
+        }
         const std::uint16_t* before = image_before.data() + run.offset;
         for (std::uint32_t i = 0; i < run.size; ++i) {
             // Unchanged by the tick, or changed by a client since begin_tick (its write

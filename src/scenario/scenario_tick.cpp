@@ -207,9 +207,11 @@ void Scenario::Impl::end_tick() noexcept {
 }
 
 void Scenario::tick(plc::TimePoint now) noexcept {
-    begin_tick(now);
-    compute();
-    end_tick();
+    impl_->host_now = now;
+    impl_->concurrent = false;
+    impl_->begin_tick();
+    impl_->compute_tags();
+    impl_->end_tick();
 }
 
 bool Scenario::offloadable() const noexcept {
@@ -218,6 +220,7 @@ bool Scenario::offloadable() const noexcept {
 
 void Scenario::begin_tick(plc::TimePoint now) noexcept {
     impl_->host_now = now;
+    impl_->concurrent = true;
     impl_->begin_tick();
 }
 
