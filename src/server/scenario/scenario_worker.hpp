@@ -37,6 +37,8 @@ class ScenarioWorker {
     };
 
     static constexpr std::size_t hand_back_batch = 64;
+    // The thread's nice value (relative priority below the I/O thread's).
+    static constexpr int worker_nice = 10;
 
     explicit ScenarioWorker(asio::io_context& io);
     ~ScenarioWorker();  // stops and joins the thread; jobs still queued are dropped
