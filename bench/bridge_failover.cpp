@@ -69,7 +69,7 @@ int main(int argc, char** argv) {
         tb::Mosquitto broker(rdir);
         tb::Proc finsd({tb::finsd_exe, "--port", "0", "--log-level", "warn"}, rdir / "finsd.log");
         const auto port = finsd_port(finsd);
-        if (!broker.up() || port == 0) {
+        if (!broker.started() || port == 0) {
             std::fprintf(stderr, "mosquitto or finsd did not start\n");
             return 1;
         }

@@ -49,6 +49,8 @@
 #include "transport/asio.hpp"
 #include "web/http_server.hpp"
 
+#include "fins_generator.hpp"
+
 namespace {
 
 namespace beast = boost::beast;
@@ -118,43 +120,15 @@ class Clients {
     std::thread thread_;
 };
 
-// FINS/UDP requests per second with `depth` 1-word reads of D0 in flight for `seconds`.
+// FINS/UDP requests per second with `depth` 1-word reads of D0 in flight for `seconds`
+// (fins_load's generator, its udp-32 case by default).
 double fins_udp_rate(std::uint16_t port, double seconds, unsigned depth = 32) {
-    std::array<std::uint8_t, 32> params{};
-    fins::ByteWriter pw{params};
-    fins::MemoryAreaRead{{0x82, 0, 0}, 1}.encode(pw);
-    fins::Header h;
-    h.destination = {0, 1, 0};
-    h.source = {0, 200, 0};
-    std::vector<std::uint8_t> frame(fins::max_frame_size);
-    frame.resize(
-        fins::encode_request(h, fins::MemoryAreaRead::code, pw.written(), frame).value_or(0));
-    const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    a.sin_port = htons(port);
-    timeval tv{1, 0};  // a lost datagram ends the case, never hangs it
-    ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
-    if (::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
-        ::close(fd);
-        return 0;
-    }
-    std::array<std::uint8_t, 256> in{};
-    const auto start = Clock::now();
-    const auto end =
-        start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
-    std::uint64_t answers = 0, in_flight = 0;
-    for (unsigned i = 0; i < depth; ++i)
-        in_flight += ::send(fd, frame.data(), frame.size(), 0) > 0 ? 1 : 0;
-    while (in_flight > 0 && ::recv(fd, in.data(), in.size(), 0) > 0) {
-        --in_flight;
-        ++answers;
-        if (Clock::now() < end) in_flight += ::send(fd, frame.data(), frame.size(), 0) > 0 ? 1 : 0;
-    }
-    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    const int fd = fins_bench::connect_to(false, port);
+    if (fd < 0) return 0;
+    const fins_bench::Frames frames{fins_bench::read_frame(0), fins_bench::read_response_size};
+    const auto stats = fins_bench::drive(fd, false, frames, depth, seconds);
     ::close(fd);
-    return static_cast<double>(answers) / elapsed;
+    return stats.rate;
 }
 
 double median(std::vector<double> v) {

@@ -7,13 +7,13 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <array>
 #include <cerrno>
 #include <cstring>
 #include <ctime>
 #include <vector>
 
 #include "plc/crc32c.hpp"
+#include "plc/storage_chunks.hpp"
 #include "plc/storage_format.hpp"
 #include "plc/storage_guard.hpp"
 
@@ -46,10 +46,6 @@ std::error_code reserve_error(int e) {
     return {e, std::system_category()};
 }
 
-std::uint64_t round_up(std::uint64_t n) {
-    return (std::max<std::uint64_t>(n, 1) + page - 1) / page * page;
-}
-
 std::string_view entry_name(const sf::Entry& e) {
     return {e.name, ::strnlen(e.name, sf::name_size)};
 }
@@ -60,20 +56,13 @@ Unexpected fail(std::error_code e) {
 
 }  // namespace
 
-constexpr std::size_t lazy_section_bytes = 16 * 1024;
-// The chunk the small heap sections are packed into (on_heap); a CJ2H's fit in one.
-constexpr std::size_t chunk_bytes = 128 * 1024;
-
 struct Storage::Impl {
-    // Heap sections, 8-byte aligned (enough for every stored type).
-    std::vector<std::vector<std::uint64_t>> heap;
+    // Sections not in the file, and those it could not map.
+    SectionChunks unmapped;
     int dir_fd = -1;  // the data directory, locked (flock) for the Storage's life
     int fd = -1;
     sf::Header* header = nullptr;
     std::vector<std::pair<void*, std::size_t>> maps;
-    std::vector<std::pair<void*, std::size_t>> anonymous;  // heap sections, lazily backed
-    std::byte* chunk_next = nullptr;  // the free rest of the last small-section chunk
-    std::size_t chunk_left = 0;
     std::vector<std::span<std::byte>> sections;  // by entry index
     std::vector<bool> claimed;                   // per existing entry
     bool existing = false;                       // restored from finsd.state
@@ -89,51 +78,13 @@ struct Storage::Impl {
     std::vector<std::pair<void*, std::size_t>> guarded;
     std::unique_ptr<StateFileGuard> guard;
 
-    // Anonymous memory the kernel backs lazily with zero pages (nullptr: refused).
-    void* reserve(std::size_t length) {
-        void* p = ::mmap(nullptr, length, PROT_READ | PROT_WRITE,
-                         MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
-        if (p == MAP_FAILED) return nullptr;
-        anonymous.emplace_back(p, length);
-        return p;
-    }
-
-    std::span<std::byte> on_heap(std::size_t bytes) {
-        // Every section comes from anonymous memory the kernel backs lazily with zero
-        // pages: a plant of 10,000 CPU Units pays only for the pages its clients touch
-        // (issues 10 and 19; docs/benchmarks.md). Large sections (EM banks, DM) get a
-        // mapping each; the small ones (about 28 per CPU Unit, 67 KB in all for a CJ2H)
-        // are packed into shared chunks, where zeroed heap blocks made each resident.
-        if (bytes >= lazy_section_bytes) {
-            if (void* p = reserve(round_up(bytes))) return {static_cast<std::byte*>(p), bytes};
-        } else {
-            const std::size_t size = (std::max<std::size_t>(bytes, 1) + 15) / 16 * 16;
-            if (chunk_left < size) {
-                chunk_left = 0;
-                if (void* p = reserve(chunk_bytes)) {
-                    chunk_next = static_cast<std::byte*>(p);
-                    chunk_left = chunk_bytes;
-                }
-            }
-            if (chunk_left >= size) {
-                std::byte* p = chunk_next;
-                chunk_next += size;
-                chunk_left -= size;
-                return {p, bytes};
-            }
-        }
-        // No mapping to be had: zeroed heap memory, resident but correct.
-        heap.emplace_back((bytes + 7) / 8 + 1, 0);
-        return {reinterpret_cast<std::byte*>(heap.back().data()), bytes};
-    }
-
     std::span<std::byte> map(std::uint64_t offset, std::size_t bytes) {
-        const std::size_t length = round_up(bytes);
+        const std::size_t length = round_up_to_page(bytes);
         void* p = ::mmap(nullptr, length, PROT_READ | PROT_WRITE, MAP_SHARED, fd,
                          static_cast<off_t>(offset));
         if (p == MAP_FAILED) {
             if (!problem) problem = last_error();
-            return on_heap(bytes);
+            return unmapped.allocate(bytes);
         }
         maps.emplace_back(p, length);
         return {static_cast<std::byte*>(p), bytes};
@@ -160,13 +111,10 @@ struct Storage::Impl {
 
     Result<void> create(std::string_view profile_id);
     Result<void> restore(std::string_view profile_id);
-    Result<void> verify_sections(std::uint64_t size);
 
     ~Impl() {
         guard.reset();  // before the mappings go
         for (auto [p, n] : maps)
-            ::munmap(p, n);
-        for (auto [p, n] : anonymous)
             ::munmap(p, n);
         if (header != nullptr) ::munmap(header, page);
         if (fd >= 0) ::close(fd);
@@ -231,13 +179,13 @@ Result<void> Storage::Impl::restore(std::string_view profile_id) {
         if (e.offset != end || e.offset > size || e.size > size - e.offset ||
             ::strnlen(e.name, sf::name_size) == sf::name_size)
             return fail(make(Error::damaged));
-        end = e.offset + round_up(e.size);
+        end = e.offset + round_up_to_page(e.size);
     }
     if (end != size) return fail(make(Error::damaged));
     const sf::Seal& seal = header->seal;
     if (seal.crc != sf::crc_without(seal, seal.crc)) return fail(make(Error::header_checksum));
     if (seal.clean == sf::clean_mark) {
-        if (auto r = verify_sections(size); !r) return r;
+        if (auto r = sf::verify_section_checksums(fd, size, *header); !r) return r;
         verified = true;
     }
     // A sparse file (an older finsd, a copy) gets its holes reserved now: a write to a
@@ -247,21 +195,6 @@ Result<void> Storage::Impl::restore(std::string_view profile_id) {
     existing = true;
     claimed.assign(d.count, false);
     sections.assign(d.count, {});
-    return {};
-}
-
-Result<void> Storage::Impl::verify_sections(std::uint64_t size) {
-    void* p = ::mmap(nullptr, size, PROT_READ, MAP_SHARED, fd, 0);
-    if (p == MAP_FAILED) return fail(last_error());
-    const auto* file = static_cast<const std::byte*>(p);
-    const sf::Descriptor& d = header->descriptor;
-    bool intact = true;
-    for (std::uint32_t i = 0; i < d.count && intact; ++i) {
-        const auto& e = d.entries[i];
-        intact = crc32c({file + e.offset, e.size}) == header->seal.section_crc[i];
-    }
-    ::munmap(p, size);
-    if (!intact) return fail(make(Error::section_checksum));
     return {};
 }
 
@@ -327,7 +260,7 @@ Result<std::filesystem::path> Storage::set_aside(const std::filesystem::path& di
 std::span<std::byte> Storage::section(std::string_view name, std::size_t bytes, std::size_t,
                                       Retention retention) {
     Impl& s = *impl_;
-    if (retention == Retention::cleared || s.fd < 0) return s.on_heap(bytes);
+    if (retention == Retention::cleared || s.fd < 0) return s.unmapped.allocate(bytes);
     sf::Descriptor& d = s.header->descriptor;
     if (s.existing) {
         for (std::uint32_t i = 0; i < d.count; ++i) {
@@ -340,25 +273,25 @@ std::span<std::byte> Storage::section(std::string_view name, std::size_t bytes, 
             }
         }
         if (!s.problem) s.problem = make(Error::layout_mismatch);
-        return s.on_heap(bytes);
+        return s.unmapped.allocate(bytes);
     }
     if (d.count >= sf::max_entries || name.size() >= sf::name_size) {
         if (!s.problem) s.problem = make(Error::too_many_sections);
-        return s.on_heap(bytes);
+        return s.unmapped.allocate(bytes);
     }
     // A duplicate could not be told apart from its twin when the file is reopened.
     for (std::uint32_t i = 0; i < d.count; ++i)
         if (name == entry_name(d.entries[i])) {
             if (!s.problem) s.problem = make(Error::duplicate_section);
-            return s.on_heap(bytes);
+            return s.unmapped.allocate(bytes);
         }
     const std::uint64_t offset = d.file_size;
-    const std::uint64_t length = round_up(bytes);
+    const std::uint64_t length = round_up_to_page(bytes);
     if (const int e =
             ::posix_fallocate(s.fd, static_cast<off_t>(offset), static_cast<off_t>(length));
         e != 0) {
         if (!s.problem) s.problem = reserve_error(e);
-        return s.on_heap(bytes);
+        return s.unmapped.allocate(bytes);
     }
     sf::Entry& e = d.entries[d.count];
     std::memset(&e, 0, sizeof e);

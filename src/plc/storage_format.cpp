@@ -1,7 +1,11 @@
 // Storage's error category (storage_format.hpp): one line each, what is wrong with the
-// state file. finsd adds what the operator can do (--reset-state) to the refusals.
+// state file. finsd adds what the operator can do (--reset-state) to the refusals. And the
+// check of a cleanly stopped file's section checksums.
 #include "plc/storage_format.hpp"
 
+#include <sys/mman.h>
+
+#include <cerrno>
 #include <string>
 
 namespace fins::plc::state_file {
@@ -73,6 +77,21 @@ bool is_refusal(const std::error_code& e) noexcept {
         default:
             return false;
     }
+}
+
+Result<void> verify_section_checksums(int fd, std::uint64_t size, const Header& header) {
+    void* p = ::mmap(nullptr, size, PROT_READ, MAP_SHARED, fd, 0);
+    if (p == MAP_FAILED) return Unexpected(std::error_code(errno, std::system_category()));
+    const auto* file = static_cast<const std::byte*>(p);
+    const Descriptor& d = header.descriptor;
+    bool intact = true;
+    for (std::uint32_t i = 0; i < d.count && intact; ++i) {
+        const auto& e = d.entries[i];
+        intact = crc32c({file + e.offset, e.size}) == header.seal.section_crc[i];
+    }
+    ::munmap(p, size);
+    if (!intact) return Unexpected(make_error(Error::section_checksum));
+    return {};
 }
 
 }  // namespace fins::plc::state_file

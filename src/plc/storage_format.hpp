@@ -110,6 +110,9 @@ std::uint32_t crc_without(const Block& block, const std::uint32_t& field) {
 // synced. Returns the new file's descriptor. An incomplete version 1 file, or one with
 // more sections than version 2 holds, is refused (incomplete, unsupported_version).
 Result<int> convert_version1(int dir_fd, int fd, std::uint64_t size);
+// A cleanly stopped file's sections (open as `fd`, `size` bytes, `header` its header)
+// against the seal's checksums: section_checksum when one differs.
+Result<void> verify_section_checksums(int fd, std::uint64_t size, const Header& header);
 // True for the errors about an existing file's content (Storage::is_refusal).
 bool is_refusal(const std::error_code& e) noexcept;
 

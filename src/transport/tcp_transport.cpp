@@ -28,36 +28,23 @@ boost::system::error_code tcp_error_code(std::uint32_t raw) {
 }  // namespace
 
 TcpTransport::TcpTransport(asio::io_context& io, TransportOptions options)
-    : options_(std::move(options)), resolver_(io), socket_(io), open_timer_(io) {}
+    : SocketTransport(io, std::move(options)) {}
 
 TcpTransport::~TcpTransport() {
     close();
 }
 
 void TcpTransport::async_open(OpenHandler done) {
-    close();
-    state_ = State::opening;
-    open_done_ = std::move(done);
-    auto gen = generation_;
-    std::weak_ptr<int> life = life_;
-    open_timer_.expires_after(options_.open_timeout);
-    open_timer_.async_wait([this, life, gen](boost::system::error_code ec) {
-        if (life.expired() || gen != generation_ || ec || state_ != State::opening) return;
-        finish_open(Unexpected(make_error_code(ClientError::timeout)));
+    begin_open(std::move(done), [this](const Resolved& results) {
+        auto gen = generation_;
+        std::weak_ptr<int> life = life_;
+        asio::async_connect(socket_, results,
+                            [this, life, gen](boost::system::error_code ec, const tcp::endpoint&) {
+                                if (life.expired() || gen != generation_) return;
+                                if (ec) return finish_open(Unexpected(ec));
+                                on_connected();
+                            });
     });
-    resolver_.async_resolve(
-        options_.host, std::to_string(options_.port), tcp::resolver::numeric_service,
-        [this, life, gen](boost::system::error_code ec, tcp::resolver::results_type results) {
-            if (life.expired() || gen != generation_) return;
-            if (ec) return finish_open(Unexpected(ec));
-            asio::async_connect(
-                socket_, results,
-                [this, life, gen](boost::system::error_code ec2, const tcp::endpoint&) {
-                    if (life.expired() || gen != generation_) return;
-                    if (ec2) return finish_open(Unexpected(ec2));
-                    on_connected();
-                });
-        });
 }
 
 void TcpTransport::on_connected() {
@@ -110,9 +97,7 @@ void TcpTransport::read_handshake() {
 }
 
 void TcpTransport::finish_open(Result<LinkInfo> result) {
-    open_timer_.cancel();
-    auto done = std::move(open_done_);
-    open_done_ = nullptr;
+    auto done = take_open_handler();
     if (!result) {
         close();
         if (done) done(std::move(result));
@@ -262,11 +247,6 @@ void TcpTransport::write_next() {
                       });
 }
 
-void TcpTransport::fail(boost::system::error_code reason) {
-    close();
-    if (on_close_) on_close_(reason);
-}
-
 void TcpTransport::set_keepalive(boost::system::error_code& ec) {
     const auto& k = options_.keepalive;
     if (k.idle.count() <= 0) return;
@@ -289,20 +269,12 @@ void TcpTransport::set_keepalive(boost::system::error_code& ec) {
 }
 
 void TcpTransport::close() {
-    ++generation_;
-    boost::system::error_code ignored;
-    resolver_.cancel();
-    open_timer_.cancel();
-    socket_.close(ignored);
+    close_connection();
     fd_ = -1;
-    queue_.clear();
-    writing_ = false;
     front_written_ = 0;
     rx_size_ = 0;
     corked_ = false;
     cork_.clear();
-    open_done_ = nullptr;
-    state_ = State::closed;
 }
 
 }  // namespace fins::transport

@@ -31,12 +31,11 @@
 
 #include "fins/tcp.hpp"
 #include "transport/asio.hpp"
-#include "transport/transport.hpp"
-#include "transport/write_queue.hpp"
+#include "transport/socket_transport.hpp"
 
 namespace fins::transport {
 
-class TcpTransport final : public Transport {
+class TcpTransport final : public SocketTransport<asio::ip::tcp> {
   public:
     TcpTransport(asio::io_context& io, TransportOptions options);
     ~TcpTransport() override;
@@ -44,8 +43,6 @@ class TcpTransport final : public Transport {
     void async_open(OpenHandler done) override;
     void send(Bytes frame) override;
     void close() override;
-    [[nodiscard]] State state() const noexcept override { return state_; }
-    [[nodiscard]] bool write_pending() const noexcept override { return !queue_.empty(); }
     [[nodiscard]] bool peer_gone() override;
     // Reads that returned bytes since construction (handshake included); lets tests see
     // how the bytes of a packet actually arrived.
@@ -58,28 +55,17 @@ class TcpTransport final : public Transport {
     // TransportOptions::keepalive on the connected socket.
     void set_keepalive(boost::system::error_code& ec);
     void read_handshake();
-    void finish_open(Result<LinkInfo> result);
+    void finish_open(Result<LinkInfo> result) override;
     void read_frames();
     // Parses what is buffered; false once the transport was closed meanwhile.
     bool process_frames();
     void send_error_and_fail(TcpError error);
     void write_raw(Bytes first, Bytes second);
     void write_next();
-    void fail(boost::system::error_code reason);
     void consume(std::size_t n) noexcept;
     void uncork();
 
-    TransportOptions options_;
-    asio::ip::tcp::resolver resolver_;
-    asio::ip::tcp::socket socket_;
-    int fd_ = -1;  // socket_'s, once connected
-    asio::steady_timer open_timer_;
-    State state_ = State::closed;
-    std::uint64_t generation_ = 0;  // bumped on close: handlers of older sockets ignore
-    std::shared_ptr<int> life_ = std::make_shared<int>(0);
-    OpenHandler open_done_;
-    WriteQueue queue_;
-    bool writing_ = false;
+    int fd_ = -1;                    // socket_'s, once connected
     std::size_t front_written_ = 0;  // bytes of queue_.front() already written
     std::array<std::uint8_t, 20> hello_{};
     // Room for two maximal packets: whatever is left after parsing fits with room to read.

@@ -16,30 +16,14 @@ namespace fins::transport {
 using asio::ip::udp;
 
 UdpTransport::UdpTransport(asio::io_context& io, TransportOptions options)
-    : options_(std::move(options)), resolver_(io), socket_(io), open_timer_(io) {}
+    : SocketTransport(io, std::move(options)) {}
 
 UdpTransport::~UdpTransport() {
     close();
 }
 
 void UdpTransport::async_open(OpenHandler done) {
-    close();
-    state_ = State::opening;
-    open_done_ = std::move(done);
-    auto gen = generation_;
-    std::weak_ptr<int> life = life_;
-    open_timer_.expires_after(options_.open_timeout);
-    open_timer_.async_wait([this, life, gen](boost::system::error_code ec) {
-        if (life.expired() || gen != generation_ || ec || state_ != State::opening) return;
-        finish_open(Unexpected(make_error_code(ClientError::timeout)));
-    });
-    resolver_.async_resolve(
-        options_.host, std::to_string(options_.port), udp::resolver::numeric_service,
-        [this, life, gen](boost::system::error_code ec, udp::resolver::results_type r) {
-            if (life.expired() || gen != generation_) return;
-            if (ec) return finish_open(Unexpected(ec));
-            connect_first(r);
-        });
+    begin_open(std::move(done), [this](const Resolved& results) { connect_first(results); });
 }
 
 void UdpTransport::connect_first(const udp::resolver::results_type& results) {
@@ -72,9 +56,7 @@ void UdpTransport::connect_first(const udp::resolver::results_type& results) {
 }
 
 void UdpTransport::finish_open(Result<LinkInfo> result) {
-    open_timer_.cancel();
-    auto done = std::move(open_done_);
-    open_done_ = nullptr;
+    auto done = take_open_handler();
     if (result) {
         state_ = State::open;
         receive();
@@ -174,21 +156,8 @@ void UdpTransport::write_next() {
                        });
 }
 
-void UdpTransport::fail(boost::system::error_code reason) {
-    close();
-    if (on_close_) on_close_(reason);
-}
-
 void UdpTransport::close() {
-    ++generation_;
-    boost::system::error_code ignored;
-    resolver_.cancel();
-    open_timer_.cancel();
-    socket_.close(ignored);
-    queue_.clear();
-    writing_ = false;
-    open_done_ = nullptr;
-    state_ = State::closed;
+    close_connection();
 }
 
 }  // namespace fins::transport

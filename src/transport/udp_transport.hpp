@@ -26,12 +26,11 @@
 
 #include "fins/frame.hpp"
 #include "transport/asio.hpp"
-#include "transport/transport.hpp"
-#include "transport/write_queue.hpp"
+#include "transport/socket_transport.hpp"
 
 namespace fins::transport {
 
-class UdpTransport final : public Transport {
+class UdpTransport final : public SocketTransport<asio::ip::udp> {
   public:
     UdpTransport(asio::io_context& io, TransportOptions options);
     ~UdpTransport() override;
@@ -39,30 +38,17 @@ class UdpTransport final : public Transport {
     void async_open(OpenHandler done) override;
     void send(Bytes frame) override;
     void close() override;
-    [[nodiscard]] State state() const noexcept override { return state_; }
-    [[nodiscard]] bool write_pending() const noexcept override { return !queue_.empty(); }
 
     [[nodiscard]] bool peer_gone() override;
 
   private:
     void connect_first(const asio::ip::udp::resolver::results_type& results);
-    void finish_open(Result<LinkInfo> result);
+    void finish_open(Result<LinkInfo> result) override;
     void receive();
     // Handles one receive result; false once the transport was closed or replaced.
     bool on_receive(boost::system::error_code ec, std::size_t n);
     void write_next();
-    void fail(boost::system::error_code reason);
 
-    TransportOptions options_;
-    asio::ip::udp::resolver resolver_;
-    asio::ip::udp::socket socket_;
-    asio::steady_timer open_timer_;
-    State state_ = State::closed;
-    std::uint64_t generation_ = 0;  // bumped on close: handlers of older sockets ignore
-    std::shared_ptr<int> life_ = std::make_shared<int>(0);  // handlers check it is alive
-    OpenHandler open_done_;
-    WriteQueue queue_;
-    bool writing_ = false;
     std::array<std::uint8_t, max_frame_size + 1> rx_{};
 };
 

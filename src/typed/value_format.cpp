@@ -28,6 +28,14 @@ constexpr FormatRow formats[] = {
     {Format::bits, "bits", 0},     {Format::hex, "hex", 1},
 };
 
+// The Format column of `formats`, for all_formats().
+constexpr auto format_order = [] {
+    std::array<Format, std::size(formats)> out{};
+    for (std::size_t i = 0; i < out.size(); ++i)
+        out[i] = formats[i].format;
+    return out;
+}();
+
 template <class T>
 std::optional<T> parse_integer(std::string_view s) {
     int base = 10;
@@ -75,6 +83,10 @@ void append(std::vector<std::uint16_t>& out, const Array& words) {
 }
 
 }  // namespace
+
+std::span<const Format> all_formats() noexcept {
+    return format_order;
+}
 
 std::optional<Format> parse_format(std::string_view name) {
     for (const auto& f : formats)

@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -36,6 +37,8 @@ enum class Format : std::uint8_t {
     hex,      // one word, printed 0x1234
 };
 
+// Every format, in the table's order (int16 first).
+std::span<const Format> all_formats() noexcept;
 // Also takes "float32", "float64", "ascii" (string) and "bool" (bits).
 std::optional<Format> parse_format(std::string_view name);
 std::string_view format_name(Format f);

@@ -1,5 +1,5 @@
-// Real parts for the bridge tests: a mosquitto broker started on a free loopback port
-// (plain, TLS with a CA made by openssl, or with a password file from mosquitto_passwd),
+// Real parts for the bridge tests: a mosquitto broker (bridge_processes.hpp's) plain, with
+// TLS from a CA made by openssl, or with a password file from mosquitto_passwd,
 // a libmosquitto subscriber that records every message, and fins-bridge itself. Every
 // wait is bounded.
 #pragma once
@@ -31,6 +31,7 @@ using fins::test::Child;
 using fins::test::ScratchDir;
 
 using fins::test::bridge::bridge_path;
+using fins::test::bridge::Mosquitto;
 using fins::test::bridge::Proc;
 inline std::uint16_t free_port() {
     return fins::test::bridge::free_tcp_port();
@@ -57,36 +58,6 @@ inline bool make_tls(const ScratchDir& dir) {
                  // mosquitto started as root reads them as the user "mosquitto"
                  " && chmod 0755 . && chmod 0644 ca.crt server.crt server.key") == 0;
 }
-
-class Mosquitto {
-  public:
-    // `extra`: more lines for the listener (TLS files, password_file ...).
-    explicit Mosquitto(const ScratchDir& dir, const std::string& extra = "", std::uint16_t port = 0)
-        : port_(port != 0 ? port : free_port()) {
-        const auto conf = dir.write(
-            "mosquitto-" + std::to_string(port_) + ".conf",
-            "per_listener_settings true\nlog_dest none\npersistence false\n"
-            "listener " +
-                std::to_string(port_) + " 127.0.0.1\n" +
-                (extra.find("password_file") == std::string::npos ? "allow_anonymous true\n"
-                                                                  : "allow_anonymous false\n") +
-                extra);
-        child_ = std::make_unique<Proc>(std::vector<std::string>{"/usr/sbin/mosquitto", "-c", conf},
-                                        conf + ".log");
-        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-        while (std::chrono::steady_clock::now() < deadline && !accepts(port_))
-            std::this_thread::sleep_for(std::chrono::milliseconds(20));
-        started_ = accepts(port_);
-    }
-    [[nodiscard]] bool started() const { return started_; }
-    [[nodiscard]] std::uint16_t port() const { return port_; }
-    void kill() { child_->kill(SIGKILL); }
-
-  private:
-    std::uint16_t port_;
-    std::unique_ptr<Proc> child_;
-    bool started_ = false;
-};
 
 struct Received {
     std::string topic;

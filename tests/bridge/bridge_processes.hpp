@@ -1,8 +1,8 @@
-// Child processes and loopback ports for every bridge test (bridge_fixture.hpp, the
-// cluster and Sparkplug tests in cluster/processes.hpp, bench/bridge_failover.cpp): one
-// copy. A child's stdout and stderr go to a log file, so a chatty child never blocks on a
-// full pipe; it dies with the test (PR_SET_PDEATHSIG) and is killed by its destructor.
-// Every wait is bounded.
+// Child processes, loopback ports and the mosquitto broker for every bridge test
+// (bridge_fixture.hpp, the cluster and Sparkplug tests in cluster/processes.hpp,
+// bench/bridge_failover.cpp): one copy. A child's stdout and stderr go to a log file, so a chatty
+// child never blocks on a full pipe; it dies with the test (PR_SET_PDEATHSIG) and is killed by its
+// destructor. Every wait is bounded.
 #pragma once
 
 #include <arpa/inet.h>
@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -134,6 +135,44 @@ class Proc {
     pid_t pid_ = -1;
     bool reaped_ = false;
     int status_ = -1;
+};
+
+// mosquitto on a free 127.0.0.1 port with no persistence (up to 5 ports tried, in case
+// another test took one meanwhile). `extra`: more lines for the
+// listener (TLS files, password_file ...); anonymous clients are allowed unless it names a
+// password_file. Its config and log are mosquitto-PORT.conf(.log) in `dir`.
+class Mosquitto {
+  public:
+    explicit Mosquitto(const std::filesystem::path& dir, const std::string& extra = "") {
+        const auto exe = mosquitto_path();
+        if (exe.empty()) return;
+        const bool anonymous = extra.find("password_file") == std::string::npos;
+        for (int attempt = 0; attempt < 5 && !started_; ++attempt) {
+            port_ = free_tcp_port();
+            const auto conf = dir / ("mosquitto-" + std::to_string(port_) + ".conf");
+            std::ofstream(conf) << "per_listener_settings true\npersistence false\n"
+                                << "listener " << port_ << " 127.0.0.1\n"
+                                << "allow_anonymous " << (anonymous ? "true" : "false") << "\n"
+                                << extra;
+            proc_ = std::make_unique<Proc>(std::vector<std::string>{exe, "-c", conf.string()},
+                                           conf.string() + ".log");
+            const auto deadline = std::chrono::steady_clock::now() + 10s;
+            while (std::chrono::steady_clock::now() < deadline && proc_->running()) {
+                if (tcp_connectable(port_)) {
+                    started_ = true;
+                    break;
+                }
+                std::this_thread::sleep_for(20ms);
+            }
+        }
+    }
+    [[nodiscard]] bool started() const { return started_; }
+    [[nodiscard]] std::uint16_t port() const { return port_; }
+
+  private:
+    std::unique_ptr<Proc> proc_;
+    std::uint16_t port_ = 0;
+    bool started_ = false;
 };
 
 }  // namespace fins::test::bridge

@@ -35,7 +35,7 @@ tags = [ { name = "speed", address = "D100", type = "int16" },
 
 struct Rig {
     ScratchDir dir{"bridge"};
-    Mosquitto broker{dir};
+    Mosquitto broker{dir.path()};
     Finsd finsd{{}};
     Subscriber sub{broker.port(), "t/#"};
     std::unique_ptr<BridgeProcess> bridge;

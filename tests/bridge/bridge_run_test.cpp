@@ -86,7 +86,7 @@ TEST(BridgeRun, AKilledBridgesPlcStatusNamesItsOwnerWhoseStatusSaysOffline) {
 
 TEST(BridgeRun, EndCodesAreCarriedPerTag) {
     ScratchDir dir{"bridge"};
-    Mosquitto broker{dir};
+    Mosquitto broker{dir.path()};
     // A CJ1M has no EM (1101 area missing) and refuses network writes (protected).
     Finsd finsd{{"--profile", "cj1m", "--network-write-protection", "all"}};
     Subscriber sub(broker.port(), "t/#");
@@ -140,8 +140,9 @@ TEST(BridgeRun, TlsAndPasswordBroker) {
     ASSERT_EQ(shell("mosquitto_passwd -b -c " + d + "/passwd bridge s3cret && chmod 0644 " + d +
                     "/passwd"),
               0);
-    Mosquitto broker{dir, "cafile " + d + "/ca.crt\ncertfile " + d + "/server.crt\nkeyfile " + d +
-                              "/server.key\npassword_file " + d + "/passwd\n"};
+    Mosquitto broker{dir.path(), "cafile " + d + "/ca.crt\ncertfile " + d +
+                                     "/server.crt\nkeyfile " + d + "/server.key\npassword_file " +
+                                     d + "/passwd\n"};
     Finsd finsd{{}};
     ASSERT_TRUE(broker.started() && finsd.started());
     Subscriber sub(broker.port(), "t/#", {d + "/ca.crt", "bridge", "s3cret"});
@@ -160,7 +161,7 @@ TEST(BridgeRun, TlsAndPasswordBroker) {
 
 TEST(BridgeRun, SecondBrokerIsTriedWhenTheFirstIsDown) {
     ScratchDir dir{"bridge"};
-    Mosquitto broker{dir};
+    Mosquitto broker{dir.path()};
     Finsd finsd{{}};
     Subscriber sub(broker.port(), "t/#");
     ASSERT_TRUE(broker.started() && finsd.started() && sub.connected());
@@ -258,7 +259,7 @@ name = "line-2"
   via_node = 1
 )");
     Finsd finsd{{"--config", plant}};
-    Mosquitto broker{dir};
+    Mosquitto broker{dir.path()};
     Subscriber sub(broker.port(), "t/#");
     ASSERT_TRUE(finsd.started() && broker.started() && sub.connected()) << finsd.result().err;
     BridgeProcess bridge(dir, mqtt_section(broker.port()) +

@@ -108,7 +108,7 @@ TEST(BridgeRun, BadCommandsAreAnsweredAndChangeNothing) {
 
 TEST(BridgeRun, RetainedCommandsAreRefused) {
     ScratchDir dir{"bridge"};
-    Mosquitto broker{dir};
+    Mosquitto broker{dir.path()};
     Finsd finsd{{}};
     ASSERT_TRUE(broker.started() && finsd.started());
     {
@@ -128,7 +128,7 @@ TEST(BridgeRun, RetainedCommandsAreRefused) {
 
 TEST(BridgeRun, StoppedPlcIsOfflineWritesFailAtOnceOthersGoOn) {
     ScratchDir dir{"bridge"};
-    Mosquitto broker{dir};
+    Mosquitto broker{dir.path()};
     Finsd finsd{{}};
     Subscriber sub(broker.port(), "t/#");
     ASSERT_TRUE(broker.started() && finsd.started() && sub.connected());

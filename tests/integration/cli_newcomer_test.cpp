@@ -249,7 +249,8 @@ TEST(CliMemory, TypedInitialValues) {
     const auto range = dir.write("range.toml", "[memory]\n\"D0\" = { bcd = 12345 }\n");
     r = run({finsd_path, "--port", "0", "--config", range});
     EXPECT_EQ(r.exit_code, 2);
-    EXPECT_NE(r.err.find("memory.\"D0\".bcd: 12345 out of range for bcd"), std::string::npos)
+    EXPECT_NE(r.err.find("memory.\"D0\".bcd: 12345 is out of range for bcd (0 to 9999)"),
+              std::string::npos)
         << r.err;
 }
 

@@ -134,6 +134,42 @@ TEST(FinsdSettings, ErrorsNameTheKeyAndPosition) {
     EXPECT_NE(error_of("a = [").find("t.toml:1:"), std::string::npos);
 }
 
+// [memory]'s { TYPE = value } takes src/typed's formats, ranges and words (the table
+// behind fins --as, the web API and fins-bridge's tag types).
+TEST(FinsdSettings, TypedValuesAreTheSharedFormats) {
+    EXPECT_EQ(error_of("[memory]\n\"D0\" = { flaot = 1 }\n"),
+              "t.toml:2:1: memory.\"D0\": 'flaot' is not a value type: int16, uint16, int32, "
+              "uint32, float, double, bcd, bcd32 or string");
+    EXPECT_EQ(error_of("[memory]\n\"D0\" = { hex = 1 }\n"),
+              "t.toml:2:1: memory.\"D0\": 'hex' is not a value type: int16, uint16, int32, "
+              "uint32, float, double, bcd, bcd32 or string");
+    EXPECT_EQ(error_of("[memory]\n\"D0\" = { int16 = 1.5 }\n"),
+              "t.toml:2:1: memory.\"D0\".int16: must be an integer");
+    EXPECT_EQ(error_of("[memory]\n\"D0\" = { double = \"x\" }\n"),
+              "t.toml:2:1: memory.\"D0\".double: must be a number");
+    EXPECT_EQ(error_of("[memory]\n\"D0\" = { uint32 = [1, -1] }\n"),
+              "t.toml:2:1: memory.\"D0\".uint32: -1 is out of range for uint32 (0 to 4294967295)");
+    EXPECT_EQ(error_of("[memory]\n\"D0\" = { int16 = 32768 }\n"),
+              "t.toml:2:1: memory.\"D0\".int16: 32768 is out of range for int16 (-32768 to 32767)");
+    EXPECT_EQ(error_of("[memory]\n\"D0\" = { float = 1e39 }\n"),
+              "t.toml:2:1: memory.\"D0\".float: 1e+39 is out of range for float");
+
+    const Settings s = load(R"([memory]
+"D0" = { int32 = [-5, 70000] }
+"D10" = { float32 = 1.5 }
+"D20" = { float = 1.5 }
+"D30" = { bcd32 = 12345678 }
+"D40" = { string = "ABC" }
+)");
+    ASSERT_EQ(s.memory.size(), 5u);
+    using WordValues = std::vector<std::uint32_t>;
+    EXPECT_EQ(s.memory[0].values, (WordValues{0xFFFB, 0xFFFF, 0x1170, 0x0001}));
+    EXPECT_EQ(s.memory[1].values, (WordValues{0x0000, 0x3FC0}));  // "float32" is "float"
+    EXPECT_EQ(s.memory[2].values, s.memory[1].values);
+    EXPECT_EQ(s.memory[3].values, (WordValues{0x5678, 0x1234}));
+    EXPECT_EQ(s.memory[4].values, (WordValues{0x4142, 0x4300}));
+}
+
 TEST(FinsdSettings, ParsersOfModesProtectionsAndNodes) {
     EXPECT_EQ(parse_mode("stop"), plc::OperatingMode::program);
     EXPECT_EQ(parse_mode("RUN"), std::nullopt);

@@ -2,15 +2,20 @@
 #include "cli/finsd/config_values.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cstddef>
 #include <cstdint>
-#include <iterator>
 #include <limits>
 #include <optional>
+#include <string>
 #include <string_view>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <nlohmann/json.hpp>
 
 #include "fins/values.hpp"
+#include "typed/value_format.hpp"
 
 namespace fins::cli::finsd {
 
@@ -18,72 +23,71 @@ namespace {
 
 using WordList = std::vector<std::uint32_t>;
 using Failure = tl::unexpected<TypedValueError>;
+using typed::Format;
 
-constexpr std::string_view types =
-    "int16, uint16, int32, uint32, float, double, bcd, bcd32 or string";
+// The value formats of src/typed (fins --as, the web API, the bridge) that name words to
+// store: not bits, nor hex (a way to print uint16).
+bool storable(Format f) {
+    return f != Format::bits && f != Format::hex;
+}
 
-// One value of `type` appended to `out`; the message when it does not fit the type.
-std::optional<std::string> add_value(const std::string& type, const toml::node& n, WordList& out) {
-    const auto add = [&out](const auto& words) {
-        out.insert(out.end(), words.begin(), words.end());
-    };
-    if (type == "string") {
+// "int16, uint16, ... or string": the storable formats, from the one table.
+const std::string& type_names() {
+    static const std::string names = [] {
+        std::vector<std::string_view> list;
+        for (const Format f : typed::all_formats())
+            if (storable(f)) list.push_back(typed::format_name(f));
+        return fmt::format("{} or {}", fmt::join(list.begin(), list.end() - 1, ", "), list.back());
+    }();
+    return names;
+}
+
+// One value of format `f` appended to `out`; the message when it does not fit the format
+// (its range is the table's: typed::json_to_words checks it).
+std::optional<std::string> add_value(Format f, const toml::node& n, WordList& out) {
+    if (f == Format::string) {
         const auto* text = n.as_string();
         auto w = text ? string_to_words(text->get()) : Result<std::vector<std::uint16_t>>{};
         if (!text || !w) return "must be a string (two characters a word)";
-        add(*w);
+        out.insert(out.end(), w->begin(), w->end());
         return std::nullopt;
     }
-    if (type == "float" || type == "double") {
-        std::optional<double> v;
-        if (const auto* f = n.as_floating_point()) v = f->get();
-        if (const auto* i = n.as_integer()) v = static_cast<double>(i->get());
-        if (!v) return "must be a number";
-        if (type == "float")
-            add(float_to_words(static_cast<float>(*v)));
-        else
-            add(double_to_words(*v));
-        return std::nullopt;
+    nlohmann::json value;
+    if (typed::integer_range(f)) {
+        const auto* i = n.as_integer();
+        if (i == nullptr) return "must be an integer";
+        value = i->get();
+    } else if (const auto* real = n.as_floating_point()) {
+        value = real->get();
+    } else if (const auto* i = n.as_integer()) {
+        value = i->get();
+    } else {
+        return "must be a number";
     }
-    const auto* i = n.as_integer();
-    if (i == nullptr) return "must be an integer";
-    const std::int64_t v = i->get();
-    const auto in = [v](std::int64_t lo, std::int64_t hi) { return v >= lo && v <= hi; };
-    if (type == "int16" && in(-32768, 32767))
-        add(int16_to_words(static_cast<std::int16_t>(v)));
-    else if (type == "uint16" && in(0, 0xFFFF))
-        add(uint16_to_words(static_cast<std::uint16_t>(v)));
-    else if (type == "int32" &&
-             in(std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::max()))
-        add(int32_to_words(static_cast<std::int32_t>(v)));
-    else if (type == "uint32" && in(0, 0xFFFFFFFF))
-        add(uint32_to_words(static_cast<std::uint32_t>(v)));
-    else if (type == "bcd" && in(0, 9999))
-        add(*bcd16_to_words(static_cast<std::uint16_t>(v)));
-    else if (type == "bcd32" && in(0, 99999999))
-        add(*bcd32_to_words(static_cast<std::uint32_t>(v)));
-    else
-        return fmt::format("{} out of range for {}", v, type);
+    std::array<std::uint16_t, 4> words{};
+    if (auto problem = typed::json_to_words(f, value, words)) return problem;
+    const auto count = static_cast<std::ptrdiff_t>(typed::words_per_value(f));
+    out.insert(out.end(), words.begin(), words.begin() + count);
     return std::nullopt;
 }
 
 }  // namespace
 
 tl::expected<WordList, TypedValueError> typed_words(const toml::table& t) {
-    if (t.size() != 1) return Failure({"", fmt::format("a typed value is one key: {}", types)});
+    if (t.size() != 1)
+        return Failure({"", fmt::format("a typed value is one key: {}", type_names())});
     const auto first = t.begin();  // its pair refers into the iterator: keep it alive
     const std::string type(first->first.str());
     const toml::node& value = first->second;
-    static constexpr std::string_view known[] = {"int16",  "uint16", "int32", "uint32", "float",
-                                                 "double", "bcd",    "bcd32", "string"};
-    if (std::find(std::begin(known), std::end(known), type) == std::end(known))
-        return Failure({"", fmt::format("'{}' is not a value type: {}", type, types)});
+    const auto format = typed::parse_format(type);
+    if (!format || !storable(*format))
+        return Failure({"", fmt::format("'{}' is not a value type: {}", type, type_names())});
     WordList out;
     if (const auto* list = value.as_array()) {
         if (list->empty()) return Failure({"." + type, "empty array"});
         for (const auto& n : *list)
-            if (auto e = add_value(type, n, out)) return Failure({"." + type, *e});
-    } else if (auto e = add_value(type, value, out)) {
+            if (auto e = add_value(*format, n, out)) return Failure({"." + type, *e});
+    } else if (auto e = add_value(*format, value, out)) {
         return Failure({"." + type, *e});
     }
     return out;

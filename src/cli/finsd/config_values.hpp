@@ -1,8 +1,9 @@
 // finsd's [memory] typed values: { TYPE = value } or { TYPE = [values] } turned into the
-// words of each value in Omron's order (fins/values.hpp, as `fins write --as TYPE`):
-// int16 uint16 int32 uint32 float double bcd (one word, 0-9999) bcd32 (two words)
-// string (2 characters a word). Parsing only; the messages name the file, position and
-// dotted key of the entry.
+// words of each value in Omron's order (fins/values.hpp, as `fins write --as TYPE`).
+// The types, their ranges and their words are src/typed's table (value_format.hpp, also
+// the web API's and fins-bridge's): int16 uint16 int32 uint32 float double bcd (one word,
+// 0-9999) bcd32 (two words) string (2 characters a word). Parsing only; the messages name
+// the file, position and dotted key of the entry.
 #pragma once
 
 #include <cstdint>

@@ -1,65 +1,21 @@
-// File memory commands 22 01 .. 22 15 (W342 5-3-32 .. 5-3-42, fins-frames 6 "22 xx").
+// File memory commands 22 01 .. 22 08 and 22 15 (W342 5-3-32 .. 5-3-38, 5-3-42, fins-frames
+// 6 "22 xx"); the transfers 22 0A .. 22 0C are file_transfer.cpp's.
 //
 // Server side (decode): 1002 when the parameters end before a fixed field or before the
 // bytes a length field announces, 1001 when bytes are left over. Names and paths are
 // copied as they are; plc::FileMemory judges them.
 // Client side (decode_response): any length or echo mismatch is malformed_response.
-#include "codec/command_codec.hpp"
 #include "fins/commands/file_memory.hpp"
+#include "codec/command_codec.hpp"
+#include "codec/commands/file_fields.hpp"
 
 namespace fins {
 
 using codec::end_code;
 using codec::malformed;
+using namespace codec::file_fields;
 
-namespace {
-
-constexpr std::uint8_t pad = 0x20;
-
-// Reads the fields through `r`; a short input leaves r truncated (1002), extra bytes
-// leave r not at its end (1001).
-std::error_code finish(const ByteReader& r) noexcept {
-    if (r.truncated()) return make_error_code(EndCode::command_too_short);
-    if (r.remaining() != 0) return make_error_code(EndCode::command_too_long);
-    return {};
-}
-
-FileName read_name(ByteReader& r) noexcept {
-    FileName n;
-    const auto b = r.bytes(n.bytes.size());
-    for (std::size_t i = 0; i < b.size(); ++i)
-        n.bytes[i] = b[i];
-    return n;
-}
-
-void write_name(ByteWriter& w, const FileName& n) noexcept {
-    w.bytes(n.bytes);
-}
-
-std::string read_path(ByteReader& r) {
-    const auto length = r.u16();
-    const auto b = r.bytes(length);
-    return std::string(b.begin(), b.end());
-}
-
-void write_path(ByteWriter& w, std::string_view path) noexcept {
-    w.u16(static_cast<std::uint16_t>(path.size()));
-    for (const char c : path)
-        w.u8(static_cast<std::uint8_t>(c));
-}
-
-template <class C>
-Result<C> checked(C command, const ByteReader& r) {
-    if (auto ec = finish(r)) return Unexpected(ec);
-    return command;
-}
-
-Result<EmptyResponse> empty_response(Bytes data) {
-    if (!data.empty()) return malformed();
-    return EmptyResponse{};
-}
-
-}  // namespace
+constexpr std::uint8_t pad = 0x20;  // a file name's unused characters
 
 std::optional<FileName> FileName::from(std::string_view text) noexcept {
     FileName n;
@@ -327,113 +283,6 @@ Result<FileNameChange> FileNameChange::decode(Bytes parameters) {
 
 Result<FileNameChange::Response> FileNameChange::decode_response(Bytes data) const {
     return empty_response(data);
-}
-
-// ---- 22 0A / 22 0B / 22 0C transfers (5-3-39 .. 5-3-41) ----
-
-void FileTransferCountResponse::encode(ByteWriter& w) const noexcept {
-    w.u16(count);
-}
-
-namespace {
-Result<FileTransferCountResponse> count_response(Bytes data) {
-    ByteReader r(data);
-    FileTransferCountResponse out{r.u16()};
-    if (r.truncated() || r.remaining() != 0) return malformed();
-    return out;
-}
-}  // namespace
-
-void MemoryAreaFileTransfer::encode(ByteWriter& w) const noexcept {
-    w.u16(mode);
-    w.u8(start.area_code);
-    w.u16(start.word);
-    w.u8(start.bit);
-    w.u16(count);
-    w.u16(disk);
-    write_name(w, file);
-    write_path(w, directory);
-}
-
-Result<MemoryAreaFileTransfer> MemoryAreaFileTransfer::decode(Bytes parameters) {
-    ByteReader r(parameters);
-    MemoryAreaFileTransfer c;
-    c.mode = r.u16();
-    c.start.area_code = r.u8();
-    c.start.word = r.u16();
-    c.start.bit = r.u8();
-    c.count = r.u16();
-    c.disk = r.u16();
-    c.file = read_name(r);
-    c.directory = read_path(r);
-    return checked(std::move(c), r);
-}
-
-Result<MemoryAreaFileTransfer::Response> MemoryAreaFileTransfer::decode_response(Bytes data) const {
-    return count_response(data);
-}
-
-void ParameterAreaFileTransfer::encode(ByteWriter& w) const noexcept {
-    w.u16(mode);
-    w.u16(area);
-    w.u16(start);
-    w.u16(count);
-    w.u16(disk);
-    write_name(w, file);
-    write_path(w, directory);
-}
-
-Result<ParameterAreaFileTransfer> ParameterAreaFileTransfer::decode(Bytes parameters) {
-    ByteReader r(parameters);
-    ParameterAreaFileTransfer c;
-    c.mode = r.u16();
-    c.area = r.u16();
-    c.start = r.u16();
-    c.count = r.u16();
-    c.disk = r.u16();
-    c.file = read_name(r);
-    c.directory = read_path(r);
-    return checked(std::move(c), r);
-}
-
-Result<ParameterAreaFileTransfer::Response> ParameterAreaFileTransfer::decode_response(
-    Bytes data) const {
-    return count_response(data);
-}
-
-void ProgramAreaFileTransferResponse::encode(ByteWriter& w) const noexcept {
-    w.u32(length);
-}
-
-void ProgramAreaFileTransfer::encode(ByteWriter& w) const noexcept {
-    w.u16(mode);
-    w.u16(program_number);
-    w.u32(start);
-    w.u32(length);
-    w.u16(disk);
-    write_name(w, file);
-    write_path(w, directory);
-}
-
-Result<ProgramAreaFileTransfer> ProgramAreaFileTransfer::decode(Bytes parameters) {
-    ByteReader r(parameters);
-    ProgramAreaFileTransfer c;
-    c.mode = r.u16();
-    c.program_number = r.u16();
-    c.start = r.u32();
-    c.length = r.u32();
-    c.disk = r.u16();
-    c.file = read_name(r);
-    c.directory = read_path(r);
-    return checked(std::move(c), r);
-}
-
-Result<ProgramAreaFileTransfer::Response> ProgramAreaFileTransfer::decode_response(
-    Bytes data) const {
-    ByteReader r(data);
-    ProgramAreaFileTransferResponse out{r.u32()};
-    if (r.truncated() || r.remaining() != 0) return malformed();
-    return out;
 }
 
 // ---- 22 15 CREATE/DELETE DIRECTORY (5-3-42) ----

@@ -109,7 +109,7 @@ void run_cluster(int instances) {
     if (tb::mosquitto_path().empty()) GTEST_SKIP() << "mosquitto is not installed";
     fins::test::ScratchDir dir("cluster");
     tb::Mosquitto broker(dir.path());
-    ASSERT_TRUE(broker.up());
+    ASSERT_TRUE(broker.started());
     fins::test::Finsd finsd({});
     ASSERT_TRUE(finsd.started());
     tb::CountingRelay relay(plc_count, finsd.port());
@@ -187,7 +187,7 @@ TEST(ClusterFailover, AFrozenInstanceIsReplacedAndRejoinsWhenItContinues) {
     if (tb::mosquitto_path().empty()) GTEST_SKIP() << "mosquitto is not installed";
     fins::test::ScratchDir dir("cluster-freeze");
     tb::Mosquitto broker(dir.path());
-    ASSERT_TRUE(broker.up());
+    ASSERT_TRUE(broker.started());
     fins::test::Finsd finsd({});
     ASSERT_TRUE(finsd.started());
     tb::CountingRelay relay(plc_count, finsd.port());

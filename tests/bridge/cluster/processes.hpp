@@ -1,7 +1,7 @@
-// Real parts for the Sparkplug and multi-instance tests: a mosquitto broker on a free loopback
-// port, an MQTT recorder (libmosquitto) and a UDP relay in front of finsd that counts the
-// requests of each sender (which instance polls which PLC). Child processes and ports are
-// bridge_processes.hpp's. Every wait is bounded.
+// Real parts for the Sparkplug and multi-instance tests: an MQTT recorder (libmosquitto) and
+// a UDP relay in front of finsd that counts the requests of each sender (which instance polls
+// which PLC). Child processes, ports and the mosquitto broker are bridge_processes.hpp's.
+// Every wait is bounded.
 #pragma once
 
 #include <arpa/inet.h>
@@ -35,38 +35,6 @@
 namespace fins::test::bridge {
 
 using namespace std::chrono_literals;
-
-// mosquitto on 127.0.0.1:<free port>, anonymous, no persistence.
-class Mosquitto {
-  public:
-    explicit Mosquitto(const std::filesystem::path& dir) {
-        const auto exe = mosquitto_path();
-        if (exe.empty()) return;
-        for (int attempt = 0; attempt < 5 && !up_; ++attempt) {
-            port_ = free_tcp_port();
-            const auto conf = dir / ("mosquitto-" + std::to_string(port_) + ".conf");
-            std::ofstream(conf) << "listener " << port_ << " 127.0.0.1\nallow_anonymous true\n"
-                                << "persistence false\n";
-            proc_ = std::make_unique<Proc>(std::vector<std::string>{exe, "-c", conf.string()},
-                                           dir / ("mosquitto-" + std::to_string(port_) + ".log"));
-            const auto deadline = std::chrono::steady_clock::now() + 10s;
-            while (std::chrono::steady_clock::now() < deadline && proc_->running()) {
-                if (tcp_connectable(port_)) {
-                    up_ = true;
-                    break;
-                }
-                std::this_thread::sleep_for(20ms);
-            }
-        }
-    }
-    [[nodiscard]] bool up() const { return up_; }
-    [[nodiscard]] std::uint16_t port() const { return port_; }
-
-  private:
-    std::unique_ptr<Proc> proc_;
-    std::uint16_t port_ = 0;
-    bool up_ = false;
-};
 
 struct Received {
     std::string topic;

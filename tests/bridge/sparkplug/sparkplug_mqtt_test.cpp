@@ -64,7 +64,7 @@ TEST(SparkplugMqtt, BirthSequenceSeqWrapRebirthDcmdOnceAndNdeathOnKill) {
     if (tb::mosquitto_path().empty()) GTEST_SKIP() << "mosquitto is not installed";
     fins::test::ScratchDir dir("sparkplug");
     tb::Mosquitto broker(dir.path());
-    ASSERT_TRUE(broker.up());
+    ASSERT_TRUE(broker.started());
     fins::test::Finsd finsd({});
     ASSERT_TRUE(finsd.started());
     tb::CountingRelay relay(2, finsd.port());

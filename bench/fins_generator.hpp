@@ -1,0 +1,131 @@
+// fins_load's request generator, also fins_web_load's FINS side: the 1-word MEMORY AREA
+// READ of D0 as a FINS frame, a blocking loopback socket, and the loop that keeps `depth`
+// requests in flight and times each. Header-only, bench only.
+#pragma once
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <sys/time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "echo_server.hpp"
+#include "fins/byte_io.hpp"
+#include "fins/commands/memory_area.hpp"
+#include "fins/frame.hpp"
+#include "fins/tcp.hpp"
+
+namespace fins_bench {
+
+using Clock = std::chrono::steady_clock;
+
+struct Frames {
+    std::vector<std::uint8_t> request;  // what the generator sends (with envelope on TCP)
+    std::size_t response_size = 0;      // what comes back
+};
+
+// finsd's answer to read_frame(): header, command code, end code, one word.
+inline constexpr std::size_t read_response_size = fins::header_size + 2 + 2 + 2;
+
+// The 1-word read of D0 from node 200 as a FINS frame.
+inline std::vector<std::uint8_t> read_frame(std::uint8_t sid) {
+    std::array<std::uint8_t, 32> params{};
+    fins::ByteWriter pw{params};
+    fins::MemoryAreaRead{{0x82, 0, 0}, 1}.encode(pw);
+    fins::Header h;
+    h.destination = {0, 1, 0};
+    h.source = {0, 200, 0};
+    h.service_id = sid;
+    std::vector<std::uint8_t> out(fins::max_frame_size);
+    auto n = fins::encode_request(h, fins::MemoryAreaRead::code, pw.written(), out);
+    out.resize(n.value_or(0));
+    return out;
+}
+
+struct Stats {
+    double rate = 0;
+    double p50_us = 0;
+    double p99_us = 0;
+    std::size_t count = 0;
+    double cpu_us = 0;  // the server thread's CPU time over the case
+
+    [[nodiscard]] double cpu_per_request_us() const {
+        return count > 0 ? cpu_us / static_cast<double>(count) : 0;
+    }
+};
+
+inline int connect_to(bool tcp, std::uint16_t port, bool nodelay = true) {
+    const int fd = ::socket(AF_INET, tcp ? SOCK_STREAM : SOCK_DGRAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    a.sin_port = htons(port);
+    if (::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
+        ::close(fd);
+        return -1;
+    }
+    if (tcp && nodelay) set_nodelay(fd);
+    // A lost datagram must end the case, not hang it.
+    timeval tv{1, 0};
+    setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+    return fd;
+}
+
+// Keeps `depth` requests outstanding for `seconds`; a request's latency is measured
+// from its send to the arrival of the next response (responses come back in order).
+// `split`: each request goes out in two writes, the FINS/TCP header, then the frame.
+inline Stats drive(int fd, bool tcp, const Frames& f, unsigned depth, double seconds,
+                   bool split = false) {
+    std::vector<Clock::time_point> sent;
+    sent.reserve(1 << 20);
+    std::vector<double> latencies;
+    latencies.reserve(1 << 20);
+    std::vector<std::uint8_t> in(f.response_size + 64);
+    const auto start = Clock::now();
+    const auto end =
+        start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+    std::size_t next_reply = 0;
+    auto send_one = [&] {
+        sent.push_back(Clock::now());
+        if (split)
+            return ::send(fd, f.request.data(), fins::tcp_header_size, MSG_NOSIGNAL) > 0 &&
+                   ::send(fd, f.request.data() + fins::tcp_header_size,
+                          f.request.size() - fins::tcp_header_size, MSG_NOSIGNAL) > 0;
+        return ::send(fd, f.request.data(), f.request.size(), MSG_NOSIGNAL) > 0;
+    };
+    for (unsigned i = 0; i < depth; ++i)
+        if (!send_one()) return {};
+    bool sending = true;
+    while (next_reply < sent.size()) {
+        const bool ok = tcp ? read_exact(fd, in.data(), f.response_size)
+                            : ::recv(fd, in.data(), in.size(), 0) > 0;
+        if (!ok) break;
+        const auto now = Clock::now();
+        latencies.push_back(
+            std::chrono::duration<double, std::micro>(now - sent[next_reply]).count());
+        ++next_reply;
+        if (sending && now < end) {
+            if (!send_one()) break;
+        } else {
+            sending = false;
+        }
+    }
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    Stats s;
+    s.count = latencies.size();
+    if (latencies.empty()) return s;
+    std::sort(latencies.begin(), latencies.end());
+    s.rate = static_cast<double>(latencies.size()) / elapsed;
+    s.p50_us = latencies[latencies.size() / 2];
+    s.p99_us = latencies[std::min(latencies.size() - 1, latencies.size() * 99 / 100)];
+    return s;
+}
+
+}  // namespace fins_bench
