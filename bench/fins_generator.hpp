@@ -49,6 +49,30 @@ inline std::vector<std::uint8_t> read_frame(std::uint8_t sid) {
     return out;
 }
 
+// What the generator sends and gets back for read_frame(sid): with the FINS/TCP header
+// on TCP.
+inline Frames read_frames(bool tcp, std::uint8_t sid = 1) {
+    Frames f{read_frame(sid), read_response_size};
+    if (tcp) {
+        std::array<std::uint8_t, 16> envelope{};
+        fins::ByteWriter w{envelope};
+        fins::write_tcp_header(w, fins::TcpCommand::frame, f.request.size());
+        f.request.insert(f.request.begin(), envelope.begin(), envelope.end());
+        f.response_size += fins::tcp_header_size;
+    }
+    return f;
+}
+
+// FINS/TCP handshake by hand: ask for node 200, the source node of read_frame() (finsd
+// executes only frames from the node the connection got), read the 24-byte answer.
+inline bool tcp_handshake(int fd) {
+    std::array<std::uint8_t, 24> buf{};
+    fins::ByteWriter w{buf};
+    fins::write_node_address_request(w, 200);
+    if (::send(fd, buf.data(), w.size(), MSG_NOSIGNAL) <= 0) return false;
+    return read_exact(fd, buf.data(), 24);
+}
+
 struct Stats {
     double rate = 0;
     double p50_us = 0;

@@ -65,16 +65,6 @@ Stats median_stats(std::vector<Stats> runs) {
     return s;
 }
 
-// FINS/TCP handshake by hand: ask for node 200, the source node of read_frame() (finsd
-// executes only frames from the node the connection got), read the 24-byte answer.
-bool tcp_handshake(int fd) {
-    std::array<std::uint8_t, 24> buf{};
-    fins::ByteWriter w{buf};
-    fins::write_node_address_request(w, 200);
-    if (::send(fd, buf.data(), w.size(), MSG_NOSIGNAL) <= 0) return false;
-    return read_exact(fd, buf.data(), 24);
-}
-
 }  // namespace
 
 // bench/load_client.cpp: --client mode.
@@ -119,19 +109,10 @@ int main(int argc, char** argv) {
     }
     std::thread server_thread([&] { io.run(); });
 
-    const auto frame = read_frame(1);
-    const std::size_t fins_response = read_response_size;
     if (client_mode) {
         const int rc =
             run_client_mode((*server)->tcp_port(), seconds, json, [&](bool tcp, unsigned depth) {
-                Frames f{frame, fins_response};
-                if (tcp) {
-                    std::array<std::uint8_t, 16> env{};
-                    fins::ByteWriter w{env};
-                    fins::write_tcp_header(w, fins::TcpCommand::frame, frame.size());
-                    f.request.insert(f.request.begin(), env.begin(), env.end());
-                    f.response_size += fins::tcp_header_size;
-                }
+                const Frames f = read_frames(tcp);
                 const int fd = connect_to(tcp, (*server)->tcp_port());
                 if (fd < 0 || (tcp && !tcp_handshake(fd))) return 0.0;
                 const double rate = drive(fd, tcp, f, depth, seconds).rate;
@@ -144,16 +125,7 @@ int main(int argc, char** argv) {
         return rc;
     }
     for (const bool tcp : {false, true}) {
-        Frames f;
-        f.request = frame;
-        f.response_size = fins_response;
-        if (tcp) {
-            std::array<std::uint8_t, 16> env{};
-            fins::ByteWriter w{env};
-            fins::write_tcp_header(w, fins::TcpCommand::frame, frame.size());
-            f.request.insert(f.request.begin(), env.begin(), env.end());
-            f.response_size += fins::tcp_header_size;
-        }
+        const Frames f = read_frames(tcp);
         // TCP adds the split-write client: header and frame in two writes, no TCP_NODELAY.
         struct Shape {
             unsigned depth;

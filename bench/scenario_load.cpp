@@ -13,16 +13,11 @@
 // of D0 in flight over FINS/UDP and FINS/TCP; each round measures the rate with every
 // scenario paused and with every scenario running (alternating which goes first), and the
 // median ratio running / paused is printed with the server thread's CPU share, and with
-// one in flight the round trips' p50 and p99.
+// one in flight the round trips' p50 and p99 (medians over the rounds).
 //   fins_scenario_load --units 1000 --tags 100 --tick-ms 100 --seconds 1 --rounds 5
-#include <arpa/inet.h>
-#include <netinet/in.h>
-#include <netinet/tcp.h>
-#include <sys/socket.h>
 #include <unistd.h>
 
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <cstdio>
 #include <future>
@@ -38,9 +33,7 @@
 #include <boost/asio/post.hpp>
 
 #include "echo_server.hpp"
-#include "fins/commands/memory_area.hpp"
-#include "fins/frame.hpp"
-#include "fins/tcp.hpp"
+#include "fins_generator.hpp"
 #include "plc/plc.hpp"
 #include "plc/profile.hpp"
 #include "scenario/scenario.hpp"
@@ -51,100 +44,9 @@
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-// A 1-word MEMORY AREA READ of D0 from node 200 (with the FINS/TCP envelope on TCP).
-std::vector<std::uint8_t> read_request(bool tcp) {
-    std::array<std::uint8_t, 32> params{};
-    fins::ByteWriter pw{params};
-    fins::MemoryAreaRead{{0x82, 0, 0}, 1}.encode(pw);
-    fins::Header h;
-    h.destination = {0, 1, 0};
-    h.source = {0, 200, 0};
-    h.service_id = 1;
-    std::vector<std::uint8_t> frame(fins::max_frame_size);
-    frame.resize(
-        fins::encode_request(h, fins::MemoryAreaRead::code, pw.written(), frame).value_or(0));
-    if (!tcp) return frame;
-    std::vector<std::uint8_t> out(fins::tcp_header_size);
-    fins::ByteWriter w{out};
-    fins::write_tcp_header(w, fins::TcpCommand::frame, frame.size());
-    out.insert(out.end(), frame.begin(), frame.end());
-    return out;
-}
-
-int connect_to(bool tcp, std::uint16_t port) {
-    const int fd = ::socket(AF_INET, tcp ? SOCK_STREAM : SOCK_DGRAM, 0);
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    a.sin_port = htons(port);
-    if (fd < 0 || ::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
-        if (fd >= 0) ::close(fd);
-        return -1;
-    }
-    timeval tv{1, 0};  // a lost datagram ends the case instead of hanging it
-    setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
-    if (!tcp) return fd;
-    fins_bench::set_nodelay(fd);
-    // FINS/TCP node address exchange: ask for node 200, the source node of the frames.
-    std::array<std::uint8_t, 24> buf{};
-    fins::ByteWriter w{buf};
-    fins::write_node_address_request(w, 200);
-    if (::send(fd, buf.data(), w.size(), MSG_NOSIGNAL) <= 0 ||
-        !fins_bench::read_exact(fd, buf.data(), 24)) {
-        ::close(fd);
-        return -1;
-    }
-    return fd;
-}
-
-// Answers per second with `depth` requests outstanding for `seconds`; with one in flight,
-// each answer's round trip in microseconds is appended to `round_trips`.
-double drive(int fd, bool tcp, const std::vector<std::uint8_t>& request, std::size_t answer,
-             unsigned depth, double seconds, std::vector<double>& round_trips) {
-    std::vector<std::uint8_t> in(answer + 64);
-    const auto start = Clock::now();
-    const auto end =
-        start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
-    std::size_t sent = 0, answered = 0;
-    auto sent_at = start;
-    auto send_one = [&] {
-        ++sent;
-        sent_at = Clock::now();
-        return ::send(fd, request.data(), request.size(), MSG_NOSIGNAL) > 0;
-    };
-    for (unsigned i = 0; i < depth; ++i)
-        if (!send_one()) return 0;
-    bool sending = true;
-    while (answered < sent) {
-        const bool ok = tcp ? fins_bench::read_exact(fd, in.data(), answer)
-                            : ::recv(fd, in.data(), in.size(), 0) > 0;
-        if (!ok) break;
-        ++answered;
-        if (depth == 1)
-            round_trips.push_back(
-                std::chrono::duration<double, std::micro>(Clock::now() - sent_at).count());
-        if (sending && Clock::now() < end) {
-            if (!send_one()) break;
-        } else {
-            sending = false;
-        }
-    }
-    return static_cast<double>(answered) /
-           std::chrono::duration<double>(Clock::now() - start).count();
-}
-
 double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
     return v[v.size() / 2];
-}
-
-double percentile(std::vector<double>& v, double p) {
-    if (v.empty()) return 0;
-    const auto at = static_cast<std::size_t>(p * static_cast<double>(v.size() - 1));
-    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(at), v.end());
-    return v[at];
 }
 
 }  // namespace
@@ -229,30 +131,30 @@ int main(int argc, char** argv) {
         done.get_future().wait();
     };
 
-    const std::size_t answer = fins::header_size + 2 + 2 + 2;  // header, cmd, end, 1 word
     fmt::print("{} CPU Units x {} tags at {} ms, computed on {}, {} rounds of {} s\n", units, tags,
                tick_ms, worker ? "finsd's scenario thread" : "the I/O thread", rounds, seconds);
     for (const bool tcp : {false, true}) {
         for (const unsigned depth : {1u, 32u}) {
-            const auto request = read_request(tcp);
-            const int fd = connect_to(tcp, tcp ? (*server)->tcp_port() : (*server)->udp_port());
-            if (fd < 0) {
+            const auto frames = fins_bench::read_frames(tcp);
+            const int fd =
+                fins_bench::connect_to(tcp, tcp ? (*server)->tcp_port() : (*server)->udp_port());
+            if (fd < 0 || (tcp && !fins_bench::tcp_handshake(fd))) {
                 std::fprintf(stderr, "fins_scenario_load: cannot reach finsd\n");
                 return 1;
             }
-            const std::size_t size = answer + (tcp ? fins::tcp_header_size : 0);
             std::vector<double> with, without, ratios, cpu_with, cpu_without;
-            std::vector<double> trips_with, trips_without;
+            std::vector<double> p50_with, p50_without, p99_with, p99_without;
             for (unsigned round = 0; round < rounds; ++round) {
                 double w = 0, wo = 0;
                 for (const bool running : {round % 2 == 0, round % 2 != 0}) {
                     set_running(running);
                     const double before = fins_bench::cpu_seconds(server_thread);
-                    const double rate = drive(fd, tcp, request, size, depth, seconds,
-                                              running ? trips_with : trips_without);
+                    const auto stats = fins_bench::drive(fd, tcp, frames, depth, seconds);
                     const double cpu = (fins_bench::cpu_seconds(server_thread) - before) / seconds;
-                    (running ? w : wo) = rate;
+                    (running ? w : wo) = stats.rate;
                     (running ? cpu_with : cpu_without).push_back(cpu * 100);
+                    (running ? p50_with : p50_without).push_back(stats.p50_us);
+                    (running ? p99_with : p99_without).push_back(stats.p99_us);
                 }
                 with.push_back(w);
                 without.push_back(wo);
@@ -268,9 +170,8 @@ int main(int argc, char** argv) {
                 fmt::print(
                     "{} in-flight  1 round trip: paused p50 {:.0f} us p99 {:.0f} us | running "
                     "p50 {:.0f} us p99 {:.0f} us\n",
-                    tcp ? "tcp" : "udp", percentile(trips_without, 0.5),
-                    percentile(trips_without, 0.99), percentile(trips_with, 0.5),
-                    percentile(trips_with, 0.99));
+                    tcp ? "tcp" : "udp", median(p50_without), median(p99_without), median(p50_with),
+                    median(p99_with));
         }
     }
     set_running(true);
