@@ -1,16 +1,19 @@
-// fins_scenario_load: finsd's FINS request rate with scenarios ticking on its I/O thread,
-// as a ratio of the rate without (issue 19, docs/benchmarks.md "Scenario ticks").
+// fins_scenario_load: finsd's FINS request rate with scenarios ticking, as a ratio of the
+// rate without (issue 19, docs/benchmarks.md "Scenario ticks").
 //
-// finsd serves a plant of CPU Units on one I/O thread, and every unit's scenario ticks on
-// that thread too (src/cli/finsd/serve_plant.cpp). This bench builds the same thread: a
+// finsd serves a plant of CPU Units on one I/O thread; every unit's scenario tick is
+// handed over between that thread (the words in and out) and finsd's scenario thread (the
+// tags computed), src/server/scenario/scenario_worker.hpp. This bench builds the same: a
 // Server for one CJ2H (the unit the generator polls) plus --units CPU Units (that one
 // included) each running the fins_scenario_tick scenario of --tags tags in real time at
 // --tick-ms, each with its own ScenarioRunner and timer, as finsd runs them (their ticks in
-// --groups phase groups spread over the period, finsd's ScenarioRunner::phase_of). The generator
+// --groups phase groups spread over the period, finsd's ScenarioRunner::phase_of), and one
+// ScenarioWorker (--no-worker: every tick computed on the I/O thread). The generator
 // (this process's main thread, blocking sockets, as fins_load) keeps 1 or 32 1-word reads
 // of D0 in flight over FINS/UDP and FINS/TCP; each round measures the rate with every
 // scenario paused and with every scenario running (alternating which goes first), and the
-// median ratio running / paused is printed with the server thread's CPU share.
+// median ratio running / paused is printed with the server thread's CPU share, and with
+// one in flight the round trips' p50 and p99.
 //   fins_scenario_load --units 1000 --tags 100 --tick-ms 100 --seconds 1 --rounds 5
 #include <arpa/inet.h>
 #include <netinet/in.h>
@@ -96,16 +99,19 @@ int connect_to(bool tcp, std::uint16_t port) {
     return fd;
 }
 
-// Answers per second with `depth` requests outstanding for `seconds`.
+// Answers per second with `depth` requests outstanding for `seconds`; with one in flight,
+// each answer's round trip in microseconds is appended to `round_trips`.
 double drive(int fd, bool tcp, const std::vector<std::uint8_t>& request, std::size_t answer,
-             unsigned depth, double seconds) {
+             unsigned depth, double seconds, std::vector<double>& round_trips) {
     std::vector<std::uint8_t> in(answer + 64);
     const auto start = Clock::now();
     const auto end =
         start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
     std::size_t sent = 0, answered = 0;
+    auto sent_at = start;
     auto send_one = [&] {
         ++sent;
+        sent_at = Clock::now();
         return ::send(fd, request.data(), request.size(), MSG_NOSIGNAL) > 0;
     };
     for (unsigned i = 0; i < depth; ++i)
@@ -116,6 +122,9 @@ double drive(int fd, bool tcp, const std::vector<std::uint8_t>& request, std::si
                             : ::recv(fd, in.data(), in.size(), 0) > 0;
         if (!ok) break;
         ++answered;
+        if (depth == 1)
+            round_trips.push_back(
+                std::chrono::duration<double, std::micro>(Clock::now() - sent_at).count());
         if (sending && Clock::now() < end) {
             if (!send_one()) break;
         } else {
@@ -129,6 +138,13 @@ double drive(int fd, bool tcp, const std::vector<std::uint8_t>& request, std::si
 double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
     return v[v.size() / 2];
+}
+
+double percentile(std::vector<double>& v, double p) {
+    if (v.empty()) return 0;
+    const auto at = static_cast<std::size_t>(p * static_cast<double>(v.size() - 1));
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(at), v.end());
+    return v[at];
 }
 
 }  // namespace
@@ -158,10 +174,16 @@ int main(int argc, char** argv) {
                    "all at once)")
         ->check(CLI::Range(1u, 100000u))
         ->capture_default_str();
+    bool use_worker = true;
+    app.add_flag("!--no-worker", use_worker,
+                 "Compute the ticks on the I/O thread (finsd before its scenario thread)");
     CLI11_PARSE(app, argc, argv);
     spdlog::set_level(spdlog::level::warn);
 
     asio::io_context io{1};
+    // finsd's scenario thread (--no-worker: every tick on the I/O thread, as before).
+    std::unique_ptr<fins::server::ScenarioWorker> worker;
+    if (use_worker) worker = std::make_unique<fins::server::ScenarioWorker>(io);
     std::vector<std::unique_ptr<fins::plc::Plc>> plcs;
     std::vector<std::unique_ptr<fins::server::ScenarioRunner>> runners;
     for (unsigned u = 0; u < units; ++u) {
@@ -179,7 +201,7 @@ int main(int argc, char** argv) {
                 return fins::server::ScenarioRunner::Compiled(
                     tl::unexpected(std::string("no file")));
             },
-            "bench"));
+            "bench", worker.get()));
     }
     fins::server::ServerOptions options;
     options.port = 0;
@@ -208,8 +230,8 @@ int main(int argc, char** argv) {
     };
 
     const std::size_t answer = fins::header_size + 2 + 2 + 2;  // header, cmd, end, 1 word
-    fmt::print("{} CPU Units x {} tags at {} ms on finsd's I/O thread, {} rounds of {} s\n", units,
-               tags, tick_ms, rounds, seconds);
+    fmt::print("{} CPU Units x {} tags at {} ms, computed on {}, {} rounds of {} s\n", units, tags,
+               tick_ms, worker ? "finsd's scenario thread" : "the I/O thread", rounds, seconds);
     for (const bool tcp : {false, true}) {
         for (const unsigned depth : {1u, 32u}) {
             const auto request = read_request(tcp);
@@ -220,12 +242,14 @@ int main(int argc, char** argv) {
             }
             const std::size_t size = answer + (tcp ? fins::tcp_header_size : 0);
             std::vector<double> with, without, ratios, cpu_with, cpu_without;
+            std::vector<double> trips_with, trips_without;
             for (unsigned round = 0; round < rounds; ++round) {
                 double w = 0, wo = 0;
                 for (const bool running : {round % 2 == 0, round % 2 != 0}) {
                     set_running(running);
                     const double before = fins_bench::cpu_seconds(server_thread);
-                    const double rate = drive(fd, tcp, request, size, depth, seconds);
+                    const double rate = drive(fd, tcp, request, size, depth, seconds,
+                                              running ? trips_with : trips_without);
                     const double cpu = (fins_bench::cpu_seconds(server_thread) - before) / seconds;
                     (running ? w : wo) = rate;
                     (running ? cpu_with : cpu_without).push_back(cpu * 100);
@@ -240,6 +264,13 @@ int main(int argc, char** argv) {
                 "req/s ({:.0f} % CPU) | ratio {:.3f}\n",
                 tcp ? "tcp" : "udp", depth, median(without), median(cpu_without), median(with),
                 median(cpu_with), median(ratios));
+            if (depth == 1)
+                fmt::print(
+                    "{} in-flight  1 round trip: paused p50 {:.0f} us p99 {:.0f} us | running "
+                    "p50 {:.0f} us p99 {:.0f} us\n",
+                    tcp ? "tcp" : "udp", percentile(trips_without, 0.5),
+                    percentile(trips_without, 0.99), percentile(trips_with, 0.5),
+                    percentile(trips_with, 0.99));
         }
     }
     set_running(true);

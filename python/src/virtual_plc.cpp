@@ -227,7 +227,8 @@ class VirtualPlc {
         if (!compiled) throw BadArgument(compiled.error());
         // Started before the I/O thread runs: its first real-time tick is on that thread.
         scenario_ = fins::cli::finsd::run_scenario(io_, std::optional(std::move(*loaded)),
-                                                   std::move(*compiled), *plc_);
+                                                   std::move(*compiled), *plc_, std::nullopt,
+                                                   scenario_worker_);
         server_->dispatcher().attach_faults(scenario_.get());
     }
 
@@ -265,6 +266,7 @@ class VirtualPlc {
     asio::executor_work_guard<asio::io_context::executor_type> work_{io_.get_executor()};
     std::unique_ptr<fins::plc::Plc> plc_;
     std::unique_ptr<fins::server::Server> server_;
+    std::unique_ptr<fins::server::ScenarioWorker> scenario_worker_;  // outlives scenario_
     std::unique_ptr<fins::server::ScenarioRunner> scenario_;
     std::thread thread_;
 };

@@ -119,6 +119,11 @@ class Expression {
         std::uint32_t argument = 0;  // load: reference; min/max: operand count
         double number = 0.0;
     };
+    // The compiled program (a scenario copies its tags' programs into one array).
+    [[nodiscard]] const std::vector<Instruction>& program() const noexcept { return program_; }
+    // Runs `size` instructions of a program at `program` (expression_eval.hpp).
+    template <class Context>
+    static double run(const Instruction* program, std::size_t size, Context& context) noexcept;
 
   private:
     std::vector<Instruction> program_;

@@ -12,10 +12,16 @@ namespace fins::scenario {
 
 template <class Context>
 double Expression::run(Context& context) const noexcept {
+    return run(program_.data(), program_.size(), context);
+}
+
+template <class Context>
+double Expression::run(const Instruction* program, std::size_t size, Context& context) noexcept {
     std::array<double, max_expression_stack> stack;
     std::size_t top = 0;  // number of values on the stack
     auto truth = [](double v) { return v != 0.0 && !std::isnan(v) ? 1.0 : 0.0; };
-    for (const auto& in : program_) {
+    for (const Instruction* end = program + size; program != end; ++program) {
+        const Instruction& in = *program;
         switch (in.op) {
             case Op::number:
                 stack[top++] = in.number;

@@ -70,7 +70,11 @@ struct Compiler {
         auto range =
             s.plc->memory().locate(*memory_address, bit_type ? 1 : value_words(type), use, intent);
         if (!range) return tl::unexpected(located_error(text, *s.plc, range.error()));
-        s.references.push_back({*range, type, tag});
+        Reference reference;
+        reference.range = *range;
+        reference.type = type;
+        reference.tag = tag;
+        s.references.push_back(reference);
         addresses.push_back(address);
         return static_cast<std::uint32_t>(s.references.size() - 1);
     }
@@ -139,6 +143,7 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
     Compiler c{s, {}};
     // Tags first: their references are the ones expressions find by address.
     s.tags.resize(def.tags.size());
+    s.cold.resize(def.tags.size());
     for (std::size_t i = 0; i < def.tags.size(); ++i) {
         const TagDef& t = def.tags[i];
         auto address = parse_address(t.address.text);
@@ -154,22 +159,39 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
                              fmt::format("{} overlaps {} ({}), written by the entry at line {}",
                                          t.address.text, def.tags[j].address.text,
                                          value_type_name(def.tags[j].type), def.tags[j].pos.line));
-        s.tags[i].def = &t;
+        s.cold[i].def = &t;
         s.tags[i].reference = *r;
-        s.tags[i].p = TagParams{t.kind,
-                                t.repeat,
-                                t.value,
-                                t.min,
-                                t.max,
-                                t.period_s,
-                                t.phase_s,
-                                t.duty,
-                                t.step,
-                                t.rate,
-                                1 - std::exp(-def.tick_s / t.tau_s),
-                                t.noise,
-                                t.on_above,
-                                t.off_below};
+        TagParams& p = s.tags[i].p;
+        p.kind = t.kind;
+        p.repeat = t.repeat;
+        p.min = t.min;
+        p.max = t.max;
+        switch (t.kind) {
+            case SignalKind::constant:
+                p.value = t.value;
+                break;
+            case SignalKind::sine:
+            case SignalKind::square:
+            case SignalKind::triangle:
+            case SignalKind::sawtooth:
+            case SignalKind::ramp:
+                p.wave = {t.period_s, t.phase_s, t.duty};
+                break;
+            case SignalKind::random_walk:
+                p.step = t.step;
+                break;
+            case SignalKind::counter:
+                p.rate = t.rate;
+                break;
+            case SignalKind::lag:
+                p.lag = {1 - std::exp(-def.tick_s / t.tau_s), t.noise};
+                break;
+            case SignalKind::hysteresis:
+                p.band = {t.on_above, t.off_below};
+                break;
+            default:
+                break;
+        }
         if (t.kind == SignalKind::steps) {
             if (t.steps.empty())
                 return error(t.pos, "kind = \"steps\" needs steps = [[t, value], ...]");
@@ -192,7 +214,8 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
         if (samples > max_delay_samples)
             return error(t.pos, fmt::format("delay_s {} is {} ticks: at most {}", t.delay_s,
                                             samples, max_delay_samples));
-        s.tags[i].delay.assign(samples, std::nan(""));
+        s.cold[i].delay.assign(samples, std::nan(""));
+        s.tags[i].has_delay = samples > 0;
         s.tags[i].state =
             t.initial.value_or(t.kind == SignalKind::random_walk ? (t.min + t.max) / 2 : 0.0);
     }
@@ -208,6 +231,8 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
         auto r = c.locate(*address, in.type, in.address.text, plc::Intent::read, -1);
         if (!r) return error(in.address.pos, r.error());
     }
+    // The tags' expressions, until their programs are copied into s.code.
+    std::vector<std::optional<Expression>> inputs(def.tags.size()), whens(def.tags.size());
     for (std::size_t i = 0; i < def.tags.size(); ++i) {
         const TagDef& t = def.tags[i];
         if (needs_input(t.kind) && t.input.text.empty())
@@ -219,9 +244,8 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
         if (!input) return tl::unexpected(input.error());
         auto when = c.expression(t.when);
         if (!when) return tl::unexpected(when.error());
-        s.tags[i].input = std::move(*input);
-        s.tags[i].when = std::move(*when);
-        s.tags[i].has_when = s.tags[i].when.has_value();
+        inputs[i] = std::move(*input);
+        whens[i] = std::move(*when);
     }
 
     // Dependency order: depth-first in file order, a tag after the tags it reads.
@@ -233,7 +257,7 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
         if (cycle || mark[i] == 2) return;
         mark[i] = 1;
         path.push_back(i);
-        for (const auto* e : {&s.tags[i].input, &s.tags[i].when}) {
+        for (const auto* e : {&inputs[i], &whens[i]}) {
             if (!*e) continue;
             for (auto ref : (*e)->references()) {
                 const auto dep = s.references[ref].tag;
@@ -259,8 +283,20 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
     for (std::uint32_t i = 0; i < s.tags.size(); ++i)
         visit(visit, i);
     if (cycle) return tl::unexpected(*cycle);
+    for (const auto i : s.order) {
+        auto place = [&s](const std::optional<Expression>& e, ProgramRef& where) {
+            if (!e) return;
+            where.at = static_cast<std::uint32_t>(s.code.size());
+            where.size = static_cast<std::uint32_t>(e->program().size());
+            s.code.insert(s.code.end(), e->program().begin(), e->program().end());
+        };
+        place(whens[i], s.tags[i].when);
+        place(inputs[i], s.tags[i].input);
+        s.tags[i].has_when = s.tags[i].when.size != 0;
+    }
     for (auto& reference : s.references)
         s.bind_direct(reference);
+    s.build_image();
 
     s.events.resize(def.events.size());
     for (std::size_t i = 0; i < def.events.size(); ++i) {
@@ -292,8 +328,9 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
                              fmt::format("{} is not a tag of this scenario (no signal or link "
                                          "writes it)",
                                          e.address.text));
-            s.tags[static_cast<std::size_t>(es.tag)].faults.push_back(
+            s.cold[static_cast<std::size_t>(es.tag)].faults.push_back(
                 static_cast<std::uint32_t>(i));
+            s.tags[static_cast<std::size_t>(es.tag)].has_faults = true;
         }
         switch (e.fault) {
             case FaultKind::fal:
@@ -354,11 +391,11 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
         auto r = c.locate(*address, type, l.address.text, plc::Intent::read, -1);
         if (!r) return error(l.address.pos, r.error());
         s.bind_direct(s.references[*r]);
-        if (s.references[*r].words == nullptr)
+        if (s.references[*r].memory == nullptr)
             return error(l.address.pos, fmt::format("{} is not in a word area (CIO, W, H, A, D, E)",
                                                     l.address.text));
         sources.push_back(
-            {block->address, static_cast<std::uint16_t>(l.item), s.references[*r].words});
+            {block->address, static_cast<std::uint16_t>(l.item), s.references[*r].memory});
     }
     if (!sources.empty()) plc.loop_control().set_sources(&s, std::move(sources));
     return std::unique_ptr<Scenario>(new Scenario(std::move(impl)));

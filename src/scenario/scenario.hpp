@@ -3,15 +3,28 @@
 // glue (src/server/scenario) calls tick() from a steady timer, or advance() for virtual
 // time, and passes the host time only for what the CPU Unit stamps (error log, clock).
 //
-// One tick at scenario time t = ticks() * tick_s:
-//   1. events whose start time has come start (value faults attach to their tag, unit
-//      faults change the CPU Unit or transport()); events whose duration ran out end;
-//   2. every tag, in dependency order (a tag after the tags its expressions read; a
-//      cycle is a compile error), computes its value and writes it through
-//      IoMemory::write, the path of a FINS 01 02 write: a forced bit keeps its forced
-//      state, exactly as a ladder program cannot override it;
-//   3. when anything was written, the FINS write access log gets one record from node
-//      0.0.0 (the CPU Unit itself), so a client sees that the scenario wrote.
+// One tick at scenario time t = ticks() * tick_s, in three phases:
+//   begin_tick (on the thread that owns the CPU Unit):
+//     1. events whose start time has come start (value faults attach to their tag, unit
+//        faults change the CPU Unit or transport()); events whose duration ran out end;
+//     2. the words the tags read and write are copied into the scenario's image, with
+//        their forced-bit masks (the CPU Unit's input refresh);
+//   compute (on any thread, when offloadable(): it touches the image and the
+//   scenario's own state only, never the CPU Unit):
+//     3. every tag, in dependency order (a tag after the tags its expressions read; a
+//        cycle is a compile error), computes its value and writes it on the image the
+//        way a FINS 01 02 write does: a forced bit keeps its forced state, exactly as a
+//        ladder program cannot override it;
+//   end_tick (on the owning thread again):
+//     4. the words the tick changed are copied to memory (the output refresh), forced
+//        bits kept; a word a client wrote since begin_tick keeps the client's value, and
+//        a stateful tag adopts it on the next tick;
+//     5. when anything was written, the FINS write access log gets one record from node
+//        0.0.0 (the CPU Unit itself), so a client sees that the scenario wrote;
+//     6. events whose duration ends at the new time end.
+// tick() runs the three back to back. Words the image cannot hold (timers' and counters'
+// completion flags, EM banks by number) are read and written through IoMemory during
+// compute; a scenario with such a tag is not offloadable().
 // Stateful kinds (random_walk, counter, totaliser, lag) keep their state in a double but
 // adopt the memory's value when a client (or a force) changed the tag since the last
 // write: an HMI writing 0 to a counter resets it.
@@ -81,6 +94,13 @@ class Scenario {
     [[nodiscard]] const ScenarioDef& definition() const noexcept;
     // One tick of tick_s. `now` stamps what the CPU Unit records (error log, clock jump).
     void tick(plc::TimePoint now) noexcept;
+    // tick() in its three phases, for a caller that computes on another thread: between
+    // begin_tick and end_tick the owning thread may serve requests and read status(), but
+    // must not call anything else of this scenario (settle first).
+    [[nodiscard]] bool offloadable() const noexcept;
+    void begin_tick(plc::TimePoint now) noexcept;
+    void compute() noexcept;
+    void end_tick() noexcept;
     // Runs the whole ticks that fit in `seconds` (plus what earlier calls left over);
     // returns how many ran.
     std::uint64_t advance(double seconds, plc::TimePoint now) noexcept;

@@ -1,6 +1,7 @@
 // How a scenario reads and writes its tags' memory: the value types of `fins --as` on PLC
-// words, straight on the words of word areas (resolved once at compile), else through
-// IoMemory's element path. Writes keep forced bits, as a FINS 01 02 write does.
+// words, on the image of the words of word areas (laid out once at compile, copied in and
+// out around each tick), else through IoMemory's element path. Writes keep forced bits,
+// as a FINS 01 02 write does.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -105,22 +106,138 @@ void Scenario::Impl::bind_direct(Reference& reference) noexcept {
     const auto words = memory.words(r.region, r.bank);
     const std::size_t count = bit ? 1 : value_words(reference.type);
     if (std::size_t{r.index} + count > words.size()) return;
-    reference.words = words.data() + r.index;
+    reference.memory = words.data() + r.index;
     const auto forced = std::as_const(memory).forced_mask(r.region);
-    if (std::size_t{r.index} + count <= forced.size()) reference.forced = forced.data() + r.index;
+    if (std::size_t{r.index} + count <= forced.size())
+        reference.memory_forced = forced.data() + r.index;
     if (bit) reference.bit_mask = static_cast<std::uint16_t>(1U << r.bit);
+}
+
+void Scenario::Impl::build_image() {
+    // The directly accessed words of every reference, by area and index; overlapping or
+    // adjacent ones of one area merge into a run, so that references sharing words share
+    // them in the image too (a link reading D100 sees what the tag on D100 wrote).
+    struct Span {
+        std::uint32_t reference;
+        std::uint32_t end;  // index past the last word
+    };
+    std::vector<Span> spans;
+    offloadable = true;
+    for (std::uint32_t i = 0; i < references.size(); ++i) {
+        const Reference& r = references[i];
+        if (r.memory == nullptr) {
+            offloadable = false;
+            continue;
+        }
+        const unsigned count = r.type == ValueType::boolean ? 1 : value_words(r.type);
+        spans.push_back({i, r.range.index + count});
+    }
+    const auto area = [this](const Span& s) {
+        const auto& r = references[s.reference].range;
+        return std::pair{static_cast<unsigned>(r.region), r.bank};
+    };
+    std::sort(spans.begin(), spans.end(), [&](const Span& a, const Span& b) {
+        const auto ka = area(a), kb = area(b);
+        if (ka != kb) return ka < kb;
+        return references[a.reference].range.index < references[b.reference].range.index;
+    });
+    // First pass: the runs (start index, end index, first span); then the image.
+    struct Pending {
+        std::size_t first, last;  // spans
+        std::uint32_t start, end;
+    };
+    std::vector<Pending> merged;
+    for (std::size_t i = 0; i < spans.size(); ++i) {
+        const std::uint32_t start = references[spans[i].reference].range.index;
+        if (!merged.empty() && area(spans[merged.back().first]) == area(spans[i]) &&
+            start <= merged.back().end) {
+            merged.back().end = std::max(merged.back().end, spans[i].end);
+            merged.back().last = i;
+            continue;
+        }
+        merged.push_back({i, i, start, spans[i].end});
+    }
+    std::uint32_t total = 0;
+    for (const auto& p : merged)
+        total += p.end - p.start;
+    image.assign(total, 0);
+    image_before.assign(total, 0);
+    image_forced.assign(total, 0);
+    runs.clear();
+    std::uint32_t offset = 0;
+    for (const auto& p : merged) {
+        const Reference& first = references[spans[p.first].reference];
+        const std::uint32_t back = first.range.index - p.start;  // 0: spans are sorted
+        ImageRun run{first.memory - back, nullptr, offset, p.end - p.start};
+        bool forced = true;
+        for (std::size_t i = p.first; i <= p.last; ++i)
+            forced = forced && references[spans[i].reference].memory_forced != nullptr;
+        if (forced) run.forced = first.memory_forced - back;
+        for (std::size_t i = p.first; i <= p.last; ++i) {
+            Reference& r = references[spans[i].reference];
+            const std::uint32_t at = offset + (r.range.index - p.start);
+            r.words = image.data() + at;
+            r.forced = forced ? image_forced.data() + at : nullptr;
+        }
+        runs.push_back(run);
+        offset += run.size;
+    }
+}
+
+void Scenario::Impl::gather() noexcept {
+    for (const auto& run : runs) {
+        std::copy_n(run.memory, run.size, image.data() + run.offset);
+        if (run.forced != nullptr)
+            std::copy_n(run.forced, run.size, image_forced.data() + run.offset);
+    }
+    if (concurrent) std::copy(image.begin(), image.end(), image_before.begin());
+}
+
+void Scenario::Impl::scatter() noexcept {
+    for (const auto& run : runs) {
+        const std::uint16_t* now = image.data() + run.offset;
+        if (!concurrent) {
+            // Nothing else ran since gather(): memory still holds what the image started
+            // from, and a word the tick changed differs from it.
+            for (std::uint32_t i = 0; i < run.size; ++i)
+                if (now[i] != run.memory[i])
+                    run.memory[i] = run.forced == nullptr
+                                        ? now[i]
+                                        : merge_forced(run.memory[i], now[i], run.forced[i]);
+            continue;
+        }
+        const std::uint16_t* before = image_before.data() + run.offset;
+        for (std::uint32_t i = 0; i < run.size; ++i) {
+            // Unchanged by the tick, or changed by a client since begin_tick (its write
+            // wins; a stateful tag adopts it next tick): left as memory has it.
+            if (now[i] == before[i] || run.memory[i] != before[i]) continue;
+            run.memory[i] =
+                run.forced == nullptr ? now[i] : merge_forced(run.memory[i], now[i], run.forced[i]);
+        }
+    }
 }
 
 double Scenario::Impl::read(const Reference& reference, std::uint64_t* raw) const noexcept {
     std::array<std::uint16_t, 4> words{};
     const unsigned n = value_words(reference.type);
     if (reference.words != nullptr) {
-        if (reference.type == ValueType::boolean) {
-            const bool on = (*reference.words & reference.bit_mask) != 0;
-            if (raw != nullptr) *raw = on ? 1 : 0;
-            return on ? 1.0 : 0.0;
+        switch (reference.type) {
+            case ValueType::boolean: {
+                const bool on = (*reference.words & reference.bit_mask) != 0;
+                if (raw != nullptr) *raw = on ? 1 : 0;
+                return on ? 1.0 : 0.0;
+            }
+            case ValueType::int16:  // the common one-word types: no decode
+                if (raw != nullptr) *raw = *reference.words;
+                return static_cast<std::int16_t>(*reference.words);
+            case ValueType::uint16:
+                if (raw != nullptr) *raw = *reference.words;
+                return *reference.words;
+            default:
+                break;
         }
-        std::copy_n(reference.words, n, words.begin());
+        for (unsigned i = 0; i < n; ++i)
+            words[i] = reference.words[i];
     } else {
         std::array<std::uint8_t, 8> bytes{};
         ByteWriter out(bytes);
@@ -139,13 +256,24 @@ double Scenario::Impl::read(const Reference& reference, std::uint64_t* raw) cons
 bool Scenario::Impl::write(TagState& tag, double value) noexcept {
     const Reference& reference = references[tag.reference];
     if (!std::isfinite(value)) return false;
+    // The common case first: a one-word integer on a word of an area without forcing.
+    if (reference.words != nullptr && reference.forced == nullptr &&
+        (reference.type == ValueType::int16 || reference.type == ValueType::uint16)) {
+        const auto word = reference.type == ValueType::int16
+                              ? static_cast<std::uint16_t>(clamp_round<std::int16_t>(value))
+                              : clamp_round<std::uint16_t>(value);
+        *reference.words = word;
+        tag.last_raw = word;
+        tag.written = true;
+        return true;
+    }
     const bool bit = reference.type == ValueType::boolean;
     const bool on = value != 0.0;
     const unsigned n = value_words(reference.type);
     const auto words = encode(reference.type, value);
     if (reference.words != nullptr) {
         // The path of a FINS write on plain words: forced bits keep their forced state.
-        // What memory holds after it (a forced bit may differ from what was asked) is
+        // What the image holds after it (a forced bit may differ from what was asked) is
         // what the next tick compares with, to see a client's change and not the force.
         if (bit) {
             std::uint16_t& word = *reference.words;

@@ -1,4 +1,5 @@
-// One scenario tick: events, then every tag in dependency order (contract in scenario.hpp).
+// One scenario tick in its three phases: events and the image in, every tag in dependency
+// order on the image, the image out (contract in scenario.hpp).
 // Expressions run on Impl itself (a final class), so their loads are direct calls.
 #include <algorithm>
 #include <cmath>
@@ -25,10 +26,15 @@ double fraction(double x) {
 
 }  // namespace
 
-double Scenario::Impl::compute(TagState& tag, bool& skip) noexcept {
+double Scenario::Impl::run(ProgramRef program) noexcept {
+    return Expression::run(code.data() + program.at, program.size, *this);
+}
+
+double Scenario::Impl::compute(std::uint32_t index, bool& skip) noexcept {
+    TagState& tag = tags[index];
     const TagParams& d = tag.p;
     skip = false;
-    if (tag.has_when && !truth(tag.when->run(*this))) {
+    if (tag.has_when && !truth(run(tag.when))) {
         skip = true;
         return 0.0;
     }
@@ -46,17 +52,19 @@ double Scenario::Impl::compute(TagState& tag, bool& skip) noexcept {
             return d.value;
         case SignalKind::sine:
             return d.min + span / 2 +
-                   span / 2 * std::sin(2 * std::numbers::pi * (t + d.phase_s) / d.period_s);
+                   span / 2 *
+                       std::sin(2 * std::numbers::pi * (t + d.wave.phase_s) / d.wave.period_s);
         case SignalKind::square:
-            return fraction((t + d.phase_s) / d.period_s) < d.duty ? d.max : d.min;
+            return fraction((t + d.wave.phase_s) / d.wave.period_s) < d.wave.duty ? d.max : d.min;
         case SignalKind::triangle: {
-            const double f = fraction((t + d.phase_s) / d.period_s);
+            const double f = fraction((t + d.wave.phase_s) / d.wave.period_s);
             return f < 0.5 ? d.min + span * 2 * f : d.max - span * (2 * f - 1);
         }
         case SignalKind::sawtooth:
-            return d.min + span * fraction((t + d.phase_s) / d.period_s);
+            return d.min + span * fraction((t + d.wave.phase_s) / d.wave.period_s);
         case SignalKind::ramp: {
-            const double f = d.repeat ? fraction(t / d.period_s) : std::min(t / d.period_s, 1.0);
+            const double f =
+                d.repeat ? fraction(t / d.wave.period_s) : std::min(t / d.wave.period_s, 1.0);
             return d.min + span * f;
         }
         case SignalKind::random_walk:
@@ -64,7 +72,7 @@ double Scenario::Impl::compute(TagState& tag, bool& skip) noexcept {
             tag.state = std::clamp(tag.state + d.step * random.normal(), d.min, d.max);
             return tag.state;
         case SignalKind::steps: {
-            const TagDef& schedule = *tag.def;
+            const TagDef& schedule = *cold[index].def;
             const double at = schedule.repeat_s > 0 ? std::fmod(t, schedule.repeat_s) : t;
             double v = schedule.initial.value_or(schedule.steps.front().second);
             for (const auto& [when, value] : schedule.steps) {
@@ -75,7 +83,7 @@ double Scenario::Impl::compute(TagState& tag, bool& skip) noexcept {
         }
         case SignalKind::counter: {
             adopt();
-            const bool on = truth(tag.input->run(*this));
+            const bool on = truth(run(tag.input));
             if (d.rate > 0) {
                 if (on) tag.state += d.rate * def.tick_s;
             } else if (on && !tag.previous_input) {
@@ -87,29 +95,30 @@ double Scenario::Impl::compute(TagState& tag, bool& skip) noexcept {
         }
         case SignalKind::totaliser:
             adopt();
-            tag.state += tag.input->run(*this) * def.tick_s;
+            tag.state += run(tag.input) * def.tick_s;
             return tag.state;
         case SignalKind::lag: {
             adopt();
-            const double setpoint = tag.input->run(*this);
-            const double noise = d.noise > 0 ? d.noise * random.normal() : 0.0;
-            // lag_gain = 1 - exp(-tick_s / tau_s), computed once at compile.
-            if (std::isfinite(setpoint)) tag.state += (setpoint - tag.state) * d.lag_gain;
+            const double setpoint = run(tag.input);
+            const double noise = d.lag.noise > 0 ? d.lag.noise * random.normal() : 0.0;
+            // gain = 1 - exp(-tick_s / tau_s), computed once at compile.
+            if (std::isfinite(setpoint)) tag.state += (setpoint - tag.state) * d.lag.gain;
             return tag.state + noise;
         }
         case SignalKind::hysteresis: {
-            const double input = tag.input->run(*this);
-            if (input >= d.on_above)
+            const double input = run(tag.input);
+            if (input >= d.band.on_above)
                 tag.previous_input = true;
-            else if (input <= d.off_below)
+            else if (input <= d.band.off_below)
                 tag.previous_input = false;
             return tag.previous_input ? 1.0 : 0.0;
         }
         case SignalKind::link: {
-            double v = tag.input->run(*this);
-            if (!tag.delay.empty()) {
-                std::swap(v, tag.delay[tag.delay_next]);
-                tag.delay_next = (tag.delay_next + 1) % tag.delay.size();
+            double v = run(tag.input);
+            if (tag.has_delay) {
+                TagCold& c = cold[index];
+                std::swap(v, c.delay[c.delay_next]);
+                c.delay_next = (c.delay_next + 1) % c.delay.size();
             }
             return v;
         }
@@ -117,53 +126,76 @@ double Scenario::Impl::compute(TagState& tag, bool& skip) noexcept {
     return 0.0;
 }
 
-void Scenario::Impl::step() noexcept {
-    now_s = static_cast<double>(tick_count) * def.tick_s;
-    run_events();
-    bool wrote = false;
-    for (const auto index : order) {
-        TagState& tag = tags[index];
-        bool skip = false;
-        double value = compute(tag, skip);
-        if (skip) {
-            ++skipped;
-            continue;
-        }
-        for (const auto e : tag.faults) {
-            EventState& event = events[e];
-            if (!event.active) continue;
-            const double v = event.def->value;
-            switch (event.def->fault) {
-                case FaultKind::stuck:
-                    if (event.capture) event.stuck_value = value;
-                    event.capture = false;
-                    value = event.stuck_value;
-                    break;
-                case FaultKind::drift:
-                    value += v * (now_s - event.start);
-                    break;
-                case FaultKind::spike:
-                    value += v;
-                    break;
-                case FaultKind::set:
-                    value = v;
-                    break;
-                case FaultKind::noise:
-                    value += v * random.normal();
-                    break;
-                default:
-                    break;
-            }
-        }
-        if (write(tag, value)) {
-            ++writes;
-            wrote = true;
-        } else {
-            ++skipped;
+void Scenario::Impl::apply_faults(std::uint32_t index, double& value) noexcept {
+    for (const auto e : cold[index].faults) {
+        EventState& event = events[e];
+        if (!event.active) continue;
+        const double v = event.def->value;
+        switch (event.def->fault) {
+            case FaultKind::stuck:
+                if (event.capture) event.stuck_value = value;
+                event.capture = false;
+                value = event.stuck_value;
+                break;
+            case FaultKind::drift:
+                value += v * (now_s - event.start);
+                break;
+            case FaultKind::spike:
+                value += v;
+                break;
+            case FaultKind::set:
+                value = v;
+                break;
+            case FaultKind::noise:
+                value += v * random.normal();
+                break;
+            default:
+                break;
         }
     }
+}
+
+void Scenario::Impl::begin_tick() noexcept {
+    now_s = static_cast<double>(tick_count) * def.tick_s;
+    run_events();
+    gather();
+    tick_writes = 0;
+    tick_skipped = 0;
+}
+
+void Scenario::Impl::compute_tags() noexcept {
+    // A plant's tags do not stay in the cache between ticks: ask for a tag's lines a few
+    // tags ahead of computing it.
+    constexpr std::size_t ahead = 4;
+    const std::size_t count = order.size();
+    for (std::size_t k = 0; k < count; ++k) {
+        if (k + ahead < count) {
+            const char* next = reinterpret_cast<const char*>(&tags[order[k + ahead]]);
+            __builtin_prefetch(next);
+            __builtin_prefetch(next + sizeof(TagState) - 1);
+        }
+        const std::uint32_t index = order[k];
+        TagState& tag = tags[index];
+        bool skip = false;
+        double value = compute(index, skip);
+        if (skip) {
+            ++tick_skipped;
+            continue;
+        }
+        if (tag.has_faults) apply_faults(index, value);
+        if (write(tag, value))
+            ++tick_writes;
+        else
+            ++tick_skipped;
+    }
+}
+
+void Scenario::Impl::end_tick() noexcept {
+    scatter();
+    writes += tick_writes;
+    skipped += tick_skipped;
     // One record per tick from node 0.0.0, the CPU Unit itself (what its program writes).
-    if (wrote)
+    if (tick_writes > 0)
         plc->write_access_log().record(NodeAddress{0, 0, 0}, CommandCode{0x01, 0x02},
                                        EndCode::normal_completion, host_now);
     ++tick_count;
@@ -176,7 +208,28 @@ void Scenario::Impl::step() noexcept {
 
 void Scenario::tick(plc::TimePoint now) noexcept {
     impl_->host_now = now;
-    impl_->step();
+    impl_->concurrent = false;
+    impl_->begin_tick();
+    impl_->compute_tags();
+    impl_->end_tick();
+}
+
+bool Scenario::offloadable() const noexcept {
+    return impl_->offloadable;
+}
+
+void Scenario::begin_tick(plc::TimePoint now) noexcept {
+    impl_->host_now = now;
+    impl_->concurrent = true;
+    impl_->begin_tick();
+}
+
+void Scenario::compute() noexcept {
+    impl_->compute_tags();
+}
+
+void Scenario::end_tick() noexcept {
+    impl_->end_tick();
 }
 
 std::uint64_t Scenario::advance(double seconds, plc::TimePoint now) noexcept {

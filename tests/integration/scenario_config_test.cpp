@@ -19,6 +19,8 @@ TEST(ScenarioConfig, BadScenariosExit2WithTheirPosition) {
         {"[scenario]\nseed = 1\ntick = 5\n", "bad.toml:3:1: ", "scenario.tick: unknown key"},
         {"[scenario]\ntime = \"fast\"\n",
          "bad.toml:2:8: ", "scenario.time: 'fast' is not real or virtual"},
+        {"[scenario]\ncompute = \"gpu\"\n",
+         "bad.toml:2:11: ", "scenario.compute: 'gpu' is not auto, io or thread"},
         {"[[scenario.signal]]\naddress = \"D0\"\nkind = \"sine\"\nfrequency = 3\n",
          "bad.toml:4:1: ", "scenario.signal[0].frequency: unknown key for kind = \"sine\""},
         {"[[scenario.signal]]\naddress = \"D0\"\nkind = \"wobble\"\n",

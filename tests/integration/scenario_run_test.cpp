@@ -284,5 +284,73 @@ TEST(ScenarioRun, RealTimeTicksWithoutAdvance) {
     EXPECT_TRUE(scenario_status(socket)["paused"].get<bool>());
 }
 
+// compute = "thread" (finsd's scenario thread) and "io" (the I/O thread) run the same
+// scenario: time runs, and a client's write to a counter is where it goes on from,
+// whichever phase of a tick the write lands in (docs/scenarios.md "How writes reach
+// memory").
+TEST(ScenarioRun, ComputeOnTheScenarioThreadOrTheIoThreadAdoptsClientWrites) {
+    for (const char* where : {"thread", "io"}) {
+        SCOPED_TRACE(where);
+        ScratchDir dir(std::string("scenario-compute-") + where);
+        const auto file =
+            dir.write("s.toml", std::string("[scenario]\ntick_ms = 10\ncompute = \"") + where +
+                                    "\"\n[[scenario.signal]]\naddress = \"D8\"\nkind = "
+                                    "\"counter\"\ninput = \"1\"\nrate = 100\n");
+        Finsd d({"--scenario", file});
+        ASSERT_TRUE(d.started()) << d.result().err;
+        auto c = d.client();
+        std::int16_t v = 0;
+        for (int i = 0; i < 200 && v < 5; ++i) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(25));
+            v = read_int16(*c, "D8");
+        }
+        ASSERT_GE(v, 5);
+        ASSERT_TRUE(c->write_words(addr("D8"), std::vector<std::uint16_t>{20000}).has_value());
+        for (int i = 0; i < 200 && (v < 20000 || v > 20000 + 5000); ++i) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(25));
+            v = read_int16(*c, "D8");
+        }
+        // Counting on from the client's 20000 (not from where it was before the write).
+        EXPECT_GT(v, 20000);
+        EXPECT_LT(v, 20000 + 5000);
+    }
+}
+
+// A plant whose CPU Units compute on finsd's one scenario thread: every unit's ticks go
+// through it, each with its own scenario time, and a pause settles the one in flight.
+TEST(ScenarioRun, APlantsUnitsShareTheScenarioThread) {
+    ScratchDir dir("scenario-plant-thread");
+    const std::string socket = (dir.path() / "ctl.sock").string();
+    std::string config = "log_level = \"warn\"\n";
+    for (int i = 1; i <= 3; ++i)
+        config += "[[plc]]\nname = \"m" + std::to_string(i) +
+                  "\"\n[[plc.ethernet]]\nnetwork = 1\nbind = \"127.0.1." + std::to_string(i) +
+                  "\"\n[plc.scenario]\ntick_ms = 10\ncompute = \"thread\"\n"
+                  "[[plc.scenario.signal]]\naddress = \"D8\"\nkind = \"counter\"\n"
+                  "input = \"1\"\nrate = 100\n";
+    const auto file = dir.write("plant.toml", config);
+    Finsd d({"--config", file, "--control", socket});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    const auto status = [&](int i) {
+        const auto r = ctl(socket, {"--plc", "m" + std::to_string(i), "scenario", "status"});
+        EXPECT_EQ(r.exit_code, 0) << r.err;
+        return Json::parse(r.out, nullptr, false)["scenario"];
+    };
+    for (int i = 1; i <= 3; ++i) {
+        std::uint64_t ticks = 0;
+        for (int k = 0; k < 200 && ticks < 10; ++k) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(25));
+            ticks = status(i)["ticks"].get<std::uint64_t>();
+        }
+        EXPECT_GE(ticks, 10u) << "m" << i;
+        EXPECT_GE(status(i)["writes"].get<std::uint64_t>(), 10u) << "m" << i;
+    }
+    ASSERT_EQ(ctl(socket, {"--plc", "m2", "scenario", "pause"}).exit_code, 0);
+    const auto paused = status(2)["ticks"].get<std::uint64_t>();
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    EXPECT_EQ(status(2)["ticks"].get<std::uint64_t>(), paused);
+    EXPECT_TRUE(status(2)["paused"].get<bool>());
+}
+
 }  // namespace
 }  // namespace fins::test

@@ -60,6 +60,14 @@ tl::expected<void, std::string> ScenarioLoader::table(const toml::node& node,
             if (*s != "real" && *s != "virtual")
                 return fail(v, p, fmt::format("'{}' is not real or virtual", *s));
             def.virtual_time = *s == "virtual";
+        } else if (k == "compute") {
+            auto s = text(v, p);
+            if (!s) return tl::unexpected(s.error());
+            if (*s != "auto" && *s != "io" && *s != "thread")
+                return fail(v, p, fmt::format("'{}' is not auto, io or thread", *s));
+            out_.compute = *s == "io"       ? ComputeOn::io_thread
+                           : *s == "thread" ? ComputeOn::scenario_thread
+                                            : ComputeOn::automatic;
         } else if (k == "time_scale") {
             auto d = number(v, p);
             if (!d) return tl::unexpected(d.error());

@@ -31,8 +31,15 @@ class Scenario;
 
 namespace fins::cli::finsd {
 
+// Where a CPU Unit's real-time ticks are computed (`compute`): on finsd's scenario
+// thread (server/scenario/scenario_worker.hpp), on the I/O thread with the requests, or
+// auto: the scenario thread on a host of at least auto_thread_cores cores.
+enum class ComputeOn { automatic, io_thread, scenario_thread };
+inline constexpr unsigned auto_thread_cores = 4;
+
 struct ScenarioConfig {
     scenario::ScenarioDef def;
+    ComputeOn compute = ComputeOn::automatic;
     std::vector<std::string> sources;  // SourcePos::source -> file name
     // Where `finsd ctl scenario reload` reads it again: this file's [scenario] table, or
     // with `plc` the one of the [[plc]] of that name.

@@ -350,8 +350,11 @@ int serve(const Settings& s) {
     fins::server::SerialPorts gateway_ports;
     fins::cli::finsd::open_gateway_ports(io, s.serial, gateway_ports);
     (*server)->attach_serial_ports(&gateway_ports);
-    // The scenario ticks on this io_context; its unit faults reach the dispatcher.
-    auto runner = fins::cli::finsd::run_scenario(io, s.scenario, std::move(scenario), plc);
+    // The scenario's ticks are computed on finsd's scenario thread, handed over on this
+    // io_context; its unit faults reach the dispatcher.
+    std::unique_ptr<fins::server::ScenarioWorker> scenario_worker;
+    auto runner = fins::cli::finsd::run_scenario(io, s.scenario, std::move(scenario), plc,
+                                                 std::nullopt, scenario_worker);
     if (runner) (*server)->dispatcher().attach_faults(runner.get());
     // --control, FINSD_SOCKET or the default path (control_setup.hpp).
     fins::server::ControlTarget target;

@@ -14,11 +14,12 @@
 
 namespace fins::cli::finsd {
 
-// Null when `config` is empty. Starts the runner (`phase`: ScenarioRunner::start).
-std::unique_ptr<server::ScenarioRunner> run_scenario(asio::io_context& io,
-                                                     const std::optional<ScenarioConfig>& config,
-                                                     std::unique_ptr<scenario::Scenario> compiled,
-                                                     plc::Plc& plc,
-                                                     std::optional<double> phase = std::nullopt);
+// Null when `config` is empty. Starts the runner (`phase`: ScenarioRunner::start) with
+// its ticks computed where `compute` says: on `worker` (finsd's one scenario thread, made
+// on first use; it must outlive the runners) or on the I/O thread.
+std::unique_ptr<server::ScenarioRunner> run_scenario(
+    asio::io_context& io, const std::optional<ScenarioConfig>& config,
+    std::unique_ptr<scenario::Scenario> compiled, plc::Plc& plc, std::optional<double> phase,
+    std::unique_ptr<server::ScenarioWorker>& worker);
 
 }  // namespace fins::cli::finsd

@@ -124,6 +124,8 @@ std::string plant_config(const Settings& s, server::PlantConfig& config) {
 
 // What runs beside the plant for its CPU Units; stopped before the plant.
 struct CpuUnitExtras {
+    // finsd's scenario thread (declared first: it outlives the runners).
+    std::unique_ptr<server::ScenarioWorker> scenario_worker;
     std::vector<std::unique_ptr<server::SerialPorts>> gateways;
     std::vector<SerialPorts> host_link;
     std::vector<std::unique_ptr<server::InstructionSchedule>> schedules;
@@ -162,8 +164,9 @@ int set_up_cpu(asio::io_context& io, const Settings& s, server::Plant& plant, st
             plant.cpu_count() <= units_logged_at_info ? spdlog::level::info : spdlog::level::debug,
             "finsd: plc \"{}\": {} memory entries written", config.name, written);
     apply_cpu_options(cpu, plc);  // [plc.protection], [plc.inject]
-    // [plc.scenario]: compiled against this CPU Unit, ticking on the io_context, its unit
-    // faults on every unit of the CPU Unit.
+    // [plc.scenario]: compiled against this CPU Unit, its ticks handed over between the
+    // io_context and the plant's scenario thread, its unit faults on every unit of the
+    // CPU Unit.
     std::unique_ptr<scenario::Scenario> compiled;
     if (cpu.scenario) {
         auto c = compile_scenario(*cpu.scenario, plc);
@@ -172,7 +175,8 @@ int set_up_cpu(asio::io_context& io, const Settings& s, server::Plant& plant, st
     }
     // The plant's ticks spread over the period in groups (ScenarioRunner::phase_of).
     extras.scenarios.push_back(run_scenario(io, cpu.scenario, std::move(compiled), plc,
-                                            server::ScenarioRunner::phase_of(i)));
+                                            server::ScenarioRunner::phase_of(i),
+                                            extras.scenario_worker));
     for (std::size_t k = 0; k < config.ports.size() && extras.scenarios.back(); ++k)
         plant.server(i, k).dispatcher().attach_faults(extras.scenarios.back().get());
 

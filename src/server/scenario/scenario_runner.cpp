@@ -17,17 +17,36 @@ std::chrono::system_clock::time_point host_now() {
 }  // namespace
 
 ScenarioRunner::ScenarioRunner(asio::io_context& io, std::unique_ptr<scenario::Scenario> scenario,
-                               Reloader reload, std::string source)
+                               Reloader reload, std::string source, ScenarioWorker* worker)
     : io_(io),
       scenario_(std::move(scenario)),
       reload_(std::move(reload)),
       source_(std::move(source)),
       timer_(io),
+      worker_(worker),
       drops_(scenario_->definition().seed ^ 0xD809D809D809D809ULL),
       delay_timer_(io) {}
 
 ScenarioRunner::~ScenarioRunner() {
+    settle();
     *alive_ = false;
+}
+
+void ScenarioRunner::settle() {
+    if (!in_flight_) return;
+    worker_->settle(*this);
+    scenario_->end_tick();
+    in_flight_ = false;
+}
+
+void ScenarioRunner::compute() noexcept {
+    scenario_->compute();
+}
+
+void ScenarioRunner::finish() noexcept {
+    scenario_->end_tick();
+    in_flight_ = false;
+    if (running_ && !paused_) schedule();
 }
 
 void ScenarioRunner::start(std::optional<double> phase) {
@@ -54,6 +73,7 @@ void ScenarioRunner::start(std::optional<double> phase) {
 }
 
 void ScenarioRunner::stop() {
+    settle();
     running_ = false;
     timer_.cancel();
     delay_timer_.cancel();
@@ -70,7 +90,21 @@ void ScenarioRunner::schedule() {
 
 void ScenarioRunner::on_tick(boost::system::error_code ec) {
     if (ec || !running_ || paused_ || scenario_->definition().virtual_time) return;
+    if (in_flight_) return;  // its finish() schedules the next
     const auto now = std::chrono::steady_clock::now();
+    if (worker_ != nullptr && scenario_->offloadable()) {
+        // One tick per hand-over; a backlog beyond max_catch_up periods is dropped.
+        if (next_ > now) {
+            schedule();
+            return;
+        }
+        if (now - next_ >= period_ * max_catch_up) next_ = now;
+        scenario_->begin_tick(host_now());
+        next_ += period_;
+        in_flight_ = true;
+        worker_->submit(*this);
+        return;
+    }
     unsigned ran = 0;
     while (next_ <= now && ran < max_catch_up) {
         scenario_->tick(host_now());
@@ -97,6 +131,7 @@ ScenarioRunStatus ScenarioRunner::run_status() const {
 }
 
 void ScenarioRunner::pause() {
+    settle();
     paused_ = true;
     timer_.cancel();
 }
@@ -113,10 +148,12 @@ void ScenarioRunner::resume() {
 }
 
 std::uint64_t ScenarioRunner::advance(double seconds) {
+    settle();
     return scenario_->advance(seconds, host_now());
 }
 
 bool ScenarioRunner::trigger(std::string_view event) {
+    settle();
     return scenario_->trigger(event, host_now());
 }
 
@@ -124,6 +161,7 @@ tl::expected<void, std::string> ScenarioRunner::reload() {
     if (!reload_) return tl::unexpected(std::string("this scenario has no file to reload"));
     auto fresh = reload_();
     if (!fresh) return tl::unexpected(fresh.error());
+    settle();
     timer_.cancel();
     scenario_ = std::move(*fresh);
     ++reloads_;

@@ -10,6 +10,10 @@
 // Virtual time: no timer; time moves only by advance() (`finsd ctl scenario advance`).
 // Reload compiles the new file first and swaps only on success; the unit faults the old
 // one had started are cleared with it.
+// With a ScenarioWorker (finsd's), a real-time tick of an offloadable scenario is handed
+// over: begin_tick here, compute on the worker, end_tick here when it comes back (one tick
+// in flight at most; the next is due one period later). Every control verb settles a tick
+// in flight first, so it sees (and changes) the scenario between ticks.
 #pragma once
 
 #include <chrono>
@@ -27,11 +31,12 @@
 #include "scenario/scenario.hpp"
 #include "server/scenario/fault_hook.hpp"
 #include "server/scenario/scenario_control.hpp"
+#include "server/scenario/scenario_worker.hpp"
 #include "transport/asio.hpp"
 
 namespace fins::server {
 
-class ScenarioRunner final : public ScenarioControl, public FaultHook {
+class ScenarioRunner final : public ScenarioControl, public FaultHook, private ScenarioWorker::Job {
   public:
     using Compiled = tl::expected<std::unique_ptr<scenario::Scenario>, std::string>;
     // Reads and compiles the scenario again (for reload).
@@ -48,8 +53,9 @@ class ScenarioRunner final : public ScenarioControl, public FaultHook {
     }
     static constexpr std::size_t max_delayed_answers = 1024;
 
+    // `worker` (may be null: every tick on this thread) must outlive the runner.
     ScenarioRunner(asio::io_context& io, std::unique_ptr<scenario::Scenario> scenario,
-                   Reloader reload, std::string source);
+                   Reloader reload, std::string source, ScenarioWorker* worker = nullptr);
     ~ScenarioRunner() override;
     ScenarioRunner(const ScenarioRunner&) = delete;
     ScenarioRunner& operator=(const ScenarioRunner&) = delete;
@@ -63,6 +69,8 @@ class ScenarioRunner final : public ScenarioControl, public FaultHook {
     void start(std::optional<double> phase = std::nullopt);
     void stop();
     [[nodiscard]] const scenario::Scenario& scenario() const noexcept { return *scenario_; }
+    // Ends a tick in flight on the worker now (waiting for its compute if needed).
+    void settle();
 
     // ScenarioControl
     [[nodiscard]] ScenarioRunStatus run_status() const override;
@@ -80,6 +88,10 @@ class ScenarioRunner final : public ScenarioControl, public FaultHook {
     void send_later(Bytes response, Completion completion) override;
 
   private:
+    // ScenarioWorker::Job
+    void compute() noexcept override;
+    void finish() noexcept override;
+
     void schedule();
     void on_tick(boost::system::error_code ec);
     void flush_delayed();
@@ -91,6 +103,8 @@ class ScenarioRunner final : public ScenarioControl, public FaultHook {
     asio::steady_timer timer_;
     std::chrono::steady_clock::duration period_{};
     std::chrono::steady_clock::time_point next_{};
+    ScenarioWorker* worker_ = nullptr;
+    bool in_flight_ = false;  // a tick handed to the worker, not yet ended
     bool running_ = false;
     bool paused_ = false;
     std::uint64_t reloads_ = 0;
