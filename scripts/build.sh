@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Configures and builds one tree. Usage: scripts/build.sh [release|asan|fuzz] [TARGET...]
-# (no targets: everything the tree builds)
+# (no targets: everything the tree builds; for fuzz, every fuzzer: fuzz/CMakeLists.txt's
+# fuzz_all). FINS_BUILD_DIR puts the tree elsewhere; FINS_NINJA_ARGS are extra ninja
+# options (-n: print what would be built, build nothing).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 kind=${1:-release}
@@ -16,9 +18,10 @@ case "$kind" in
 esac
 # ccache (optional, not a dependency) makes rebuilds in several work trees cheap.
 if command -v ccache >/dev/null; then args+=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
-cmake -S "$root" -B "$root/$dir" -G Ninja "${args[@]}" >/dev/null
-if [[ "$kind" == fuzz ]]; then
-  ninja -C "$root/$dir" -j "$jobs" fuzz_frame fuzz_tcp fuzz_address fuzz_dispatch fuzz_session fuzz_files fuzz_host_link fuzz_router fuzz_serial_gateway fuzz_serial_session fuzz_http fuzz_scenario_expr
-else
-  ninja -C "$root/$dir" -j "$jobs" "$@"
-fi
+dir=${FINS_BUILD_DIR:-$root/$dir}
+cmake -S "$root" -B "$dir" -G Ninja "${args[@]}" >/dev/null
+# The fuzz tree's "everything" would also build the libraries' other programs: its
+# default is the fuzzers alone, which CMake lists (fuzz_all).
+if [[ "$kind" == fuzz && $# -eq 0 ]]; then set -- fuzz_all; fi
+read -r -a ninja_args <<<"${FINS_NINJA_ARGS:-}"
+ninja -C "$dir" -j "$jobs" "${ninja_args[@]}" "$@"

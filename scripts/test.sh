@@ -44,7 +44,8 @@ rm -f "$soak_log"
 echo "== fuzz (${fuzz_seconds}s per target)"
 "$root/scripts/build.sh" fuzz
 fuzz_ok=0
-for target in fuzz_frame fuzz_tcp fuzz_address fuzz_dispatch fuzz_session fuzz_files fuzz_host_link fuzz_router fuzz_serial_gateway fuzz_serial_session fuzz_http fuzz_scenario_expr; do
+mapfile -t fuzzers <"$root/build-fuzz/fuzzers.txt"  # written by fuzz/CMakeLists.txt
+for target in "${fuzzers[@]}"; do
   corpus=$(mktemp -d)
   seeds="$root/fuzz/corpus/$target"
   [[ -d "$seeds" ]] && cp -r "$seeds/." "$corpus/"

@@ -1,13 +1,14 @@
 // PLC address strings as engineers write them, and their FINS memory addresses.
 //
-//   D100  D100.15  CIO10.13  10.13  W5  H10.1  A448  T10  C10
-//   E3_100  E0_0.5  E100 (current EM bank)  IR0  DR3  TK2  DM100 = D100 (address_names.hpp)
+//   D100  D100.15  CIO10.13  10.13  W5  H10.01  A448  T10  C10
+//   E3_100  E0_0.05  E100 (current EM bank)  IR0  DR3  TK2  DM100 = D100 (address_names.hpp)
 //
 // parse_address() accepts these forms (area letters case-insensitive, "CIO" optional
-// for a bare number); format_address() prints the canonical form back, so
-// format(parse(s)) is stable. to_memory_address() chooses the CS/CJ area code from
-// the 5-2-2 table: a word address reads the word code, an address with ".bit" the bit
-// code; for T/C the word is the PV (89) and Access::bit the completion flag (09).
+// for a bare number, a bit number with one digit or two: H10.1 = H10.01);
+// format_address() prints the canonical form back, bit numbers with two digits as Omron
+// writes them (CIO0.00 .. CIO0.15): format(parse(s)) is stable. to_memory_address() picks
+// the CS/CJ area code of 5-2-2: a word address the word code, an address with ".bit" the
+// bit code; for T/C the word is the PV (89) and Access::bit the completion flag (09).
 #pragma once
 
 #include <cstdint>

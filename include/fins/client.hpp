@@ -164,7 +164,7 @@ class Client {
     // partly done). Bits use the same limits per element.
     Result<std::vector<std::uint16_t>> read_words(const Address& start, std::size_t count);
     Result<void> write_words(const Address& start, std::span<const std::uint16_t> words);
-    // Bit addresses (D100.3, CIO10.15) step bit by bit; T/C/TK flags step word by word.
+    // Bit addresses (D100.03, CIO10.15) step bit by bit; T/C/TK flags step word by word.
     Result<std::vector<bool>> read_bits(const Address& start, std::size_t count);
     Result<void> write_bits(const Address& start, const std::vector<bool>& bits);
     Result<void> fill(const Address& start, std::size_t count, std::uint16_t value);

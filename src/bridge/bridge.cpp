@@ -263,6 +263,7 @@ void Bridge::report() {
             t.timeouts += s.timeouts;
             t.resends += s.resends;
             t.end_codes += s.end_codes;
+            t.other_node_answers += s.other_node_answers;
             online += p->online() ? 1u : 0u;
             polled += p->running() ? 1u : 0u;
         }
@@ -282,6 +283,7 @@ void Bridge::report() {
             {"timeouts", t.timeouts},
             {"resends", t.resends},
             {"end_codes", t.end_codes},
+            {"other_node_answers", t.other_node_answers},
             {"published", m.published},
             {"dropped", m.dropped},
             {"connects", m.connects},

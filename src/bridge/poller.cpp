@@ -259,7 +259,18 @@ void PlcPoller::on_frame(Bytes frame) {
     auto v = decode_response(frame);
     if (!v) return;
     auto r = window_.take_answer(v->header, v->command, destination_.node, PollClock::now());
-    if (!r) return;  // late (after a resend), duplicated or not ours
+    if (!r) {
+        // Late (after a resend), duplicated or not ours: dropped. But an answer to a frame
+        // in flight from another node means the PLC is not the node it is addressed as
+        // (dest, or its IP's last number): its frames then time out, and the status says
+        // why (go_offline).
+        if (window_.from_other_node(v->header, v->command, destination_.node)) {
+            ++stats_.other_node_answers;
+            answered_by_ = v->header.source;
+        }
+        return;
+    }
+    answered_by_.reset();
     ++stats_.frames;
     if (state_ != State::online) go_online();
     complete(*r, &*v, {});

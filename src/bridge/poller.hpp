@@ -11,7 +11,9 @@
 //   max_pending_writes writes.
 // - Answers (request_window.hpp): matched by service ID, source node and command code; a
 //   SID is not reused for 2 x timeout after its frame was answered or given up, so a late
-//   or duplicated answer never completes another request.
+//   or duplicated answer never completes another request. An answer that matches but for
+//   its source node is dropped too, counted, and the PLC's offline status then names
+//   both nodes and the `dest` to configure instead of a bare timeout.
 // - Timeouts: a frame unanswered after Plc::timeout is sent again with a new service ID
 //   (Plc::retries times); then it fails with ClientError::timeout and the PLC is offline.
 // - Offline: every queued frame fails at once, writes are refused, the status says
@@ -54,6 +56,9 @@ struct PollerStats {
     std::uint64_t timeouts = 0;   // frames that failed after every retry
     std::uint64_t resends = 0;    // frames sent again after a timeout
     std::uint64_t end_codes = 0;  // frames answered with an error end code
+    // Answers with the SID and command of a frame in flight but from another node than
+    // the one it went to: dropped (they are not the addressed PLC's), counted and reported.
+    std::uint64_t other_node_answers = 0;
 };
 
 // What a poller reports; implemented by the Bridge (bridge.hpp). Called on the
@@ -114,6 +119,7 @@ class PlcPoller {
     void finish_write(PendingWrite& op, std::error_code error, const ResponseView* response);
     void go_online();
     void go_offline(std::error_code why);
+    std::string other_node_text() const;
     void close_socket();
     void backoff();
     std::int64_t now_ms() const;
@@ -150,6 +156,10 @@ class PlcPoller {
     asio::steady_timer backoff_timer_;
     Backoff backoff_;
     std::string last_error_;
+    // Who answered the frames sent to destination_ since the last answer accepted, when
+    // that was another node (on_frame).
+    std::optional<NodeAddress> answered_by_;
+    bool other_node_reported_ = false;  // the offline status published names answered_by_
     PollerStats stats_;
 };
 

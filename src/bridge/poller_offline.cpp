@@ -2,11 +2,25 @@
 // the status; an offline PLC is probed again after a back-off with full jitter.
 #include "bridge/poller_parts.hpp"
 
+#include <fmt/format.h>
+
 namespace fins::bridge {
+
+std::string PlcPoller::other_node_text() const {
+    const NodeAddress& from = *answered_by_;
+    const char* why = plc_.dest                          ? "its dest"
+                      : plc_.transport == Transport::tcp ? "the node the FINS/TCP handshake named"
+                                                         : "the last number of its IP address";
+    return fmt::format(
+        "answers come from node {}, requests go to node {} ({}): set dest = \"{}.{}.{}\" for "
+        "plc \"{}\"",
+        from.node, destination_.node, why, from.network, from.node, destination_.unit, plc_.name);
+}
 
 void PlcPoller::go_online() {
     if (state_ == State::online) return;
     state_ = State::online;
+    other_node_reported_ = false;
     backoff_.reset();
     for (auto& gs : groups_)
         gs->need_full = true;
@@ -15,8 +29,14 @@ void PlcPoller::go_online() {
 
 void PlcPoller::go_offline(std::error_code why) {
     if (!running_) return;
-    last_error_ = error_text(why);
-    const bool was = state_ == State::offline;
+    // Frames that timed out while another node answered them: that is the error to fix.
+    const bool other_node = answered_by_ && why == make_error_code(ClientError::timeout);
+    last_error_ = other_node ? other_node_text() : error_text(why);
+    answered_by_.reset();  // the next probe's answers tell again
+    // Published when the PLC goes offline, and again only when another node's answers
+    // start or stop being the reason: not for every probe that fails the same way.
+    const bool news = state_ != State::offline || other_node != other_node_reported_;
+    other_node_reported_ = other_node;
     state_ = State::offline;
     ++generation_;  // handlers of this connection and pending timers return early
     timeout_timer_.cancel();
@@ -34,7 +54,7 @@ void PlcPoller::go_offline(std::error_code why) {
         gs->outstanding = 0;
     }
     if (plc_.transport == Transport::tcp) close_socket();
-    if (!was) events_.status_changed({&plc_, false, last_error_, now_ms()});
+    if (news) events_.status_changed({&plc_, false, last_error_, now_ms()});
     // The groups' timers belonged to the old generation: keep them on their grid.
     for (std::size_t g = 0; g < groups_.size(); ++g)
         schedule(g);

@@ -60,6 +60,15 @@ std::optional<Request> RequestWindow::take_answer(const Header& answer, CommandC
     return r;
 }
 
+bool RequestWindow::from_other_node(const Header& answer, CommandCode command,
+                                    std::uint8_t plc_node) const noexcept {
+    if (!busy_[answer.service_id] || answer.source.node == plc_node) return false;
+    return std::any_of(in_flight_.begin(), in_flight_.end(), [&](const Request& r) {
+        return r.kind != Request::Kind::handshake && r.service_id == answer.service_id &&
+               r.command == command;
+    });
+}
+
 void RequestWindow::take_expired(PollClock::time_point now, std::vector<Request>& out) {
     for (std::size_t i = 0; i < in_flight_.size();) {
         if (in_flight_[i].deadline <= now) {

@@ -58,6 +58,11 @@ class RequestWindow {
     // nullopt: late, duplicated, from another node or another command.
     std::optional<Request> take_answer(const Header& answer, CommandCode command,
                                        std::uint8_t plc_node, PollClock::time_point now);
+    // Is this an answer to a request in flight (its SID and command) from a node other
+    // than `plc_node`? take_answer refuses it; this tells the poller that the PLC answers
+    // under another node address than the one it is sent to (a configuration error).
+    [[nodiscard]] bool from_other_node(const Header& answer, CommandCode command,
+                                       std::uint8_t plc_node) const noexcept;
     // Moves the requests whose deadline is not after `now` to `out` (SIDs quarantined).
     void take_expired(PollClock::time_point now, std::vector<Request>& out);
     // Moves everything in flight to `out` (the PLC went offline; SIDs quarantined).

@@ -231,7 +231,9 @@ std::string format_address(const Address& a) {
     std::string out(prefix_of(a.area));
     if (a.area == Area::em) out += fmt::format("{:X}_", a.bank);
     out += fmt::format("{}", a.word);
-    if (a.bit) out += fmt::format(".{}", *a.bit);
+    // Two digits, as Omron writes bit numbers (CIO 0.00 to 0.15 in W342 5-2-2, and
+    // CX-Programmer): "CIO0.05", not "CIO0.5".
+    if (a.bit) out += fmt::format(".{:02}", *a.bit);
     return out;
 }
 

@@ -46,7 +46,7 @@ ApiResult<ValueQuery> classify(std::string_view address, std::string_view as, bo
         if (start->area == Area::index_register || start->area == Area::data_register)
             return tl::unexpected(
                 bad(fmt::format("{} has no bits: IR and DR are word access only", address)));
-        return tl::unexpected(bad(fmt::format("{} is a word: name a bit ({}.0) for bits", address,
+        return tl::unexpected(bad(fmt::format("{} is a word: name a bit ({}.00) for bits", address,
                                               format_address(*start))));
     }
     q.wide = start->area == Area::index_register;

@@ -1,6 +1,6 @@
 // Typed reads and writes of a CPU Unit's I/O memory for the HTTP API and the WebSocket,
 // with the `fins` CLI's address strings and value formats (typed/value_format.hpp) and its
-// rules: a bit address (D100.3, CIO10.13, TK2) reads and writes bits; a word address with
+// rules: a bit address (D100.03, CIO10.13, TK2) reads and writes bits; a word address with
 // as=bits reads T/C completion flags (T5); IR0-15 are 32-bit elements; ascii (string)
 // reads `count` words as one text.
 //

@@ -146,6 +146,25 @@ TEST(PollerWindow, MatchesAnAnswerBySidSourceNodeAndCommandOnly) {
     EXPECT_TRUE(w.empty());
 }
 
+// The answer a PLC gives under another node than the one addressed: refused as every
+// answer not ours, and recognised, so the poller can say what to configure.
+TEST(PollerWindow, TellsAnAnswerFromAnotherNodeToAFrameInFlight) {
+    RequestWindow w(4, 2s);
+    const auto a = sent(w, t0, 0);
+    const auto other = answer_header(a.service_id, 12);
+    EXPECT_TRUE(w.from_other_node(other, MemoryAreaRead::code, plc_node));
+    EXPECT_FALSE(w.take_answer(other, MemoryAreaRead::code, plc_node, t0));
+    EXPECT_EQ(w.size(), 1u);  // still in flight: it times out
+    // Not from another node: the right node, another command, a SID not in flight.
+    EXPECT_FALSE(w.from_other_node(answer_header(a.service_id), MemoryAreaRead::code, plc_node));
+    EXPECT_FALSE(w.from_other_node(other, MultipleMemoryAreaRead::code, plc_node));
+    EXPECT_FALSE(w.from_other_node(answer_header(static_cast<std::uint8_t>(a.service_id + 1), 12),
+                                   MemoryAreaRead::code, plc_node));
+    ASSERT_TRUE(w.take_answer(answer_header(a.service_id), MemoryAreaRead::code, plc_node, t0));
+    // Answered (quarantined): a late copy from another node is nothing to report.
+    EXPECT_FALSE(w.from_other_node(other, MemoryAreaRead::code, plc_node));
+}
+
 TEST(PollerWindow, ALateAnswerAfterAResendNeverCompletesAnotherRequest) {
     RequestWindow w(4, 2s);
     const auto first = sent(w, t0, 0);

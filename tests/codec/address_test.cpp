@@ -23,8 +23,8 @@ const Form forms[] = {
     {"10.13", "CIO10.13", {Area::cio, 0, 10, 13}},
     {"10", "CIO10", {Area::cio, 0, 10, std::nullopt}},
     {"W5", "W5", {Area::work, 0, 5, std::nullopt}},
-    {"H10.1", "H10.1", {Area::holding, 0, 10, 1}},
-    {"h10.01", "H10.1", {Area::holding, 0, 10, 1}},
+    {"H10.1", "H10.01", {Area::holding, 0, 10, 1}},
+    {"h10.01", "H10.01", {Area::holding, 0, 10, 1}},
     {"A448", "A448", {Area::auxiliary, 0, 448, std::nullopt}},
     {"T10", "T10", {Area::timer, 0, 10, std::nullopt}},
     {"C10", "C10", {Area::counter, 0, 10, std::nullopt}},
@@ -32,9 +32,9 @@ const Form forms[] = {
     {"E10_5", "E10_5", {Area::em, 0x10, 5, std::nullopt}},
     {"ea_7", "EA_7", {Area::em, 0x0A, 7, std::nullopt}},
     {"E18_32767.15", "E18_32767.15", {Area::em, 0x18, 32767, 15}},
-    {"E0_0.5", "E0_0.5", {Area::em, 0, 0, 5}},
+    {"E0_0.5", "E0_0.05", {Area::em, 0, 0, 5}},
     {"E100", "E100", {Area::em_current, 0, 100, std::nullopt}},
-    {"E100.3", "E100.3", {Area::em_current, 0, 100, 3}},
+    {"E100.3", "E100.03", {Area::em_current, 0, 100, 3}},
     {"IR0", "IR0", {Area::index_register, 0, 0, std::nullopt}},
     {"ir15", "IR15", {Area::index_register, 0, 15, std::nullopt}},
     {"DR3", "DR3", {Area::data_register, 0, 3, std::nullopt}},
@@ -46,6 +46,14 @@ const Form forms[] = {
     {"W511.15", "W511.15", {Area::work, 0, 511, 15}},
     {"A959", "A959", {Area::auxiliary, 0, 959, std::nullopt}},
     {"C4095", "C4095", {Area::counter, 0, 4095, std::nullopt}},
+    // Bit numbers print with two digits, as Omron writes them (CIO 0.00 to 0.15, W342
+    // 5-2-2 and CX-Programmer); both forms parse.
+    {"CIO0.0", "CIO0.00", {Area::cio, 0, 0, 0}},
+    {"CIO0.00", "CIO0.00", {Area::cio, 0, 0, 0}},
+    {"W3.7", "W3.07", {Area::work, 0, 3, 7}},
+    {"W3.07", "W3.07", {Area::work, 0, 3, 7}},
+    {"E3_200.5", "E3_200.05", {Area::em, 3, 200, 5}},
+    {"A448.10", "A448.10", {Area::auxiliary, 0, 448, 10}},
 };
 
 TEST(Address, ParseFormatRoundTrip) {
@@ -125,7 +133,7 @@ TEST(Address, BadStrings) {
 TEST(Address, CxProgrammerNamesOf5_2_2AreasAreAliases) {
     const Form aliases[] = {
         {"DM100", "D100", {Area::dm, 0, 100, std::nullopt}},
-        {"dm100.3", "D100.3", {Area::dm, 0, 100, 3}},
+        {"dm100.3", "D100.03", {Area::dm, 0, 100, 3}},
         {"HR0", "H0", {Area::holding, 0, 0, std::nullopt}},
         {"WR0", "W0", {Area::work, 0, 0, std::nullopt}},
         {"AR448", "A448", {Area::auxiliary, 0, 448, std::nullopt}},

@@ -188,12 +188,12 @@ TEST_F(CliDiagnostic, ForceSetReleaseAndCancel) {
     ASSERT_EQ(fins({"stop"}).exit_code, 0);
     auto set = fins({"force", "set", "CIO10.13", "T5", "W0.1"});
     ASSERT_EQ(set.exit_code, 0) << set.err;
-    EXPECT_EQ(set.out, "force set: CIO10.13 T5 W0.1\n");
+    EXPECT_EQ(set.out, "force set: CIO10.13 T5 W0.01\n");
     ASSERT_EQ(fins({"write", "CIO10.13", "0"}).exit_code, 0);
     EXPECT_EQ(fins({"read", "CIO10.13"}).out, "CIO10.13  1\n");  // forced stays ON
     EXPECT_EQ(fins({"read", "T5", "--as", "bits"}).out, "T5  1\n");
     ASSERT_EQ(fins({"force", "release-off", "W0.1"}).exit_code, 0);
-    EXPECT_EQ(fins({"read", "W0.1"}).out, "W0.1  0\n");
+    EXPECT_EQ(fins({"read", "W0.1"}).out, "W0.01  0\n");
     auto cancel = fins({"force-cancel"});
     EXPECT_EQ(cancel.exit_code, 0) << cancel.err;
     EXPECT_EQ(cancel.out, "all forced bits released\n");

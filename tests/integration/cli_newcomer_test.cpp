@@ -52,7 +52,7 @@ TEST(CliErrors, LocalDecodeAndRangeMistakesAreUsageErrorsWithTrueMessages) {
     EXPECT_EQ(bits.exit_code, 2) << bits.err;
     EXPECT_EQ(error_of(bits)["kind"], "usage");
     EXPECT_EQ(bits.err.find("only bit access"), std::string::npos) << bits.err;
-    EXPECT_NE(bits.err.find("D100 is a word: name a bit (D100.0)"), std::string::npos) << bits.err;
+    EXPECT_NE(bits.err.find("D100 is a word: name a bit (D100.00)"), std::string::npos) << bits.err;
 
     // TK has only bit access: it reads as bits without --as.
     auto task = fins(d, {"read", "TK2"});
@@ -160,7 +160,7 @@ TEST(CliConventions, VersionHelpPrefixesAndPlurals) {
     ASSERT_TRUE(d.started()) << d.result().err;
     EXPECT_EQ(fins(d, {"write", "D0", "7"}).out, "wrote 1 word at D0\n");
     EXPECT_EQ(fins(d, {"write", "D0", "7", "8"}).out, "wrote 2 words at D0\n");
-    EXPECT_EQ(fins(d, {"write", "CIO0.0", "1"}).out, "wrote 1 bit at CIO0.0\n");
+    EXPECT_EQ(fins(d, {"write", "CIO0.0", "1"}).out, "wrote 1 bit at CIO0.00\n");
     EXPECT_EQ(fins(d, {"fill", "D0", "1", "0"}).out, "filled 1 word at D0 with 0x0000\n");
     EXPECT_EQ(fins(d, {"transfer", "D0", "D1", "1"}).out, "copied 1 word from D0 to D1\n");
 }

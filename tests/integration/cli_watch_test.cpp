@@ -49,7 +49,7 @@ TEST_F(CliWatch, W342_5_3_5_FirstPollPrintsEveryValueThenOnlyChanges) {
     EXPECT_EQ(d0["address"], "D0");
     EXPECT_EQ(d0["value"], 5);
     EXPECT_TRUE(d0["time"].is_string());
-    EXPECT_EQ(nlohmann::json::parse(got[1], nullptr, false)["address"], "D1.3");
+    EXPECT_EQ(nlohmann::json::parse(got[1], nullptr, false)["address"], "D1.03");
 }
 
 TEST_F(CliWatch, PrintsAChangeAndCtrlCExitsZero) {

@@ -150,8 +150,8 @@ int run_read(const GlobalOptions& g, const ReadArgs& a, Format f, Output& out) {
             return out.usage(
                 fmt::format("{} has no bits to read: IR and DR are word access only", a.address));
         return out.usage(fmt::format(
-            "{} is a word: name a bit ({}.0) to read bits, or use --as hex for the word", a.address,
-            format_address(*start)));
+            "{} is a word: name a bit ({}.00) to read bits, or use --as hex for the word",
+            a.address, format_address(*start)));
     }
     // Index registers are 32-bit elements (5-2-2, element size 4): one value each.
     const bool wide = start->area == Area::index_register;
@@ -227,7 +227,7 @@ int run_write(const GlobalOptions& g, const WriteArgs& a, Format f, Output& out)
     if ((start->bit || bit_only) && !bits)
         return out.usage(fmt::format("{} names a bit: use --as bits", a.address));
     if (bits && !start->bit && !bit_only)
-        return out.usage(fmt::format("{} is a word: name a bit ({}.0) to write bits", a.address,
+        return out.usage(fmt::format("{} is a word: name a bit ({}.00) to write bits", a.address,
                                      format_address(*start)));
     if (start->area == Area::index_register)
         return out.usage(

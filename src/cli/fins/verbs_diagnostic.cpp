@@ -417,7 +417,8 @@ void add_diagnostic_verbs(CLI::App& app, const GlobalOptions& g, int& exit_code)
         ->required()
         ->check(CLI::IsMember({"set", "reset", "release", "release-on", "release-off"}));
     force
-        ->add_option("addresses", a->addresses, "Bits (CIO10.13, W0.1, H5.0) or T/C flags (T5, C3)")
+        ->add_option("addresses", a->addresses,
+                     "Bits (CIO10.13, W0.01, H5.00) or T/C flags (T5, C3)")
         ->required();
     force->callback(run([&g, a](Output& out) { return run_force(g, out, *a); }));
 

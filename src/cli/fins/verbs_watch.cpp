@@ -122,7 +122,7 @@ void add_watch_verbs(CLI::App& app, const GlobalOptions& g, int& exit_code) {
     auto a = std::make_shared<WatchArgs>();
     auto* c = verb(app, "watch", "Poll addresses and print each change (01 04)", g, exit_code, a,
                    &run_watch);
-    c->add_option("addresses", a->addresses, "Addresses, e.g. D100 CIO10.3 T5")->required();
+    c->add_option("addresses", a->addresses, "Addresses, e.g. D100 CIO10.03 T5")->required();
     c->add_option("--interval", a->interval_seconds, "Seconds between polls")
         ->capture_default_str()
         ->check(CLI::Range(0.01, 86400.0));

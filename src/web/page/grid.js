@@ -42,7 +42,8 @@ export class Grid {
   }
 
   address(word, bit) {
-    return `${this.area.prefix}${word}${bit === undefined ? '' : '.' + bit}`;
+    // Bit numbers with two digits, as format_address prints them (CIO0.05).
+    return `${this.area.prefix}${word}${bit === undefined ? '' : '.' + String(bit).padStart(2, '0')}`;
   }
 
   // Shows `area` from `word`, keeping the view.
