@@ -39,6 +39,9 @@ struct WebOptions {
 
     // WebSocket.
     std::size_t max_ws_message_bytes = 4 * 1024;
+    // Keep-alive: a client silent for half of it is pinged; one that does not answer
+    // (nothing received, not even the pong) by the end of it is closed.
+    std::chrono::milliseconds websocket_idle_timeout{std::chrono::seconds(60)};
     std::size_t max_subscriptions = 64;           // per connection
     std::size_t max_queued_messages = 32;         // per connection; beyond: drop to snapshots
     std::chrono::milliseconds min_interval{100};  // per subscription: at most 10 updates/s

@@ -3,8 +3,8 @@
 // every min_interval while any connection has subscriptions (an idle page costs
 // nothing), and at once after a subscribe (its snapshot does not wait for the tick), with
 // a bounded send queue of messages whose values are shared between connections.
-// Keep-alive: Beast pings a client that sent nothing for half the idle timeout and
-// closes one that does not answer.
+// Keep-alive: Beast pings a client that sent nothing for half of
+// WebOptions::websocket_idle_timeout and closes one that does not answer by its end.
 //
 // A slow client: when max_queued_messages are waiting, the queue is dropped (the message
 // being written finishes) and every subscription sends a fresh snapshot next, so the
@@ -29,9 +29,6 @@ namespace {
 
 namespace websocket = beast::websocket;
 
-// A client that sends nothing for half of it is pinged; one silent for all of it is closed.
-constexpr std::chrono::seconds idle_timeout{60};
-
 class WebSocketSession : public Connection, public std::enable_shared_from_this<WebSocketSession> {
   public:
     WebSocketSession(beast::tcp_stream stream, std::shared_ptr<ServerShared> shared)
@@ -42,7 +39,7 @@ class WebSocketSession : public Connection, public std::enable_shared_from_this<
     void start(http::request<http::string_body> request) {
         ++shared_->websockets;
         auto timeouts = websocket::stream_base::timeout::suggested(beast::role_type::server);
-        timeouts.idle_timeout = idle_timeout;
+        timeouts.idle_timeout = shared_->context.options.websocket_idle_timeout;
         timeouts.keep_alive_pings = true;
         ws_.set_option(timeouts);
         ws_.set_option(websocket::stream_base::decorator(

@@ -93,6 +93,13 @@ tl::expected<void, std::string> load_http_table(const toml::node& node, std::str
             const auto* i = value.as_integer();
             if (i == nullptr || i->get() < 1 || i->get() > 1024) return fail("must be 1-1024");
             http.max_connections = static_cast<std::size_t>(i->get());
+        } else if (k == "websocket_idle_timeout") {
+            // Seconds, a decimal allowed: 0.2 s (tests) to an hour.
+            const auto seconds = value.value<double>();
+            if (!seconds || !(*seconds >= 0.2 && *seconds <= 3600))
+                return fail("must be a number of seconds 0.2-3600");
+            http.websocket_idle_timeout = std::chrono::milliseconds(
+                static_cast<std::chrono::milliseconds::rep>(*seconds * 1000 + 0.5));
         } else {
             return fail("unknown key");
         }

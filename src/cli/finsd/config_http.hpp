@@ -9,11 +9,14 @@
 //   allowed_hosts = ["plc-sim.lan"]  # host names the Host header may carry (besides
 //                                    # localhost and IP addresses)
 //   max_connections = 64
+//   websocket_idle_timeout = 60      # seconds: a silent WebSocket client is pinged after
+//                                    # half of it and closed when nothing came by its end
 //
 // Parsing and checks only (no sockets, no files); cli/finsd/web_setup reads the token
 // file and starts the server (docs/web.md).
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -34,6 +37,7 @@ struct HttpSettings {
     std::optional<std::filesystem::path> token_file;
     std::vector<std::string> allowed_hosts;
     std::size_t max_connections = 64;
+    std::chrono::milliseconds websocket_idle_timeout{std::chrono::seconds(60)};
 };
 
 // "127.0.0.1:8080", "[::1]:0", "0.0.0.0:80" -> (address, port); an error sentence else.

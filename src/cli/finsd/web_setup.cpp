@@ -4,6 +4,7 @@
 #include <chrono>
 #include <ctime>
 #include <fstream>
+#include <memory>
 #include <sstream>
 #include <utility>
 
@@ -67,6 +68,7 @@ WebStart start_web(boost::asio::io_context& io, const HttpSettings& http,
     context.options.control = http.control;
     context.options.allowed_hosts = http.allowed_hosts;
     context.options.max_connections = http.max_connections;
+    context.options.websocket_idle_timeout = http.websocket_idle_timeout;
     if (http.token_file) {
         std::string why;
         const auto token = read_token(*http.token_file, why);
@@ -121,7 +123,9 @@ WebStart start_web(boost::asio::io_context& io, const HttpSettings& http,
         entry["tcp_port"] = s->tcp_port();
         entry["tcp_connections"] = s->tcp_connections();
     };
-    context.metrics = [servers]() {
+    // The server the metrics below describe, known once it started (it owns this hook).
+    auto web_server = std::make_shared<const web::HttpServer*>(nullptr);
+    context.metrics = [servers, web_server]() {
         using server::metrics::Family;
         Family tcp{"fins_tcp_connections", "FINS/TCP client connections by state", "gauge", {}};
         std::size_t established = 0;
@@ -131,7 +135,15 @@ WebStart start_web(boost::asio::io_context& io, const HttpSettings& http,
                 ++(c.established ? established : handshake);
         tcp.samples = {{"state=\"established\"", static_cast<double>(established)},
                        {"state=\"handshake\"", static_cast<double>(handshake)}};
-        const std::vector<Family> extra{tcp};
+        Family web{"fins_web_connections", "Open HTTP and WebSocket connections", "gauge", {}};
+        if (*web_server != nullptr) {
+            const auto all = (*web_server)->connections();
+            const auto websockets = (*web_server)->websockets();
+            web.samples = {
+                {"kind=\"http\"", static_cast<double>(all > websockets ? all - websockets : 0)},
+                {"kind=\"websocket\"", static_cast<double>(websockets)}};
+        }
+        const std::vector<Family> extra{tcp, web};
         return server::metrics::expose(server::metrics::process_metrics(), extra);
     };
     auto started = web::HttpServer::start(io, std::move(context));
@@ -142,6 +154,7 @@ WebStart start_web(boost::asio::io_context& io, const HttpSettings& http,
         return out;
     }
     out.server = std::move(*started);
+    *web_server = out.server.get();
     spdlog::info("finsd: HTTP on {} port {} (control {})", listen->first, out.server->port(),
                  http.control ? "on" : "off");
     return out;
