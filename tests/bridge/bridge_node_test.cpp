@@ -27,7 +27,7 @@ const std::string expected_error =
 
 struct NodeRig {
     ScratchDir dir{"bridge-node"};
-    Mosquitto broker{dir};
+    Mosquitto broker{dir.path()};
     Finsd finsd{{"--node", "12"}};
     Subscriber sub{broker.port(), "t/#"};
     std::unique_ptr<BridgeProcess> bridge;
