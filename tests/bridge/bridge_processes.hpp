@@ -24,6 +24,8 @@
 #include <thread>
 #include <vector>
 
+#include "integration/free_port.hpp"
+
 namespace fins::test::bridge {
 
 using namespace std::chrono_literals;
@@ -40,22 +42,7 @@ inline std::string mosquitto_path() {
     return {};
 }
 
-// A loopback port that was free a moment ago (the kernel's choice).
-inline std::uint16_t free_tcp_port() {
-    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    a.sin_port = 0;
-    socklen_t len = sizeof a;
-    if (::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0 ||
-        ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) != 0) {
-        ::close(fd);
-        return 0;
-    }
-    ::close(fd);
-    return ntohs(a.sin_port);
-}
+using fins::test::free_tcp_port;
 
 inline bool tcp_connectable(std::uint16_t port) {
     const int fd = ::socket(AF_INET, SOCK_STREAM, 0);

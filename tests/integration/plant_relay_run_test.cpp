@@ -21,6 +21,7 @@
 #include <gtest/gtest.h>
 
 #include "finsd_run.hpp"
+#include "free_port.hpp"
 #include "raw_socket.hpp"
 #include "web/web_server.hpp"
 
@@ -41,18 +42,6 @@ std::string example_on_free_ports(std::uint16_t http_port) {
         if (!std::regex_match(line, std::regex(R"(\s*port\s*=\s*9600\s*)"))) out << line << '\n';
     out << "\n[http]\nlisten = \"127.0.0.1:" << http_port << "\"\n";
     return out.str();
-}
-
-std::uint16_t free_tcp_port() {
-    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t n = sizeof a;
-    ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
-    ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &n);
-    ::close(fd);
-    return ntohs(a.sin_port);
 }
 
 // A FINS command frame from `source` to `destination` (GCT 02, W342 3-3-3).

@@ -10,25 +10,14 @@
 #include "fins/values.hpp"
 #include "plc/plc.hpp"
 #include "scenario/scenario.hpp"
+#include "scenario_support.hpp"
 
 namespace fins::scenario {
 namespace {
 
-const plc::TimePoint now{std::chrono::seconds(1'700'000'000)};
-
-TagDef tag(std::string address, SignalKind kind, ValueType type = ValueType::int16) {
-    TagDef t;
-    t.address.text = std::move(address);
-    t.kind = kind;
-    t.type = type;
-    return t;
-}
-
-std::unique_ptr<Scenario> compile(ScenarioDef def, plc::Plc& plc) {
-    auto s = Scenario::compile(std::move(def), plc);
-    EXPECT_TRUE(s.has_value()) << (s ? "" : s.error().message);
-    return s ? std::move(*s) : nullptr;
-}
+using test::compile;
+using test::now;
+using test::tag;
 
 // Every kind that draws random numbers or reads other tags, with a value fault.
 ScenarioDef mixed() {

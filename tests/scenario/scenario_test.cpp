@@ -8,29 +8,19 @@
 
 #include "fins/values.hpp"
 #include "plc/plc.hpp"
+#include "scenario_support.hpp"
 
 namespace fins::scenario {
 namespace {
 
-const plc::TimePoint now{std::chrono::seconds(1'700'000'000)};
+using test::compile;
+using test::now;
+using test::tag;
 
-TagDef tag(std::string address, SignalKind kind, ValueType type = ValueType::int16) {
-    TagDef t;
-    t.address.text = std::move(address);
-    t.kind = kind;
-    t.type = type;
-    return t;
-}
 TagDef link(std::string address, std::string expr, ValueType type = ValueType::int16) {
     TagDef t = tag(std::move(address), SignalKind::link, type);
     t.input.text = std::move(expr);
     return t;
-}
-
-std::unique_ptr<Scenario> compile(ScenarioDef def, plc::Plc& plc) {
-    auto s = Scenario::compile(std::move(def), plc);
-    EXPECT_TRUE(s.has_value()) << (s ? "" : s.error().message);
-    return s ? std::move(*s) : nullptr;
 }
 
 std::string compile_error(ScenarioDef def, const char* profile = "cj2h") {

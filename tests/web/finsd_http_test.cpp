@@ -9,6 +9,7 @@
 #include <string>
 
 #include "integration/finsd_run.hpp"
+#include "integration/free_port.hpp"
 #include "web_server.hpp"
 
 namespace fins::test {
@@ -16,22 +17,9 @@ namespace {
 
 using Json = nlohmann::json;
 
-// A port free now (the kernel's choice), for --http ADDRESS:PORT.
-std::uint16_t free_port() {
-    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t n = sizeof a;
-    ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
-    ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &n);
-    ::close(fd);
-    return ntohs(a.sin_port);
-}
-
 TEST(FinsdHttp, FinsAndHttpSeeTheSamePlc) {
     ScratchDir dir("http");
-    const auto port = free_port();
+    const auto port = free_tcp_port();
     Finsd finsd({"--http", "127.0.0.1:" + std::to_string(port), "--http-control", "--control",
                  (dir.path() / "ctl.sock").string()});
     ASSERT_TRUE(finsd.started()) << finsd.result().err;
@@ -60,7 +48,7 @@ TEST(FinsdHttp, FinsAndHttpSeeTheSamePlc) {
 // /api/status lists who talks FINS to this node: the FINS/UDP peers with the node their
 // frames named and when, and the FINS/TCP connections with the node of their handshake.
 TEST(FinsdHttp, StatusNamesTheUdpPeersAndTcpNodes) {
-    const auto port = free_port();
+    const auto port = free_tcp_port();
     Finsd finsd({"--http", "127.0.0.1:" + std::to_string(port)});
     ASSERT_TRUE(finsd.started()) << finsd.result().err;
     ClientOptions udp;
@@ -94,7 +82,7 @@ TEST(FinsdHttp, StatusNamesTheUdpPeersAndTcpNodes) {
 // `finsd ctl scenario status` answers (time, ticks, events), one without carries nothing.
 TEST(FinsdHttp, StatusCarriesTheRunningScenario) {
     ScratchDir dir("http-scenario");
-    const auto port = free_port();
+    const auto port = free_tcp_port();
     const std::string conveyor = std::string(FINS_SOURCE_DIR) + "/examples/scenarios/conveyor.toml";
     Finsd finsd({"--http", "127.0.0.1:" + std::to_string(port), "--http-control", "--scenario",
                  conveyor, "--control", (dir.path() / "ctl.sock").string()});
@@ -113,7 +101,7 @@ TEST(FinsdHttp, StatusCarriesTheRunningScenario) {
     EXPECT_EQ(status["scenario"]["events"][0]["name"], "jam");
     EXPECT_EQ(finsd.stop().exit_code, 0);
 
-    const auto plain_port = free_port();
+    const auto plain_port = free_tcp_port();
     Finsd plain({"--http", "127.0.0.1:" + std::to_string(plain_port)});
     ASSERT_TRUE(plain.started()) << plain.result().err;
     HttpClient plain_http(plain_port);
@@ -123,7 +111,7 @@ TEST(FinsdHttp, StatusCarriesTheRunningScenario) {
 }
 
 TEST(FinsdHttp, ReadOnlyByDefault) {
-    const auto port = free_port();
+    const auto port = free_tcp_port();
     Finsd finsd({"--http", "127.0.0.1:" + std::to_string(port)});
     ASSERT_TRUE(finsd.started()) << finsd.result().err;
     HttpClient http(port);

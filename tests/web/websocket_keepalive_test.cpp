@@ -20,6 +20,7 @@
 #include <boost/beast/websocket.hpp>
 
 #include "integration/finsd_run.hpp"
+#include "integration/free_port.hpp"
 #include "web_server.hpp"
 
 namespace fins::test {
@@ -245,18 +246,6 @@ TEST(WebSocketKeepAlive, AClientThatAnswersNothingIsPingedThenClosedAndForgotten
 }
 
 // --- finsd as users run it: [http] websocket_idle_timeout in the configuration file ---
-
-std::uint16_t free_tcp_port() {
-    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t n = sizeof a;
-    ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
-    ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &n);
-    ::close(fd);
-    return ntohs(a.sin_port);
-}
 
 // The value of `fins_web_connections{kind="websocket"}` in GET /metrics; -1 if absent.
 int websocket_gauge(std::uint16_t port) {
