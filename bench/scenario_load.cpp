@@ -15,11 +15,15 @@
 // median ratio running / paused is printed with the server thread's CPU share, and with
 // one in flight the round trips' p50 and p99 (medians over the rounds).
 //   fins_scenario_load --units 1000 --tags 100 --tick-ms 100 --seconds 1 --rounds 5
+#include <pthread.h>
+#include <sched.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <future>
 #include <memory>
 #include <string>
@@ -47,6 +51,38 @@ namespace {
 double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
     return v[v.size() / 2];
+}
+
+// The Linux thread id of this process's thread named `name` (0: none).
+pid_t thread_named(const std::string& name) {
+    for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
+        std::ifstream comm(task.path() / "comm");
+        std::string line;
+        if (std::getline(comm, line) && line == name)
+            return static_cast<pid_t>(std::stol(task.path().filename().string()));
+    }
+    return 0;
+}
+
+// Seconds a thread of this process has run on a CPU (/proc/self/task/TID/schedstat).
+double run_seconds(pid_t tid) {
+    std::ifstream in("/proc/self/task/" + std::to_string(tid) + "/schedstat");
+    double ns = 0;
+    in >> ns;
+    return ns * 1e-9;
+}
+
+double own_cpu_seconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+}
+
+bool pin(pid_t tid, int cpu) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(cpu, &set);
+    return sched_setaffinity(tid, sizeof set, &set) == 0;
 }
 
 }  // namespace
@@ -79,6 +115,10 @@ int main(int argc, char** argv) {
     bool use_worker = true;
     app.add_flag("!--no-worker", use_worker,
                  "Compute the ticks on the I/O thread (finsd before its scenario thread)");
+    bool pinned = false;
+    app.add_flag("--pin", pinned,
+                 "The I/O thread alone on CPU 0; the generator and the scenario thread on CPU "
+                 "1 (as when the clients run on other hosts and finsd has 2 cores)");
     CLI11_PARSE(app, argc, argv);
     spdlog::set_level(spdlog::level::warn);
 
@@ -118,7 +158,17 @@ int main(int argc, char** argv) {
     // every unit's first tick now, all in one burst per period).
     for (std::size_t u = 0; u < runners.size(); ++u)
         runners[u]->start(static_cast<double>(u % groups) / groups);  // on the shared grid
-    std::thread server_thread([&] { io.run(); });
+    std::promise<pid_t> io_tid;
+    std::thread server_thread([&] {
+        io_tid.set_value(static_cast<pid_t>(::gettid()));
+        io.run();
+    });
+    const pid_t server_tid = io_tid.get_future().get();
+    const pid_t worker_tid = worker ? thread_named(fins::server::ScenarioWorker::thread_name) : 0;
+    if (pinned && (!pin(server_tid, 0) || !pin(0, 1) || (worker_tid != 0 && !pin(worker_tid, 1)))) {
+        std::fprintf(stderr, "fins_scenario_load: cannot pin threads to CPUs 0 and 1\n");
+        return 1;
+    }
 
     // Pauses or resumes every scenario on the I/O thread and waits until it has.
     auto set_running = [&](bool running) {
@@ -131,8 +181,10 @@ int main(int argc, char** argv) {
         done.get_future().wait();
     };
 
-    fmt::print("{} CPU Units x {} tags at {} ms, computed on {}, {} rounds of {} s\n", units, tags,
-               tick_ms, worker ? "finsd's scenario thread" : "the I/O thread", rounds, seconds);
+    fmt::print("{} CPU Units x {} tags at {} ms, computed on {}, {} rounds of {} s{}\n", units, tags,
+               tick_ms, worker ? "finsd's scenario thread" : "the I/O thread", rounds, seconds,
+               pinned ? ", I/O thread pinned to CPU 0, generator and scenario thread to CPU 1"
+                      : "");
     for (const bool tcp : {false, true}) {
         for (const unsigned depth : {1u, 32u}) {
             const auto frames = fins_bench::read_frames(tcp);
@@ -144,13 +196,21 @@ int main(int argc, char** argv) {
             }
             std::vector<double> with, without, ratios, cpu_with, cpu_without;
             std::vector<double> p50_with, p50_without, p99_with, p99_without;
+            std::vector<double> generator_with, generator_without, worker_cpu;
             for (unsigned round = 0; round < rounds; ++round) {
                 double w = 0, wo = 0;
                 for (const bool running : {round % 2 == 0, round % 2 != 0}) {
                     set_running(running);
                     const double before = fins_bench::cpu_seconds(server_thread);
+                    const double own_before = own_cpu_seconds();
+                    const double worker_before = worker_tid != 0 ? run_seconds(worker_tid) : 0;
                     const auto stats = fins_bench::drive(fd, tcp, frames, depth, seconds);
                     const double cpu = (fins_bench::cpu_seconds(server_thread) - before) / seconds;
+                    (running ? generator_with : generator_without)
+                        .push_back((own_cpu_seconds() - own_before) / seconds * 100);
+                    if (running && worker_tid != 0)
+                        worker_cpu.push_back((run_seconds(worker_tid) - worker_before) / seconds *
+                                             100);
                     (running ? w : wo) = stats.rate;
                     (running ? cpu_with : cpu_without).push_back(cpu * 100);
                     (running ? p50_with : p50_without).push_back(stats.p50_us);
@@ -163,9 +223,12 @@ int main(int argc, char** argv) {
             ::close(fd);
             fmt::print(
                 "{} in-flight {:>2}: paused {:>7.0f} req/s ({:.0f} % CPU) | running {:>7.0f} "
-                "req/s ({:.0f} % CPU) | ratio {:.3f}\n",
+                "req/s ({:.0f} % CPU) | ratio {:.3f} | generator {:.0f} / {:.0f} % CPU{}\n",
                 tcp ? "tcp" : "udp", depth, median(without), median(cpu_without), median(with),
-                median(cpu_with), median(ratios));
+                median(cpu_with), median(ratios), median(generator_without),
+                median(generator_with),
+                worker_cpu.empty() ? std::string()
+                                   : fmt::format(", scenario thread {:.1f} %", median(worker_cpu)));
             if (depth == 1)
                 fmt::print(
                     "{} in-flight  1 round trip: paused p50 {:.0f} us p99 {:.0f} us | running "

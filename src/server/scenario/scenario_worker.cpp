@@ -1,6 +1,7 @@
 // The scenario compute thread (contract in scenario_worker.hpp).
 #include "server/scenario/scenario_worker.hpp"
 
+#include <pthread.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <unistd.h>
@@ -93,6 +94,8 @@ void ScenarioWorker::run() {
     // requests go first, and the ticks take the idle time between them; at nice 10 the
     // thread still gets about a tenth of a contended core, more than ticks need.
     setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), worker_nice);
+    // Named, so that `top -H` and `ps -L` tell it from the I/O thread.
+    pthread_setname_np(pthread_self(), thread_name);
     Shared& s = *shared_;
     std::unique_lock lock(s.mutex);
     for (;;) {

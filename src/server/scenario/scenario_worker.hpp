@@ -39,6 +39,8 @@ class ScenarioWorker {
     static constexpr std::size_t hand_back_batch = 64;
     // The thread's nice value (relative priority below the I/O thread's).
     static constexpr int worker_nice = 10;
+    // The thread's name (at most 15 characters, as Linux allows).
+    static constexpr const char* thread_name = "finsd-scenario";
 
     explicit ScenarioWorker(asio::io_context& io);
     ~ScenarioWorker();  // stops and joins the thread; jobs still queued are dropped
