@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <ctime>
+#include <limits>
 
 namespace fins::plc {
 
@@ -51,13 +52,21 @@ unsigned Clock::weekday(CivilSeconds t) noexcept {
 
 CivilSeconds Clock::host_local(TimePoint now) noexcept {
     const auto seconds = std::chrono::floor<std::chrono::seconds>(now).time_since_epoch().count();
+    // The last second converted, per thread: a plant's units read the clock for every
+    // write access record and status within the same second, and localtime_r costs far
+    // more than the arithmetic around it (it reads the time zone only once anyway).
+    thread_local std::int64_t cached_second = std::numeric_limits<std::int64_t>::min();
+    thread_local CivilSeconds cached_local = 0;
+    if (seconds == cached_second) return cached_local;
     const auto t = static_cast<std::time_t>(seconds);
     std::tm tm{};
     if (::localtime_r(&t, &tm) == nullptr) return seconds;
-    return to_civil(tm.tm_year + 1900, static_cast<unsigned>(tm.tm_mon + 1),
-                    static_cast<unsigned>(tm.tm_mday), static_cast<unsigned>(tm.tm_hour),
-                    static_cast<unsigned>(tm.tm_min),
-                    static_cast<unsigned>(std::min(tm.tm_sec, 59)));  // leap second -> :59
+    cached_second = seconds;
+    return cached_local =
+               to_civil(tm.tm_year + 1900, static_cast<unsigned>(tm.tm_mon + 1),
+                        static_cast<unsigned>(tm.tm_mday), static_cast<unsigned>(tm.tm_hour),
+                        static_cast<unsigned>(tm.tm_min),
+                        static_cast<unsigned>(std::min(tm.tm_sec, 59)));  // leap second -> :59
 }
 
 CivilSeconds Clock::civil(TimePoint now) const noexcept {

@@ -59,6 +59,8 @@ class WriteAccessLog {
   private:
     State& state_;
     const Clock* clock_ = nullptr;
+    // Where the last record() wrote (valid while that slot holds state_.sequence).
+    std::size_t newest_ = log_max_records;
 };
 
 }  // namespace fins::plc

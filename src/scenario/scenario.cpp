@@ -297,6 +297,7 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
     for (auto& reference : s.references)
         s.bind_direct(reference);
     s.build_image();
+    s.bind_words();
 
     s.events.resize(def.events.size());
     for (std::size_t i = 0; i < def.events.size(); ++i) {

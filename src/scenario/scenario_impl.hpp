@@ -80,12 +80,19 @@ struct TagState {
     ProgramRef input;
     ProgramRef when;
     std::uint32_t reference = 0;
+    // The tag's one int16 or uint16 word in the image when it has no forced bits to keep
+    // (the common tag: written without a look at its Reference), else no_word.
+    static constexpr std::uint32_t no_word = 0xFFFFFFFF;
+    std::uint32_t word = no_word;
+    bool word_signed = false;
     bool written = false;
     bool previous_input = false;  // counter edges, hysteresis output
     bool has_when = false;        // when.size != 0
     bool has_delay = false;       // !TagCold::delay.empty()
     bool has_faults = false;      // !TagCold::faults.empty()
 };
+
+static_assert(sizeof(TagState) <= 96, "a tick reads TagState for every tag: keep it small");
 
 struct TagCold {
     const TagDef* def = nullptr;  // steps: the schedule
@@ -148,6 +155,9 @@ struct Scenario::Impl final : ExpressionContext {
 
     // ExpressionContext. Impl is final: Expression::run(*this) calls these directly.
     double load(std::uint32_t reference) noexcept override { return read(references[reference]); }
+    // Expression's load_int16/load_uint16 (the programs' loads of image words, rewritten by
+    // bind_loads).
+    [[nodiscard]] std::uint16_t word(std::uint32_t index) const noexcept { return image[index]; }
     double normal() noexcept override { return random.normal(); }
     double uniform() noexcept override { return random.uniform(); }
     double time() const noexcept override { return now_s; }
@@ -158,11 +168,16 @@ struct Scenario::Impl final : ExpressionContext {
     // Lays the directly accessed words of every reference out in runs in the image and
     // points Reference::words there.
     void build_image();
+    // After build_image: the programs' loads of one-word integers read the image directly,
+    // and every tag on one such word writes it directly (TagState::word).
+    void bind_words() noexcept;
     void gather() noexcept;   // memory -> image
     void scatter() noexcept;  // image -> memory, the words the tick changed
     // The value a reference's memory holds now, as a double; `raw`: its words packed
     // (first word in the high bits) or its bit, to notice a client's write.
     double read(const Reference& reference, std::uint64_t* raw = nullptr) const noexcept;
+    // read() of a tag's own reference, through TagState::word when it has one.
+    double read_own(const TagState& tag, std::uint64_t& raw) const noexcept;
     // Writes `value` (rounded and clamped to the type); false when nothing was written.
     bool write(TagState& tag, double value) noexcept;
     double compute(std::uint32_t index, bool& skip) noexcept;

@@ -184,6 +184,26 @@ void Scenario::Impl::build_image() {
     }
 }
 
+void Scenario::Impl::bind_words() noexcept {
+    auto one_word = [](const Reference& r) {
+        return r.words != nullptr && (r.type == ValueType::int16 || r.type == ValueType::uint16);
+    };
+    for (auto& in : code) {
+        if (in.op != Expression::Op::load) continue;
+        const Reference& r = references[in.argument];
+        if (!one_word(r)) continue;
+        in.op =
+            r.type == ValueType::int16 ? Expression::Op::load_int16 : Expression::Op::load_uint16;
+        in.argument = static_cast<std::uint32_t>(r.words - image.data());
+    }
+    for (auto& tag : tags) {
+        const Reference& r = references[tag.reference];
+        if (!one_word(r) || r.forced != nullptr) continue;
+        tag.word = static_cast<std::uint32_t>(r.words - image.data());
+        tag.word_signed = r.type == ValueType::int16;
+    }
+}
+
 void Scenario::Impl::gather() noexcept {
     for (const auto& run : runs) {
         std::copy_n(run.memory, run.size, image.data() + run.offset);
@@ -215,6 +235,14 @@ void Scenario::Impl::scatter() noexcept {
                 run.forced == nullptr ? now[i] : merge_forced(run.memory[i], now[i], run.forced[i]);
         }
     }
+}
+
+double Scenario::Impl::read_own(const TagState& tag, std::uint64_t& raw) const noexcept {
+    if (tag.word == TagState::no_word) return read(references[tag.reference], &raw);
+    const std::uint16_t w = image[tag.word];
+    raw = w;
+    return tag.word_signed ? static_cast<double>(static_cast<std::int16_t>(w))
+                           : static_cast<double>(w);
 }
 
 double Scenario::Impl::read(const Reference& reference, std::uint64_t* raw) const noexcept {
@@ -254,19 +282,18 @@ double Scenario::Impl::read(const Reference& reference, std::uint64_t* raw) cons
 }
 
 bool Scenario::Impl::write(TagState& tag, double value) noexcept {
-    const Reference& reference = references[tag.reference];
     if (!std::isfinite(value)) return false;
     // The common case first: a one-word integer on a word of an area without forcing.
-    if (reference.words != nullptr && reference.forced == nullptr &&
-        (reference.type == ValueType::int16 || reference.type == ValueType::uint16)) {
-        const auto word = reference.type == ValueType::int16
+    if (tag.word != TagState::no_word) {
+        const auto word = tag.word_signed
                               ? static_cast<std::uint16_t>(clamp_round<std::int16_t>(value))
                               : clamp_round<std::uint16_t>(value);
-        *reference.words = word;
+        image[tag.word] = word;
         tag.last_raw = word;
         tag.written = true;
         return true;
     }
+    const Reference& reference = references[tag.reference];
     const bool bit = reference.type == ValueType::boolean;
     const bool on = value != 0.0;
     const unsigned n = value_words(reference.type);

@@ -27,6 +27,9 @@ double fraction(double x) {
 }  // namespace
 
 double Scenario::Impl::run(ProgramRef program) noexcept {
+    // The most common program, one word read (a lag's setpoint, a counter's input).
+    if (program.size == 1 && code[program.at].op == Expression::Op::load_int16)
+        return static_cast<std::int16_t>(image[code[program.at].argument]);
     return Expression::run(code.data() + program.at, program.size, *this);
 }
 
@@ -44,7 +47,7 @@ double Scenario::Impl::compute(std::uint32_t index, bool& skip) noexcept {
     auto adopt = [&] {
         if (!tag.written) return;
         std::uint64_t raw = 0;
-        const double held = read(references[tag.reference], &raw);
+        const double held = read_own(tag, raw);
         if (raw != tag.last_raw && std::isfinite(held)) tag.state = held;
     };
     switch (d.kind) {
