@@ -76,6 +76,9 @@ CivilSeconds Clock::civil(TimePoint now) const noexcept {
 ClockTime Clock::read(TimePoint now) const noexcept {
     using namespace std::chrono;
     const CivilSeconds t = civil(now);
+    // The same second as the last read, with the same weekday shift: the same reading
+    // (a plant's scenarios stamp a write access record every tick).
+    if (t == cached_.civil && state_.weekday_shift == cached_.weekday_shift) return cached_.time;
     const auto days = floor_div(t, seconds_per_day);
     const auto second_of_day = t - days * seconds_per_day;
     const year_month_day date{sys_days{std::chrono::days{days}}};
@@ -88,6 +91,7 @@ ClockTime Clock::read(TimePoint now) const noexcept {
     out.second = static_cast<std::uint8_t>(second_of_day % 60);
     out.day_of_week = static_cast<std::uint8_t>(floor_mod(
         std::int64_t{weekday(t)} + floor_mod(state_.weekday_shift, days_per_week), days_per_week));
+    cached_ = {t, state_.weekday_shift, out};
     return out;
 }
 

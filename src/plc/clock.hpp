@@ -16,6 +16,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 
 #include "fins/commands/clock.hpp"
 #include "fins/error.hpp"
@@ -56,6 +57,14 @@ class Clock {
         std::int64_t weekday_shift = 0;   // 0-6, added to the calendar's day of week
     };
     State& state_;
+    // The last reading and what it was read from (like the rest of a Plc, used from one
+    // thread at a time).
+    struct Cached {
+        CivilSeconds civil = std::numeric_limits<CivilSeconds>::min();
+        std::int64_t weekday_shift = 0;
+        ClockTime time{};
+    };
+    mutable Cached cached_;
 };
 
 }  // namespace fins::plc

@@ -169,7 +169,7 @@ void Scenario::Impl::begin_tick() noexcept {
 void Scenario::Impl::compute_tags() noexcept {
     // A plant's tags do not stay in the cache between ticks: ask for a tag's lines a few
     // tags ahead of computing it.
-    constexpr std::size_t ahead = 4;
+    constexpr std::size_t ahead = 8;
     const std::size_t count = order.size();
     for (std::size_t k = 0; k < count; ++k) {
         if (k + ahead < count) {

@@ -4,7 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "fins/values.hpp"
 #include "plc/plc.hpp"
@@ -55,6 +58,38 @@ TEST(Scenario, SineFollowsTheIssueFormulaAndLinksReadItInTheSameTick) {
     s->advance(5.0, now);  // t = 7.5
     EXPECT_EQ(dm(plc, 100), 0);
     EXPECT_DOUBLE_EQ(s->time(), 7.6);
+}
+
+// Values are rounded half away from zero (std::llround) and clamped to the type.
+TEST(Scenario, ValuesAreRoundedHalfAwayFromZeroAndClampedToTheType) {
+    const std::vector<std::pair<double, std::int32_t>> cases = {
+        {2.5, 3},           {-2.5, -3},   {0.49999999999999994, 0}, {-0.49999999999999994, 0},
+        {1.4999999, 1},     {-1.5, -2},   {32767.4, 32767},         {32767.6, 32767},
+        {-32768.6, -32768}, {1e9, 32767}, {-1e300, -32768},         {0.5, 1}};
+    for (const auto& [value, expected] : cases) {
+        plc::Plc plc;
+        ScenarioDef def;
+        TagDef c = tag("D10", SignalKind::constant);
+        c.value = value;
+        def.tags.push_back(c);
+        TagDef u = tag("D11", SignalKind::constant, ValueType::uint16);
+        u.value = value;
+        def.tags.push_back(u);
+        TagDef d = tag("D12", SignalKind::constant, ValueType::int32);
+        d.value = value;
+        def.tags.push_back(d);
+        auto s = compile(def, plc);
+        ASSERT_TRUE(s);
+        s->tick(now);
+        EXPECT_EQ(static_cast<std::int16_t>(dm(plc, 10)), expected) << value;
+        EXPECT_EQ(dm(plc, 11),
+                  std::clamp<std::int64_t>(std::llround(std::clamp(value, 0.0, 65535.0)), 0, 65535))
+            << value;
+        const auto w = plc.memory().words(Region::dm);
+        // The int32 read back as `fins --as int32` reads it.
+        const auto v32 = words_to_int32(Words(w.data() + 12, 2)).value_or(0);
+        EXPECT_EQ(v32, std::llround(std::clamp(value, -2147483648.0, 2147483647.0))) << value;
+    }
 }
 
 TEST(Scenario, WaveformsAndSteps) {
