@@ -14,20 +14,6 @@ namespace fins::scenario {
 
 namespace {
 
-// `v` clamped to T's range and rounded half away from zero, as std::llround, without its
-// libm call (4 % of a tick): within 32-bit ranges the whole part converts exactly and the
-// rest is exact.
-template <typename T>
-T clamp_round(double v) {
-    static_assert(sizeof(T) <= 4);
-    const double lo = static_cast<double>(std::numeric_limits<T>::min());
-    const double hi = static_cast<double>(std::numeric_limits<T>::max());
-    v = std::clamp(v, lo, hi);
-    const auto whole = static_cast<std::int64_t>(v);  // toward zero
-    const double rest = v - static_cast<double>(whole);
-    return static_cast<T>(whole + (rest >= 0.5 ? 1 : 0) - (rest <= -0.5 ? 1 : 0));
-}
-
 // Keeps the forced bits of `old` and takes the others from `value` (W342 5-3-4).
 std::uint16_t merge_forced(std::uint16_t old, std::uint16_t value, std::uint16_t forced) {
     return static_cast<std::uint16_t>((value & ~forced) | (old & forced));
@@ -288,18 +274,7 @@ double Scenario::Impl::read(const Reference& reference, std::uint64_t* raw) cons
     return decode(reference.type, words);
 }
 
-bool Scenario::Impl::write(TagState& tag, double value) noexcept {
-    if (!std::isfinite(value)) return false;
-    // The common case first: a one-word integer on a word of an area without forcing.
-    if (tag.word != TagState::no_word) {
-        const auto word = tag.word_signed
-                              ? static_cast<std::uint16_t>(clamp_round<std::int16_t>(value))
-                              : clamp_round<std::uint16_t>(value);
-        image[tag.word] = word;
-        tag.last_raw = word;
-        tag.written = true;
-        return true;
-    }
+bool Scenario::Impl::write_reference(TagState& tag, double value) noexcept {
     const Reference& reference = references[tag.reference];
     const bool bit = reference.type == ValueType::boolean;
     const bool on = value != 0.0;
