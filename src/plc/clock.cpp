@@ -107,6 +107,7 @@ EndCode Clock::write(const ClockWrite& s, TimePoint now) noexcept {
     const CivilSeconds target = to_civil(year, s.month, s.day, s.hour, s.minute, second);
     const unsigned day_of_week = s.day_of_week.value_or(kept_day_of_week);
     state_.offset_seconds = target - host_local(now);
+    ++version_;
     state_.weekday_shift =
         floor_mod(std::int64_t{day_of_week} - std::int64_t{weekday(target)}, days_per_week);
     return EndCode::normal_completion;

@@ -39,6 +39,9 @@ class Clock {
     // day of week omitted: the value read at `now` is kept). 110C, with nothing
     // changed, when a field is out of range; 0000 otherwise.
     EndCode write(const ClockWrite& setting, TimePoint now) noexcept;
+    // Changes with every setting of the clock (read() within one host second gives the
+    // same reading while it stays the same).
+    [[nodiscard]] std::uint64_t version() const noexcept { return version_; }
 
     // The CPU Unit's time as calendar seconds (for the CLI and tests).
     [[nodiscard]] CivilSeconds civil(TimePoint now) const noexcept;
@@ -65,6 +68,7 @@ class Clock {
         ClockTime time{};
     };
     mutable Cached cached_;
+    std::uint64_t version_ = 0;
 };
 
 }  // namespace fins::plc

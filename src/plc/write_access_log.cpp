@@ -14,6 +14,13 @@ WriteAccessLog::WriteAccessLog(const Profile&, Storage& storage)
 
 void WriteAccessLog::record(const NodeAddress& source, CommandCode command, EndCode,
                             std::chrono::system_clock::time_point now) noexcept {
+    const std::int64_t second =
+        std::chrono::floor<std::chrono::seconds>(now).time_since_epoch().count();
+    const std::uint64_t clock_version = clock_ != nullptr ? clock_->version() : 0;
+    if (last_.valid && last_.second == second && last_.clock_version == clock_version &&
+        last_.source == source && last_.command == command)
+        return;
+    last_ = {source, command, second, clock_version, true};
     const LogTime time = clock_ != nullptr ? to_log_time(clock_->read(now)) : to_log_time(now);
     const WriteAccessRecord entry{source, 0x00, command, time};
     // The newest record is already this one (the same writer, command and second: a

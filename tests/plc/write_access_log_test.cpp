@@ -95,6 +95,26 @@ TEST(WriteAccessLog, W342_5_3_30_TheNewestWrittenAgainStaysTheNewest) {
     EXPECT_EQ(log.at(19).source.node, 22);
 }
 
+// Setting the clock (W342 5-3-21) within the second of the newest record: the same
+// writer's next write carries the new time.
+TEST(WriteAccessLog, W342_5_3_30_AWriteAfterTheClockIsSetCarriesTheNewTime) {
+    Plc plc;
+    auto& log = plc.write_access_log();
+    write_from(log, 1, t0);
+    const auto before = log.at(0).time;
+    ClockWrite set;
+    set.year = 30;
+    set.month = 1;
+    set.day = 2;
+    set.hour = 3;
+    set.minute = 4;
+    set.second = 5;
+    ASSERT_EQ(plc.clock().write(set, t0), EndCode::normal_completion);
+    write_from(log, 1, t0 + milliseconds{10});
+    EXPECT_NE(log.at(0).time, before);
+    EXPECT_EQ(log.at(0).time, (LogTime{30, 1, 2, 3, 4, 5}));
+}
+
 TEST(WriteAccessLog, W342_5_3_31_ClearEmptiesTheLog) {
     Plc plc;
     auto& log = plc.write_access_log();

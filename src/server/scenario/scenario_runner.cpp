@@ -22,13 +22,14 @@ ScenarioRunner::ScenarioRunner(asio::io_context& io, std::unique_ptr<scenario::S
       scenario_(std::move(scenario)),
       reload_(std::move(reload)),
       source_(std::move(source)),
-      timer_(io),
+      ticker_(asio::use_service<ScenarioTicker>(io)),
       worker_(worker),
       drops_(scenario_->definition().seed ^ 0xD809D809D809D809ULL),
       delay_timer_(io) {}
 
 ScenarioRunner::~ScenarioRunner() {
     settle();
+    ticker_.cancel(*this);
     *alive_ = false;
 }
 
@@ -75,21 +76,21 @@ void ScenarioRunner::start(std::optional<double> phase) {
 void ScenarioRunner::stop() {
     settle();
     running_ = false;
-    timer_.cancel();
+    ticker_.cancel(*this);
     delay_timer_.cancel();
     delayed_.clear();
 }
 
 void ScenarioRunner::schedule() {
-    timer_.expires_at(next_);
-    timer_.async_wait([this, alive = alive_](boost::system::error_code ec) {
-        if (!*alive) return;
-        on_tick(ec);
-    });
+    ticker_.schedule(*this, next_);
 }
 
-void ScenarioRunner::on_tick(boost::system::error_code ec) {
-    if (ec || !running_ || paused_ || scenario_->definition().virtual_time) return;
+void ScenarioRunner::due() noexcept {
+    on_tick();
+}
+
+void ScenarioRunner::on_tick() {
+    if (!running_ || paused_ || scenario_->definition().virtual_time) return;
     if (in_flight_) return;  // its finish() schedules the next
     const auto now = std::chrono::steady_clock::now();
     if (worker_ != nullptr && scenario_->offloadable()) {
@@ -133,7 +134,7 @@ ScenarioRunStatus ScenarioRunner::run_status() const {
 void ScenarioRunner::pause() {
     settle();
     paused_ = true;
-    timer_.cancel();
+    ticker_.cancel(*this);
 }
 
 void ScenarioRunner::resume() {
@@ -162,7 +163,7 @@ tl::expected<void, std::string> ScenarioRunner::reload() {
     auto fresh = reload_();
     if (!fresh) return tl::unexpected(fresh.error());
     settle();
-    timer_.cancel();
+    ticker_.cancel(*this);
     scenario_ = std::move(*fresh);
     ++reloads_;
     spdlog::info("finsd: scenario reloaded from {}", source_);

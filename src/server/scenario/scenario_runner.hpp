@@ -1,6 +1,6 @@
-// A CPU Unit's running scenario on the server's io_context (issue 19): the steady timer
-// that ticks it, the control verbs (ScenarioControl) and the unit faults the network side
-// consults (FaultHook). One per CPU Unit; everything runs on the io_context's one thread.
+// A CPU Unit's running scenario on the server's io_context (issue 19): its ticks on the
+// io_context's ScenarioTicker, the control verbs (ScenarioControl) and the unit faults the network
+// side consults (FaultHook). One per CPU Unit; everything runs on the io_context's one thread.
 //
 // Real time: ticks every tick_s / time_scale wall-clock seconds, drift-free (each expiry
 // is the previous one plus the period, not "now" plus the period). A late timer (a busy
@@ -31,12 +31,16 @@
 #include "scenario/scenario.hpp"
 #include "server/scenario/fault_hook.hpp"
 #include "server/scenario/scenario_control.hpp"
+#include "server/scenario/scenario_ticker.hpp"
 #include "server/scenario/scenario_worker.hpp"
 #include "transport/asio.hpp"
 
 namespace fins::server {
 
-class ScenarioRunner final : public ScenarioControl, public FaultHook, private ScenarioWorker::Job {
+class ScenarioRunner final : public ScenarioControl,
+                             public FaultHook,
+                             private ScenarioWorker::Job,
+                             private ScenarioTicker::Client {
   public:
     using Compiled = tl::expected<std::unique_ptr<scenario::Scenario>, std::string>;
     // Reads and compiles the scenario again (for reload).
@@ -92,15 +96,19 @@ class ScenarioRunner final : public ScenarioControl, public FaultHook, private S
     void compute() noexcept override;
     void finish() noexcept override;
 
+    // ScenarioTicker::Client
+    void due() noexcept override;
+
     void schedule();
-    void on_tick(boost::system::error_code ec);
+    void on_tick();
     void flush_delayed();
 
     asio::io_context& io_;
     std::unique_ptr<scenario::Scenario> scenario_;
     Reloader reload_;
     std::string source_;
-    asio::steady_timer timer_;
+    // The io_context's one timer for scenario ticks (ScenarioTicker, a service).
+    ScenarioTicker& ticker_;
     std::chrono::steady_clock::duration period_{};
     std::chrono::steady_clock::time_point next_{};
     ScenarioWorker* worker_ = nullptr;
