@@ -289,14 +289,14 @@ bool Scenario::Impl::write_reference(TagState& tag, double value) noexcept {
             const std::uint16_t mask = reference.bit_mask;
             if (reference.forced == nullptr || (*reference.forced & mask) == 0)
                 word = static_cast<std::uint16_t>(on ? (word | mask) : (word & ~mask));
-            tag.last_raw = (word & mask) != 0 ? 1 : 0;
+            if (tag.adopts) tag.last_raw = (word & mask) != 0 ? 1 : 0;
         } else {
             for (unsigned i = 0; i < n; ++i)
                 reference.words[i] =
                     reference.forced == nullptr
                         ? words[i]
                         : merge_forced(reference.words[i], words[i], reference.forced[i]);
-            tag.last_raw = pack(reference.words, n);
+            if (tag.adopts) tag.last_raw = pack(reference.words, n);
         }
     } else {
         std::array<std::uint8_t, 8> bytes{};
@@ -311,7 +311,11 @@ bool Scenario::Impl::write_reference(TagState& tag, double value) noexcept {
             size = 2 * n;
         }
         plc->memory().write(reference.range, Bytes(bytes.data(), size));
-        read(reference, &tag.last_raw);
+        if (tag.adopts) {
+            std::uint64_t raw = 0;
+            read(reference, &raw);
+            tag.last_raw = raw;
+        }
     }
     tag.written = true;
     return true;

@@ -35,9 +35,9 @@ double Scenario::Impl::run(ProgramRef program) noexcept {
 
 double Scenario::Impl::compute(std::uint32_t index, bool& skip) noexcept {
     TagState& tag = tags[index];
-    const TagParams& d = tag.p;
+    const TagState& d = tag;
     skip = false;
-    if (tag.has_when && !truth(run(tag.when))) {
+    if (tag.has_when && !truth(run(cold[index].when))) {
         skip = true;
         return 0.0;
     }
@@ -50,24 +50,22 @@ double Scenario::Impl::compute(std::uint32_t index, bool& skip) noexcept {
         const double held = read_own(tag, raw);
         if (raw != tag.last_raw && std::isfinite(held)) tag.state = held;
     };
-    switch (d.kind) {
+    switch (tag.kind) {
         case SignalKind::constant:
             return d.value;
         case SignalKind::sine:
             return d.min + span / 2 +
-                   span / 2 *
-                       std::sin(2 * std::numbers::pi * (t + d.wave.phase_s) / d.wave.period_s);
+                   span / 2 * std::sin(2 * std::numbers::pi * (t + d.phase_s) / d.period_s);
         case SignalKind::square:
-            return fraction((t + d.wave.phase_s) / d.wave.period_s) < d.wave.duty ? d.max : d.min;
+            return fraction((t + d.phase_s) / d.period_s) < d.duty ? d.max : d.min;
         case SignalKind::triangle: {
-            const double f = fraction((t + d.wave.phase_s) / d.wave.period_s);
+            const double f = fraction((t + d.phase_s) / d.period_s);
             return f < 0.5 ? d.min + span * 2 * f : d.max - span * (2 * f - 1);
         }
         case SignalKind::sawtooth:
-            return d.min + span * fraction((t + d.wave.phase_s) / d.wave.period_s);
+            return d.min + span * fraction((t + d.phase_s) / d.period_s);
         case SignalKind::ramp: {
-            const double f =
-                d.repeat ? fraction(t / d.wave.period_s) : std::min(t / d.wave.period_s, 1.0);
+            const double f = d.repeat ? fraction(t / d.period_s) : std::min(t / d.period_s, 1.0);
             return d.min + span * f;
         }
         case SignalKind::random_walk:
@@ -103,16 +101,16 @@ double Scenario::Impl::compute(std::uint32_t index, bool& skip) noexcept {
         case SignalKind::lag: {
             adopt();
             const double setpoint = run(tag.input);
-            const double noise = d.lag.noise > 0 ? d.lag.noise * random.normal() : 0.0;
+            const double noise = d.noise > 0 ? d.noise * random.normal() : 0.0;
             // gain = 1 - exp(-tick_s / tau_s), computed once at compile.
-            if (std::isfinite(setpoint)) tag.state += (setpoint - tag.state) * d.lag.gain;
+            if (std::isfinite(setpoint)) tag.state += (setpoint - tag.state) * d.gain;
             return tag.state + noise;
         }
         case SignalKind::hysteresis: {
             const double input = run(tag.input);
-            if (input >= d.band.on_above)
+            if (input >= d.on_above)
                 tag.previous_input = true;
-            else if (input <= d.band.off_below)
+            else if (input <= d.off_below)
                 tag.previous_input = false;
             return tag.previous_input ? 1.0 : 0.0;
         }
@@ -173,9 +171,7 @@ void Scenario::Impl::compute_tags() noexcept {
     const std::size_t count = order.size();
     for (std::size_t k = 0; k < count; ++k) {
         if (k + ahead < count) {
-            const char* next = reinterpret_cast<const char*>(&tags[order[k + ahead]]);
-            __builtin_prefetch(next);
-            __builtin_prefetch(next + sizeof(TagState) - 1);
+            __builtin_prefetch(&tags[order[k + ahead]]);  // one line (TagState)
         }
         const std::uint32_t index = order[k];
         TagState& tag = tags[index];
