@@ -165,6 +165,8 @@ struct Scenario::Impl final : ExpressionContext {
     Random random;
     TransportFaults transport;
     std::uint64_t tick_count = 0;
+    // The host second of the last write access record (end_tick).
+    std::int64_t recorded_second = std::numeric_limits<std::int64_t>::min();
     double pending = 0;  // advance() seconds not yet ticked
     double now_s = 0;
     plc::TimePoint host_now{};

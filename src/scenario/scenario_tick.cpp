@@ -2,6 +2,7 @@
 // order on the image, the image out (contract in scenario.hpp).
 // Expressions run on Impl itself (a final class), so their loads are direct calls.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <numbers>
@@ -193,10 +194,16 @@ void Scenario::Impl::end_tick() noexcept {
     scatter();
     writes += tick_writes;
     skipped += tick_skipped;
-    // One record per tick from node 0.0.0, the CPU Unit itself (what its program writes).
-    if (tick_writes > 0)
+    // A record from node 0.0.0, the CPU Unit itself (what its program writes), at the
+    // first tick that writes in each second of the host clock: the log's times are whole
+    // seconds, and a plant's units would otherwise each touch their log every tick.
+    const std::int64_t second =
+        std::chrono::floor<std::chrono::seconds>(host_now).time_since_epoch().count();
+    if (tick_writes > 0 && second != recorded_second) {
         plc->write_access_log().record(NodeAddress{0, 0, 0}, CommandCode{0x01, 0x02},
                                        EndCode::normal_completion, host_now);
+        recorded_second = second;
+    }
     ++tick_count;
     // Events whose duration runs out at the new time end now: after advance(5) an event
     // of 0-5 s is over (a unit fault is cleared before the next request is served).

@@ -237,6 +237,34 @@ TEST(Scenario, AForcedBitIsNotChangedAndWritesAreLoggedAsTheCpuUnits) {
 // Word tags are written straight on the area's words (not through IoMemory::write): a
 // forced bit inside a word tag keeps its state, the other bits take the value, and a
 // client's write to a stateful tag is still seen.
+// The scenario's record (node 0.0.0) is written at the first tick that writes in each
+// second of the host clock: a client's write in that second stays after it until the next.
+TEST(Scenario, TheWriteAccessRecordIsWrittenOncePerHostSecond) {
+    plc::Plc plc;
+    ScenarioDef def;
+    def.tags.push_back(tag("D10", SignalKind::sine));
+    def.tags.back().max = 100;
+    auto s = compile(def, plc);
+    auto& log = plc.write_access_log();
+    s->tick(now);
+    ASSERT_EQ(log.size(), 1u);
+    const auto first = log.at(0).time;
+    log.record(NodeAddress{0, 5, 0}, CommandCode{0x01, 0x02}, EndCode::normal_completion, now);
+    s->tick(now + std::chrono::milliseconds(500));  // same second: no record
+    ASSERT_EQ(log.size(), 2u);
+    EXPECT_EQ(log.at(0).time, first);
+    // Fill the log: the least recently written goes first. Node 0's record is older than
+    // node 5's, so it goes before node 5's.
+    for (std::uint8_t n = 6; n < 24; ++n)
+        log.record(NodeAddress{0, n, 0}, CommandCode{0x01, 0x02}, EndCode::normal_completion, now);
+    log.record(NodeAddress{0, 30, 0}, CommandCode{0x01, 0x02}, EndCode::normal_completion, now);
+    EXPECT_EQ(log.at(0).source.node, 5);
+    // The next second: the scenario's record again, with that second's time.
+    s->tick(now + std::chrono::milliseconds(1200));
+    EXPECT_EQ(log.at(19).source.node, 0);
+    EXPECT_NE(log.at(19).time, first);
+}
+
 TEST(Scenario, WordTagsKeepForcedBitsAndSeeClientWrites) {
     plc::Plc plc;
     ScenarioDef def;

@@ -24,6 +24,8 @@ ScenarioRunner::ScenarioRunner(asio::io_context& io, std::unique_ptr<scenario::S
       source_(std::move(source)),
       ticker_(asio::use_service<ScenarioTicker>(io)),
       worker_(worker),
+      virtual_time_(scenario_->definition().virtual_time),
+      offloadable_(scenario_->offloadable()),
       drops_(scenario_->definition().seed ^ 0xD809D809D809D809ULL),
       delay_timer_(io) {}
 
@@ -90,10 +92,10 @@ void ScenarioRunner::due() noexcept {
 }
 
 void ScenarioRunner::on_tick() {
-    if (!running_ || paused_ || scenario_->definition().virtual_time) return;
+    if (!running_ || paused_ || virtual_time_) return;
     if (in_flight_) return;  // its finish() schedules the next
     const auto now = std::chrono::steady_clock::now();
-    if (worker_ != nullptr && scenario_->offloadable()) {
+    if (worker_ != nullptr && offloadable_) {
         // One tick per hand-over; a backlog beyond max_catch_up periods is dropped.
         if (next_ > now) {
             schedule();
@@ -165,6 +167,8 @@ tl::expected<void, std::string> ScenarioRunner::reload() {
     settle();
     ticker_.cancel(*this);
     scenario_ = std::move(*fresh);
+    virtual_time_ = scenario_->definition().virtual_time;
+    offloadable_ = scenario_->offloadable();
     ++reloads_;
     spdlog::info("finsd: scenario reloaded from {}", source_);
     if (running_) {

@@ -112,6 +112,10 @@ class ScenarioRunner final : public ScenarioControl,
     std::chrono::steady_clock::duration period_{};
     std::chrono::steady_clock::time_point next_{};
     ScenarioWorker* worker_ = nullptr;
+    // The scenario's virtual_time and offloadable(), kept here: a plant's on_tick reads
+    // them for every unit every period, and the scenario's own lines are cold then.
+    bool virtual_time_ = false;
+    bool offloadable_ = false;
     bool in_flight_ = false;  // a tick handed to the worker, not yet ended
     bool running_ = false;
     bool paused_ = false;
