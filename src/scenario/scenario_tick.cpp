@@ -220,6 +220,29 @@ void Scenario::tick(plc::TimePoint now) noexcept {
     impl_->end_tick();
 }
 
+std::array<const void*, Scenario::prefetch_count> Scenario::prefetch_addresses() const noexcept {
+    const Impl& s = *impl_;
+    std::array<const void*, prefetch_count> out{};
+    std::size_t n = 0;
+    auto add = [&](const void* p) {
+        if (p != nullptr && n < out.size()) out[n++] = p;
+    };
+    // The scenario's own record where a tick reads it: the vectors' heads, then the tick
+    // fields (two lines); the CPU Unit's words begin_tick copies in; the image; the tags
+    // and their programs.
+    add(&s.tags);
+    add(&s.tick_count);
+    add(reinterpret_cast<const char*>(&s.tick_count) + 64);
+    add(s.runs.data());
+    add(s.image.data());
+    add(s.tags.data());
+    add(s.order.data());
+    add(s.code.data());
+    for (const auto& run : s.runs)
+        add(run.memory);
+    return out;
+}
+
 bool Scenario::offloadable() const noexcept {
     return impl_->offloadable;
 }

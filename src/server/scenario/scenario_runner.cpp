@@ -18,16 +18,27 @@ std::chrono::system_clock::time_point host_now() {
 
 ScenarioRunner::ScenarioRunner(asio::io_context& io, std::unique_ptr<scenario::Scenario> scenario,
                                Reloader reload, std::string source, ScenarioWorker* worker)
-    : io_(io),
-      scenario_(std::move(scenario)),
-      reload_(std::move(reload)),
-      source_(std::move(source)),
+    : scenario_(std::move(scenario)),
       ticker_(asio::use_service<ScenarioTicker>(io)),
       worker_(worker),
-      virtual_time_(scenario_->definition().virtual_time),
-      offloadable_(scenario_->offloadable()),
+      io_(io),
+      reload_(std::move(reload)),
+      source_(std::move(source)),
       drops_(scenario_->definition().seed ^ 0xD809D809D809D809ULL),
-      delay_timer_(io) {}
+      delay_timer_(io) {
+    adopt_scenario();
+}
+
+void ScenarioRunner::adopt_scenario() noexcept {
+    virtual_time_ = scenario_->definition().virtual_time;
+    offloadable_ = scenario_->offloadable();
+    prefetch_ = scenario_->prefetch_addresses();
+}
+
+void ScenarioRunner::prefetch() const noexcept {
+    for (const void* p : prefetch_)
+        if (p != nullptr) __builtin_prefetch(p);
+}
 
 ScenarioRunner::~ScenarioRunner() {
     settle();
@@ -167,8 +178,7 @@ tl::expected<void, std::string> ScenarioRunner::reload() {
     settle();
     ticker_.cancel(*this);
     scenario_ = std::move(*fresh);
-    virtual_time_ = scenario_->definition().virtual_time;
-    offloadable_ = scenario_->offloadable();
+    adopt_scenario();
     ++reloads_;
     spdlog::info("finsd: scenario reloaded from {}", source_);
     if (running_) {

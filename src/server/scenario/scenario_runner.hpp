@@ -16,6 +16,7 @@
 // in flight first, so it sees (and changes) the scenario between ticks.
 #pragma once
 
+#include <array>
 #include <chrono>
 #include <deque>
 #include <functional>
@@ -96,22 +97,26 @@ class ScenarioRunner final : public ScenarioControl,
     void compute() noexcept override;
     void finish() noexcept override;
 
-    // ScenarioTicker::Client
+    // ScenarioTicker::Client (and ScenarioWorker::Job's prefetch)
     void due() noexcept override;
+    void prefetch() const noexcept override;
+    // The scenario's virtual_time, offloadable() and prefetch addresses (at start and
+    // after a reload).
+    void adopt_scenario() noexcept;
 
     void schedule();
     void on_tick();
     void flush_delayed();
 
-    asio::io_context& io_;
+    // What a tick reads of the runner first, on the object's first lines (the ticker
+    // prefetches them a unit ahead): the scenario, the schedule, the flags, and where the
+    // scenario's tick starts reading (Scenario::prefetch_addresses).
     std::unique_ptr<scenario::Scenario> scenario_;
-    Reloader reload_;
-    std::string source_;
     // The io_context's one timer for scenario ticks (ScenarioTicker, a service).
     ScenarioTicker& ticker_;
+    ScenarioWorker* worker_ = nullptr;
     std::chrono::steady_clock::duration period_{};
     std::chrono::steady_clock::time_point next_{};
-    ScenarioWorker* worker_ = nullptr;
     // The scenario's virtual_time and offloadable(), kept here: a plant's on_tick reads
     // them for every unit every period, and the scenario's own lines are cold then.
     bool virtual_time_ = false;
@@ -119,6 +124,10 @@ class ScenarioRunner final : public ScenarioControl,
     bool in_flight_ = false;  // a tick handed to the worker, not yet ended
     bool running_ = false;
     bool paused_ = false;
+    std::array<const void*, scenario::Scenario::prefetch_count> prefetch_{};
+    asio::io_context& io_;
+    Reloader reload_;
+    std::string source_;
     std::uint64_t reloads_ = 0;
     // Draws for the drop fraction: its own generator, so that client traffic never
     // changes the scenario's random numbers (and memory stays deterministic).
