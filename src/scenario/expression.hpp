@@ -113,6 +113,13 @@ class Expression {
         floor,
         ceil,
         round,
+        // A number followed by + - * / or noise, as one instruction with the number in
+        // `number` (made by parse()).
+        add_number,
+        subtract_number,
+        multiply_number,
+        divide_number,
+        noise_number,
         // Never made by parse(): a context that keeps its references' words in one array
         // (the scenario's image) rewrites a `load` of a one-word integer into these, with
         // `argument` the word's index in that array, read by the context's word(index).

@@ -42,6 +42,21 @@ double Expression::run(const Instruction* program, std::size_t size, Context& co
                     stack[top++] = std::nan("");
                 }
                 break;
+            case Op::add_number:
+                stack[top - 1] = stack[top - 1] + in.number;
+                break;
+            case Op::subtract_number:
+                stack[top - 1] = stack[top - 1] - in.number;
+                break;
+            case Op::multiply_number:
+                stack[top - 1] = stack[top - 1] * in.number;
+                break;
+            case Op::divide_number:
+                stack[top - 1] = stack[top - 1] / in.number;
+                break;
+            case Op::noise_number:
+                stack[top++] = in.number * context.normal();
+                break;
             case Op::time:
                 stack[top++] = context.time();
                 break;
