@@ -6,14 +6,17 @@
 // tags computed), src/server/scenario/scenario_worker.hpp. This bench builds the same: a
 // Server for one CJ2H (the unit the generator polls) plus --units CPU Units (that one
 // included) each running the fins_scenario_tick scenario of --tags tags in real time at
-// --tick-ms, each with its own ScenarioRunner and timer, as finsd runs them (their ticks in
-// --groups phase groups spread over the period, finsd's ScenarioRunner::phase_of), and one
-// ScenarioWorker (--no-worker: every tick computed on the I/O thread). The generator
-// (this process's main thread, blocking sockets, as fins_load) keeps 1 or 32 1-word reads
-// of D0 in flight over FINS/UDP and FINS/TCP; each round measures the rate with every
-// scenario paused and with every scenario running (alternating which goes first), and the
-// median ratio running / paused is printed with the server thread's CPU share, and with
-// one in flight the round trips' p50 and p99 (medians over the rounds).
+// --tick-ms, each with its own ScenarioRunner on the io_context's one ScenarioTicker, as
+// finsd runs them (their ticks in --groups phase groups spread over the period, finsd's
+// ScenarioRunner::phase_of), and one ScenarioWorker (--no-worker: every tick computed on
+// the I/O thread). The generator (this process's main thread, blocking sockets, as
+// fins_load) keeps 1 or 32 1-word reads of D0 in flight over FINS/UDP and FINS/TCP; each
+// round measures the rate with every scenario paused and with every scenario running
+// (alternating which goes first), and the median ratio running / paused is printed with
+// the server thread's, the generator's and the scenario thread's CPU shares, and with
+// one in flight the round trips' p50 and p99 (medians over the rounds). --pin puts the
+// I/O thread alone on CPU 0 and the rest on CPU 1; --batched makes the generator take
+// and send whole batches per system call (both to see which side limits the rate).
 //   fins_scenario_load --units 1000 --tags 100 --tick-ms 100 --seconds 1 --rounds 5
 #include <pthread.h>
 #include <sched.h>

@@ -35,7 +35,7 @@ namespace fins::cli::finsd {
 // thread (server/scenario/scenario_worker.hpp), on the I/O thread with the requests, or
 // auto: the scenario thread on a host of at least auto_thread_cores cores.
 enum class ComputeOn { automatic, io_thread, scenario_thread };
-inline constexpr unsigned auto_thread_cores = 4;
+inline constexpr unsigned auto_thread_cores = 2;
 
 struct ScenarioConfig {
     scenario::ScenarioDef def;

@@ -12,8 +12,9 @@ std::unique_ptr<server::ScenarioRunner> run_scenario(
     std::unique_ptr<scenario::Scenario> compiled, plc::Plc& plc, std::optional<double> phase,
     std::unique_ptr<server::ScenarioWorker>& worker) {
     if (!config || !compiled) return nullptr;
-    // On a host of 2 or 3 cores a scenario thread only takes time from the I/O thread and
-    // the clients on the same host (docs/benchmarks.md, fins_scenario_load --no-worker).
+    // On one core a scenario thread only adds switches; from 2 cores on it takes the ticks
+    // off the I/O thread (with clients on the same 2-core host as well: docs/benchmarks.md,
+    // fins_scenario_load with and without --no-worker).
     // Virtual time ticks only when told (ctl advance), on this thread; a reload may turn it
     // to real time, so the choice does not look at `time`.
     const bool own_thread = config->compute == ComputeOn::scenario_thread ||
