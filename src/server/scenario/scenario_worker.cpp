@@ -104,9 +104,10 @@ void ScenarioWorker::run() {
         Job* job = s.queue.front();
         s.queue.pop_front();
         s.computing = job;
-        Job* next = s.queue.empty() ? nullptr : s.queue.front();
+        // Under the lock: a queued job may be settled and destroyed by its owner as soon
+        // as the lock is free.
+        if (!s.queue.empty()) s.queue.front()->prefetch();
         lock.unlock();
-        if (next != nullptr) next->prefetch();
         job->compute();
         lock.lock();
         s.computing = nullptr;
