@@ -25,9 +25,9 @@ class Subs : public ::testing::Test {
         t.plc = &plc_;
         t.addresses = {{0, 1}};
         context_.targets.push_back(t);
-        // Running for a minute when the test starts: its cycle-time statistics have
+        // Powered up a minute before the test starts: its cycle-time statistics have
         // settled, so the status topic changes only when the test changes the PLC.
-        plc_.change_mode(plc::OperatingMode::run, wall0_ - 1min);
+        plc_.power_on(wall0_ - 1min);
     }
     std::vector<Json> send(web::Subscriptions& s, const std::string& text) {
         std::vector<std::string> out;
