@@ -73,6 +73,7 @@ std::span<const HandlerEntry> access_right_handlers() noexcept;    // 0C xx  acc
 std::span<const HandlerEntry> error_log_handlers() noexcept;       // 21 xx  error_log.cpp
 std::span<const HandlerEntry> forced_handlers() noexcept;          // 23 xx  forced.cpp
 std::span<const HandlerEntry> file_memory_handlers() noexcept;     // 22 xx  file_memory.cpp
+                                                                   //  (0A-0C file_transfer.cpp)
 std::span<const HandlerEntry> serial_gateway_handlers() noexcept;  // 28 xx  serial_gateway.cpp
 
 // Host Link FINS conversion (W342 5-1-1, host_link_relay.cpp): sends the whole request
