@@ -34,19 +34,6 @@ EndCode code_of(const std::error_code& e) noexcept {
     return to_end_code(e);
 }
 
-// 2206 RUN / 2205 MONITOR: file -> parameter or program area only in PROGRAM mode.
-EndCode program_mode_only(const plc::Plc& plc) noexcept {
-    switch (plc.mode()) {
-        case plc::OperatingMode::run:
-            return EndCode::wrong_mode_run;
-        case plc::OperatingMode::monitor:
-            return EndCode::wrong_mode_monitor;
-        case plc::OperatingMode::program:
-            break;
-    }
-    return EndCode::normal_completion;
-}
-
 // 5-3-39 table: the word areas a memory area-file transfer may name.
 bool transfer_area(std::uint8_t code) noexcept {
     return (code >= 0xB0 && code <= 0xB3) || code == 0x89 || code == 0x82 ||
@@ -157,7 +144,7 @@ EndCode execute(HandlerContext& context, const ParameterAreaFileTransfer& comman
         return EndCode::normal_completion;
     }
     if (mode == FileTransferMode::from_file) {
-        if (const auto code = program_mode_only(plc); code != EndCode::normal_completion)
+        if (const auto code = program_mode_only(plc.mode()); code != EndCode::normal_completion)
             return code;
         if (plc.dip_write_protection()) return EndCode::read_only;
     }
@@ -206,7 +193,7 @@ EndCode execute(HandlerContext& context, const ProgramAreaFileTransfer& command,
         return EndCode::normal_completion;
     }
     if (mode == FileTransferMode::from_file) {
-        if (const auto code = program_mode_only(plc); code != EndCode::normal_completion)
+        if (const auto code = program_mode_only(plc.mode()); code != EndCode::normal_completion)
             return code;
         if (plc.dip_write_protection()) return EndCode::read_only;
         if (program.prohibit_overwrite()) return EndCode::write_protected;

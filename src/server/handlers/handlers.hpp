@@ -21,7 +21,8 @@
 
 namespace fins::plc {
 class Plc;
-}
+enum class OperatingMode : std::uint8_t;
+}  // namespace fins::plc
 
 namespace fins::server {
 class SerialGatewayPort;
@@ -89,6 +90,11 @@ std::size_t relay_to_host_link(SerialGatewayPort& port, Bytes request, const Hea
 // UM read protection (2002), DIP switch UM write protection (2101).
 EndCode check_execution_conditions(const ExecutionConditions& conditions, const plc::Plc& plc,
                                    const NodeAddress& source, Link link) noexcept;
+
+// An operation only PROGRAM mode allows (file -> parameter or program area, I/O table
+// write and clear, error log clear): its end code in `mode`, the mode that refused it
+// (W342 5-1-3: 2206 RUN, 2205 MONITOR), 0000 in PROGRAM.
+EndCode program_mode_only(plc::OperatingMode mode) noexcept;
 
 // FINS end codes pass through; any other error (not expected from a decoder) is 1004.
 EndCode to_end_code(const std::error_code& error) noexcept;
