@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <ctime>
+#include <limits>
 
 namespace fins::plc {
 
@@ -51,13 +52,21 @@ unsigned Clock::weekday(CivilSeconds t) noexcept {
 
 CivilSeconds Clock::host_local(TimePoint now) noexcept {
     const auto seconds = std::chrono::floor<std::chrono::seconds>(now).time_since_epoch().count();
+    // The last second converted, per thread: a plant's units read the clock for every
+    // write access record and status within the same second, and localtime_r costs far
+    // more than the arithmetic around it (it reads the time zone only once anyway).
+    thread_local std::int64_t cached_second = std::numeric_limits<std::int64_t>::min();
+    thread_local CivilSeconds cached_local = 0;
+    if (seconds == cached_second) return cached_local;
     const auto t = static_cast<std::time_t>(seconds);
     std::tm tm{};
     if (::localtime_r(&t, &tm) == nullptr) return seconds;
-    return to_civil(tm.tm_year + 1900, static_cast<unsigned>(tm.tm_mon + 1),
-                    static_cast<unsigned>(tm.tm_mday), static_cast<unsigned>(tm.tm_hour),
-                    static_cast<unsigned>(tm.tm_min),
-                    static_cast<unsigned>(std::min(tm.tm_sec, 59)));  // leap second -> :59
+    cached_second = seconds;
+    return cached_local =
+               to_civil(tm.tm_year + 1900, static_cast<unsigned>(tm.tm_mon + 1),
+                        static_cast<unsigned>(tm.tm_mday), static_cast<unsigned>(tm.tm_hour),
+                        static_cast<unsigned>(tm.tm_min),
+                        static_cast<unsigned>(std::min(tm.tm_sec, 59)));  // leap second -> :59
 }
 
 CivilSeconds Clock::civil(TimePoint now) const noexcept {
@@ -67,6 +76,9 @@ CivilSeconds Clock::civil(TimePoint now) const noexcept {
 ClockTime Clock::read(TimePoint now) const noexcept {
     using namespace std::chrono;
     const CivilSeconds t = civil(now);
+    // The same second as the last read, with the same weekday shift: the same reading
+    // (a plant's scenarios stamp a write access record every tick).
+    if (t == cached_.civil && state_.weekday_shift == cached_.weekday_shift) return cached_.time;
     const auto days = floor_div(t, seconds_per_day);
     const auto second_of_day = t - days * seconds_per_day;
     const year_month_day date{sys_days{std::chrono::days{days}}};
@@ -79,6 +91,7 @@ ClockTime Clock::read(TimePoint now) const noexcept {
     out.second = static_cast<std::uint8_t>(second_of_day % 60);
     out.day_of_week = static_cast<std::uint8_t>(floor_mod(
         std::int64_t{weekday(t)} + floor_mod(state_.weekday_shift, days_per_week), days_per_week));
+    cached_ = {t, state_.weekday_shift, out};
     return out;
 }
 
@@ -94,6 +107,7 @@ EndCode Clock::write(const ClockWrite& s, TimePoint now) noexcept {
     const CivilSeconds target = to_civil(year, s.month, s.day, s.hour, s.minute, second);
     const unsigned day_of_week = s.day_of_week.value_or(kept_day_of_week);
     state_.offset_seconds = target - host_local(now);
+    ++version_;
     state_.weekday_shift =
         floor_mod(std::int64_t{day_of_week} - std::int64_t{weekday(target)}, days_per_week);
     return EndCode::normal_completion;

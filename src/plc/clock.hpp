@@ -16,6 +16,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 
 #include "fins/commands/clock.hpp"
 #include "fins/error.hpp"
@@ -38,6 +39,9 @@ class Clock {
     // day of week omitted: the value read at `now` is kept). 110C, with nothing
     // changed, when a field is out of range; 0000 otherwise.
     EndCode write(const ClockWrite& setting, TimePoint now) noexcept;
+    // Changes with every setting of the clock (read() within one host second gives the
+    // same reading while it stays the same).
+    [[nodiscard]] std::uint64_t version() const noexcept { return version_; }
 
     // The CPU Unit's time as calendar seconds (for the CLI and tests).
     [[nodiscard]] CivilSeconds civil(TimePoint now) const noexcept;
@@ -56,6 +60,15 @@ class Clock {
         std::int64_t weekday_shift = 0;   // 0-6, added to the calendar's day of week
     };
     State& state_;
+    // The last reading and what it was read from (like the rest of a Plc, used from one
+    // thread at a time).
+    struct Cached {
+        CivilSeconds civil = std::numeric_limits<CivilSeconds>::min();
+        std::int64_t weekday_shift = 0;
+        ClockTime time{};
+    };
+    mutable Cached cached_;
+    std::uint64_t version_ = 0;
 };
 
 }  // namespace fins::plc

@@ -32,7 +32,10 @@ class WriteAccessLog {
     WriteAccessLog(const Profile& profile, Storage& storage);
     // The clock whose reading stamps records (the Plc's own; it must outlive this).
     // Until it is set, records carry the UTC time of `now`.
-    void use_clock(const Clock* clock) noexcept { clock_ = clock; }
+    void use_clock(const Clock* clock) noexcept {
+        clock_ = clock;
+        last_.valid = false;
+    }
     // Called by the dispatcher after every FINS write command (the commands marked
     // "Disabled" under network write protection in W342 5-1-2) with its end code.
     // At most 20 records are scanned or moved: O(1), no allocation.
@@ -44,7 +47,10 @@ class WriteAccessLog {
     [[nodiscard]] const WriteAccessRecord& at(std::size_t index) const noexcept {
         return state_.slots[index < state_.count ? index : 0].record;
     }
-    void clear() noexcept { state_.count = 0; }
+    void clear() noexcept {
+        state_.count = 0;
+        last_.valid = false;
+    }
 
     struct Slot {
         WriteAccessRecord record;
@@ -59,6 +65,20 @@ class WriteAccessLog {
   private:
     State& state_;
     const Clock* clock_ = nullptr;
+    // Where the last record() wrote (valid while that slot holds state_.sequence).
+    std::size_t newest_ = log_max_records;
+    // What the last record() was given, kept here and not in the stored log: the same
+    // writer and command again within its host second, the clock not set since, would
+    // write the newest record again as it is. Skipped without a look at the clock or the
+    // stored records (a plant's scenarios record every tick; those lines are cold).
+    struct Last {
+        NodeAddress source;
+        CommandCode command;
+        std::int64_t second = 0;
+        std::uint64_t clock_version = 0;
+        bool valid = false;
+    };
+    Last last_;
 };
 
 }  // namespace fins::plc

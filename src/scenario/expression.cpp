@@ -103,8 +103,35 @@ class ExpressionParser {
         depth_ = depth_ + 1 - pops;
         if (depth_ > max_expression_stack) return error(pos_, "expression too complex");
         out_.stack_size_ = std::max(out_.stack_size_, depth_);
-        out_.program_.push_back({op, argument, number});
+        auto& program = out_.program_;
+        // A number right before + - * / is their right operand, and before noise its sd:
+        // one instruction instead of two (the same arithmetic and draws, in the same
+        // order; constants are in most expressions: "2 * D100", "D100 / 20", noise(2)).
+        if (!program.empty() && program.back().op == Op::number) {
+            const Op fused = fuse_number(op);
+            if (fused != op) {
+                program.back().op = fused;
+                return true;
+            }
+        }
+        program.push_back({op, argument, number});
         return true;
+    }
+    static Op fuse_number(Op op) {
+        switch (op) {
+            case Op::add:
+                return Op::add_number;
+            case Op::subtract:
+                return Op::subtract_number;
+            case Op::multiply:
+                return Op::multiply_number;
+            case Op::divide:
+                return Op::divide_number;
+            case Op::noise:
+                return Op::noise_number;
+            default:
+                return op;
+        }
     }
     bool error(std::size_t at, std::string message) {
         fail(at, std::move(message));

@@ -113,10 +113,22 @@ class Expression {
         floor,
         ceil,
         round,
+        // A number followed by + - * / or noise, as one instruction with the number in
+        // `number` (made by parse()).
+        add_number,
+        subtract_number,
+        multiply_number,
+        divide_number,
+        noise_number,
+        // Never made by parse(): a context that keeps its references' words in one array
+        // (the scenario's image) rewrites a `load` of a one-word integer into these, with
+        // `argument` the word's index in that array, read by the context's word(index).
+        load_int16,
+        load_uint16,
     };
     struct Instruction {
         Op op = Op::number;
-        std::uint32_t argument = 0;  // load: reference; min/max: operand count
+        std::uint32_t argument = 0;  // load: reference; load_int16/uint16: word; min/max: count
         double number = 0.0;
     };
     // The compiled program (a scenario copies its tags' programs into one array).

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdint>
 
 #include "scenario/expression.hpp"
 
@@ -28,6 +29,33 @@ double Expression::run(const Instruction* program, std::size_t size, Context& co
                 break;
             case Op::load:
                 stack[top++] = context.load(in.argument);
+                break;
+            case Op::load_int16:
+            case Op::load_uint16:
+                // Only a context with word() has programs rewritten so (Scenario::Impl).
+                if constexpr (requires { context.word(std::uint32_t{}); }) {
+                    const std::uint16_t w = context.word(in.argument);
+                    stack[top++] = in.op == Op::load_int16
+                                       ? static_cast<double>(static_cast<std::int16_t>(w))
+                                       : static_cast<double>(w);
+                } else {
+                    stack[top++] = std::nan("");
+                }
+                break;
+            case Op::add_number:
+                stack[top - 1] = stack[top - 1] + in.number;
+                break;
+            case Op::subtract_number:
+                stack[top - 1] = stack[top - 1] - in.number;
+                break;
+            case Op::multiply_number:
+                stack[top - 1] = stack[top - 1] * in.number;
+                break;
+            case Op::divide_number:
+                stack[top - 1] = stack[top - 1] / in.number;
+                break;
+            case Op::noise_number:
+                stack[top++] = in.number * context.normal();
                 break;
             case Op::time:
                 stack[top++] = context.time();

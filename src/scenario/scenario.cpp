@@ -161,11 +161,9 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
                                          value_type_name(def.tags[j].type), def.tags[j].pos.line));
         s.cold[i].def = &t;
         s.tags[i].reference = *r;
-        TagParams& p = s.tags[i].p;
+        TagState& p = s.tags[i];
         p.kind = t.kind;
         p.repeat = t.repeat;
-        p.min = t.min;
-        p.max = t.max;
         switch (t.kind) {
             case SignalKind::constant:
                 p.value = t.value;
@@ -175,19 +173,35 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
             case SignalKind::triangle:
             case SignalKind::sawtooth:
             case SignalKind::ramp:
-                p.wave = {t.period_s, t.phase_s, t.duty};
+                p.min = t.min;
+                p.max = t.max;
+                p.period_s = t.period_s;
+                p.phase_s = t.phase_s;
+                p.duty = t.duty;
                 break;
             case SignalKind::random_walk:
+                p.min = t.min;
+                p.max = t.max;
                 p.step = t.step;
+                p.adopts = true;
                 break;
             case SignalKind::counter:
+                p.min = t.min;
+                p.max = t.max;
                 p.rate = t.rate;
+                p.adopts = true;
+                break;
+            case SignalKind::totaliser:
+                p.adopts = true;
                 break;
             case SignalKind::lag:
-                p.lag = {1 - std::exp(-def.tick_s / t.tau_s), t.noise};
+                p.gain = 1 - std::exp(-def.tick_s / t.tau_s);
+                p.noise = t.noise;
+                p.adopts = true;
                 break;
             case SignalKind::hysteresis:
-                p.band = {t.on_above, t.off_below};
+                p.on_above = t.on_above;
+                p.off_below = t.off_below;
                 break;
             default:
                 break;
@@ -216,8 +230,9 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
                                             samples, max_delay_samples));
         s.cold[i].delay.assign(samples, std::nan(""));
         s.tags[i].has_delay = samples > 0;
-        s.tags[i].state =
-            t.initial.value_or(t.kind == SignalKind::random_walk ? (t.min + t.max) / 2 : 0.0);
+        if (s.tags[i].adopts)
+            s.tags[i].state =
+                t.initial.value_or(t.kind == SignalKind::random_walk ? (t.min + t.max) / 2 : 0.0);
     }
     for (const auto& in : def.inputs) {
         auto address = parse_address(in.address.text);
@@ -290,13 +305,14 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
             where.size = static_cast<std::uint32_t>(e->program().size());
             s.code.insert(s.code.end(), e->program().begin(), e->program().end());
         };
-        place(whens[i], s.tags[i].when);
+        place(whens[i], s.cold[i].when);
         place(inputs[i], s.tags[i].input);
-        s.tags[i].has_when = s.tags[i].when.size != 0;
+        s.tags[i].has_when = s.cold[i].when.size != 0;
     }
     for (auto& reference : s.references)
         s.bind_direct(reference);
     s.build_image();
+    s.bind_words();
 
     s.events.resize(def.events.size());
     for (std::size_t i = 0; i < def.events.size(); ++i) {

@@ -1,8 +1,11 @@
 // Scenario's private state, shared by scenario.cpp (compile) and scenario_tick.cpp.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -12,6 +15,20 @@
 #include "scenario/scenario.hpp"
 
 namespace fins::scenario {
+
+// `v` clamped to T's range and rounded half away from zero, as std::llround, without its
+// libm call (4 % of a tick): within 32-bit ranges the whole part converts exactly and the
+// rest is exact.
+template <typename T>
+inline T clamp_round(double v) {
+    static_assert(sizeof(T) <= 4);
+    const double lo = static_cast<double>(std::numeric_limits<T>::min());
+    const double hi = static_cast<double>(std::numeric_limits<T>::max());
+    v = std::clamp(v, lo, hi);
+    const auto whole = static_cast<std::int64_t>(v);  // toward zero
+    const double rest = v - static_cast<double>(whole);
+    return static_cast<T>(whole + (rest >= 0.5 ? 1 : 0) - (rest <= -0.5 ? 1 : 0));
+}
 
 // A located address and the type its words are read and written as.
 struct Reference {
@@ -41,54 +58,74 @@ struct ImageRun {
     std::uint32_t size = 0;
 };
 
-// What computing a tag reads of its TagDef, copied at compile into its state, so that a
-// tick touches one small record per tag and not the large TagDef (strings, vectors). The
-// kind decides which member of the union holds its parameters.
-struct TagParams {
-    SignalKind kind = SignalKind::constant;
-    bool repeat = false;      // ramp
-    double min = 0, max = 0;  // sine square triangle sawtooth ramp random_walk counter
-    union {
-        double value = 0;  // constant
-        struct {
-            double period_s, phase_s, duty;
-        } wave;       // sine square triangle sawtooth ramp (period_s)
-        double step;  // random_walk
-        double rate;  // counter
-        struct {
-            double gain, noise;  // gain = 1 - exp(-tick_s / tau_s)
-        } lag;
-        struct {
-            double on_above, off_below;
-        } band;  // hysteresis
-    };
-};
-
 // Where an expression's program is in Scenario::Impl::code (size 0: no expression).
 struct ProgramRef {
     std::uint32_t at = 0;
     std::uint32_t size = 0;
 };
 
-// What a tick reads of every tag, 96 bytes: with 1,000 CPU Units of 100 tags the tags do
-// not stay in the cache between ticks, and each line a tag touches costs. The rest of a
-// tag is in TagCold, read only when the flags say so.
-struct TagState {
-    TagParams p;
-    double state = 0;            // stateful kinds
-    std::uint64_t last_raw = 0;  // the words (or bit) the last write left in the image
-    ProgramRef input;
-    ProgramRef when;
+// What a tick reads of every tag, one 64-byte cache line: with 1,000 CPU Units of 100
+// tags the tags do not stay in the cache between ticks, and each line a tag touches costs
+// (a 96-byte record, 1.5 lines a tag, cost a fifth more per tick). What computing a tag
+// reads of its TagDef is copied here at compile, in five slots whose meaning the kind
+// gives; the rest of a tag is in TagCold, read only when the flags say so.
+//   kind                 slot 1     slot 2     slot 3     slot 4     slot 5
+//   constant             value
+//   sine ... ramp        min        max        period_s   phase_s    duty
+//   random_walk          min        max        step       state      last_raw
+//   counter              min        max        rate       state      last_raw
+//   totaliser                                             state      last_raw
+//   lag                  gain       noise                 state      last_raw
+//   hysteresis           on_above   off_below
+// gain = 1 - exp(-tick_s / tau_s). last_raw: the words (or bit) the tag's last write left
+// in the image, for the stateful kinds (`adopts`) to notice a client's write.
+struct alignas(64) TagState {
+    SignalKind kind = SignalKind::constant;
+    bool repeat : 1 = false;          // ramp
+    bool adopts : 1 = false;          // stateful: takes a client's write as its state
+    bool written : 1 = false;         // written at least once (last_raw is set)
+    bool previous_input : 1 = false;  // counter edges, hysteresis output
+    bool has_when : 1 = false;        // TagCold::when.size != 0
+    bool has_delay : 1 = false;       // !TagCold::delay.empty()
+    bool has_faults : 1 = false;      // !TagCold::faults.empty()
+    bool word_signed : 1 = false;
+    // The tag's one int16 or uint16 word in the image when it has no forced bits to keep
+    // (the common tag: written without a look at its Reference), else no_word.
+    static constexpr std::uint32_t no_word = 0xFFFFFFFF;
+    std::uint32_t word = no_word;
     std::uint32_t reference = 0;
-    bool written = false;
-    bool previous_input = false;  // counter edges, hysteresis output
-    bool has_when = false;        // when.size != 0
-    bool has_delay = false;       // !TagCold::delay.empty()
-    bool has_faults = false;      // !TagCold::faults.empty()
+    ProgramRef input;  // counter totaliser lag hysteresis link
+    union {
+        double min = 0;
+        double value;
+        double gain;
+        double on_above;
+    };
+    union {
+        double max = 0;
+        double noise;
+        double off_below;
+    };
+    union {
+        double period_s = 0;
+        double step;
+        double rate;
+    };
+    union {
+        double state = 0;
+        double phase_s;
+    };
+    union {
+        std::uint64_t last_raw = 0;
+        double duty;
+    };
 };
+
+static_assert(sizeof(TagState) == 64, "a tick reads TagState for every tag: one cache line");
 
 struct TagCold {
     const TagDef* def = nullptr;  // steps: the schedule
+    ProgramRef when;              // the enable condition (TagState::has_when)
     std::vector<double> delay;    // ring of delay_s / tick_s samples
     std::size_t delay_next = 0;
     std::vector<std::uint32_t> faults;  // events that may fault this tag
@@ -128,6 +165,8 @@ struct Scenario::Impl final : ExpressionContext {
     Random random;
     TransportFaults transport;
     std::uint64_t tick_count = 0;
+    // The host second of the last write access record (end_tick).
+    std::int64_t recorded_second = std::numeric_limits<std::int64_t>::min();
     double pending = 0;  // advance() seconds not yet ticked
     double now_s = 0;
     plc::TimePoint host_now{};
@@ -148,6 +187,9 @@ struct Scenario::Impl final : ExpressionContext {
 
     // ExpressionContext. Impl is final: Expression::run(*this) calls these directly.
     double load(std::uint32_t reference) noexcept override { return read(references[reference]); }
+    // Expression's load_int16/load_uint16 (the programs' loads of image words, rewritten by
+    // bind_loads).
+    [[nodiscard]] std::uint16_t word(std::uint32_t index) const noexcept { return image[index]; }
     double normal() noexcept override { return random.normal(); }
     double uniform() noexcept override { return random.uniform(); }
     double time() const noexcept override { return now_s; }
@@ -158,13 +200,31 @@ struct Scenario::Impl final : ExpressionContext {
     // Lays the directly accessed words of every reference out in runs in the image and
     // points Reference::words there.
     void build_image();
+    // After build_image: the programs' loads of one-word integers read the image directly,
+    // and every tag on one such word writes it directly (TagState::word).
+    void bind_words() noexcept;
     void gather() noexcept;   // memory -> image
     void scatter() noexcept;  // image -> memory, the words the tick changed
     // The value a reference's memory holds now, as a double; `raw`: its words packed
     // (first word in the high bits) or its bit, to notice a client's write.
     double read(const Reference& reference, std::uint64_t* raw = nullptr) const noexcept;
+    // read() of a tag's own reference, through TagState::word when it has one.
+    double read_own(const TagState& tag, std::uint64_t& raw) const noexcept;
     // Writes `value` (rounded and clamped to the type); false when nothing was written.
-    bool write(TagState& tag, double value) noexcept;
+    bool write(TagState& tag, double value) noexcept {
+        if (!std::isfinite(value)) return false;
+        // The common case here, inline: a one-word integer on a word without forcing.
+        if (tag.word == TagState::no_word) return write_reference(tag, value);
+        const auto word = tag.word_signed
+                              ? static_cast<std::uint16_t>(clamp_round<std::int16_t>(value))
+                              : clamp_round<std::uint16_t>(value);
+        image[tag.word] = word;
+        if (tag.adopts) tag.last_raw = word;
+        tag.written = true;
+        return true;
+    }
+    // write() of every other tag: through its Reference (forced bits, other types).
+    bool write_reference(TagState& tag, double value) noexcept;
     double compute(std::uint32_t index, bool& skip) noexcept;
     // Runs a tag's program (defined in scenario_tick.cpp, with the evaluator).
     double run(ProgramRef program) noexcept;

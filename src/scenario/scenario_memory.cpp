@@ -14,13 +14,6 @@ namespace fins::scenario {
 
 namespace {
 
-template <typename T>
-T clamp_round(double v) {
-    const double lo = static_cast<double>(std::numeric_limits<T>::min());
-    const double hi = static_cast<double>(std::numeric_limits<T>::max());
-    return static_cast<T>(std::llround(std::clamp(v, lo, hi)));
-}
-
 // Keeps the forced bits of `old` and takes the others from `value` (W342 5-3-4).
 std::uint16_t merge_forced(std::uint16_t old, std::uint16_t value, std::uint16_t forced) {
     return static_cast<std::uint16_t>((value & ~forced) | (old & forced));
@@ -184,6 +177,26 @@ void Scenario::Impl::build_image() {
     }
 }
 
+void Scenario::Impl::bind_words() noexcept {
+    auto one_word = [](const Reference& r) {
+        return r.words != nullptr && (r.type == ValueType::int16 || r.type == ValueType::uint16);
+    };
+    for (auto& in : code) {
+        if (in.op != Expression::Op::load) continue;
+        const Reference& r = references[in.argument];
+        if (!one_word(r)) continue;
+        in.op =
+            r.type == ValueType::int16 ? Expression::Op::load_int16 : Expression::Op::load_uint16;
+        in.argument = static_cast<std::uint32_t>(r.words - image.data());
+    }
+    for (auto& tag : tags) {
+        const Reference& r = references[tag.reference];
+        if (!one_word(r) || r.forced != nullptr) continue;
+        tag.word = static_cast<std::uint32_t>(r.words - image.data());
+        tag.word_signed = r.type == ValueType::int16;
+    }
+}
+
 void Scenario::Impl::gather() noexcept {
     for (const auto& run : runs) {
         std::copy_n(run.memory, run.size, image.data() + run.offset);
@@ -215,6 +228,14 @@ void Scenario::Impl::scatter() noexcept {
                 run.forced == nullptr ? now[i] : merge_forced(run.memory[i], now[i], run.forced[i]);
         }
     }
+}
+
+double Scenario::Impl::read_own(const TagState& tag, std::uint64_t& raw) const noexcept {
+    if (tag.word == TagState::no_word) return read(references[tag.reference], &raw);
+    const std::uint16_t w = image[tag.word];
+    raw = w;
+    return tag.word_signed ? static_cast<double>(static_cast<std::int16_t>(w))
+                           : static_cast<double>(w);
 }
 
 double Scenario::Impl::read(const Reference& reference, std::uint64_t* raw) const noexcept {
@@ -253,20 +274,8 @@ double Scenario::Impl::read(const Reference& reference, std::uint64_t* raw) cons
     return decode(reference.type, words);
 }
 
-bool Scenario::Impl::write(TagState& tag, double value) noexcept {
+bool Scenario::Impl::write_reference(TagState& tag, double value) noexcept {
     const Reference& reference = references[tag.reference];
-    if (!std::isfinite(value)) return false;
-    // The common case first: a one-word integer on a word of an area without forcing.
-    if (reference.words != nullptr && reference.forced == nullptr &&
-        (reference.type == ValueType::int16 || reference.type == ValueType::uint16)) {
-        const auto word = reference.type == ValueType::int16
-                              ? static_cast<std::uint16_t>(clamp_round<std::int16_t>(value))
-                              : clamp_round<std::uint16_t>(value);
-        *reference.words = word;
-        tag.last_raw = word;
-        tag.written = true;
-        return true;
-    }
     const bool bit = reference.type == ValueType::boolean;
     const bool on = value != 0.0;
     const unsigned n = value_words(reference.type);
@@ -280,14 +289,14 @@ bool Scenario::Impl::write(TagState& tag, double value) noexcept {
             const std::uint16_t mask = reference.bit_mask;
             if (reference.forced == nullptr || (*reference.forced & mask) == 0)
                 word = static_cast<std::uint16_t>(on ? (word | mask) : (word & ~mask));
-            tag.last_raw = (word & mask) != 0 ? 1 : 0;
+            if (tag.adopts) tag.last_raw = (word & mask) != 0 ? 1 : 0;
         } else {
             for (unsigned i = 0; i < n; ++i)
                 reference.words[i] =
                     reference.forced == nullptr
                         ? words[i]
                         : merge_forced(reference.words[i], words[i], reference.forced[i]);
-            tag.last_raw = pack(reference.words, n);
+            if (tag.adopts) tag.last_raw = pack(reference.words, n);
         }
     } else {
         std::array<std::uint8_t, 8> bytes{};
@@ -302,7 +311,11 @@ bool Scenario::Impl::write(TagState& tag, double value) noexcept {
             size = 2 * n;
         }
         plc->memory().write(reference.range, Bytes(bytes.data(), size));
-        read(reference, &tag.last_raw);
+        if (tag.adopts) {
+            std::uint64_t raw = 0;
+            read(reference, &raw);
+            tag.last_raw = raw;
+        }
     }
     tag.written = true;
     return true;

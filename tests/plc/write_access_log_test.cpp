@@ -66,6 +66,55 @@ TEST(WriteAccessLog, W342_5_3_30_FullLogDiscardsTheLeastRecentlyWritten) {
     EXPECT_EQ(log.at(19).source.node, 79);
 }
 
+// The newest record written again (same node, command and second, as a scenario writes
+// every tick) is kept as it is, and it still counts as the newest when the log is full.
+TEST(WriteAccessLog, W342_5_3_30_TheNewestWrittenAgainStaysTheNewest) {
+    Plc plc;
+    auto& log = plc.write_access_log();
+    write_from(log, 1, t0);
+    write_from(log, 2, t0);
+    write_from(log, 1, t0);  // not the newest: its record is new now
+    write_from(log, 1, t0);  // the newest again, nothing changes
+    write_from(log, 1, t0 + milliseconds{300});
+    ASSERT_EQ(log.size(), 2u);
+    for (std::uint8_t n = 3; n <= 20; ++n)
+        write_from(log, n, t0);
+    write_from(log, 20, t0);  // the newest, again
+    write_from(log, 21, t0);  // discards node 2, the least recently written
+    EXPECT_EQ(log.at(0).source.node, 1);
+    EXPECT_EQ(log.at(1).source.node, 3);
+    EXPECT_EQ(log.at(18).source.node, 20);
+    EXPECT_EQ(log.at(19).source.node, 21);
+    // The same node at another second or with another command is recorded.
+    write_from(log, 21, t0 + seconds{2});
+    EXPECT_EQ(log.at(19).time.second, 2);
+    write_from(log, 21, t0 + seconds{2}, CommandCode{0x01, 0x03});
+    EXPECT_EQ(log.at(19).command, (CommandCode{0x01, 0x03}));
+    write_from(log, 22, t0);  // node 1 is the oldest now
+    EXPECT_EQ(log.at(0).source.node, 3);
+    EXPECT_EQ(log.at(19).source.node, 22);
+}
+
+// Setting the clock (W342 5-3-21) within the second of the newest record: the same
+// writer's next write carries the new time.
+TEST(WriteAccessLog, W342_5_3_30_AWriteAfterTheClockIsSetCarriesTheNewTime) {
+    Plc plc;
+    auto& log = plc.write_access_log();
+    write_from(log, 1, t0);
+    const auto before = log.at(0).time;
+    ClockWrite set;
+    set.year = 30;
+    set.month = 1;
+    set.day = 2;
+    set.hour = 3;
+    set.minute = 4;
+    set.second = 5;
+    ASSERT_EQ(plc.clock().write(set, t0), EndCode::normal_completion);
+    write_from(log, 1, t0 + milliseconds{10});
+    EXPECT_NE(log.at(0).time, before);
+    EXPECT_EQ(log.at(0).time, (LogTime{30, 1, 2, 3, 4, 5}));
+}
+
 TEST(WriteAccessLog, W342_5_3_31_ClearEmptiesTheLog) {
     Plc plc;
     auto& log = plc.write_access_log();

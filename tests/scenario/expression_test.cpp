@@ -55,6 +55,25 @@ TEST(ScenarioExpression, ArithmeticFollowsPrecedence) {
     EXPECT_DOUBLE_EQ(eval("0x1F + 1e1 + .5"), 41.5);
 }
 
+// A number right before + - * / or noise is one instruction with it (the same results,
+// left to right, and the same random draws).
+TEST(ScenarioExpression, ANumberAndTheOperatorAfterItAreOneInstruction) {
+    ExpressionError e;
+    auto x = Expression::parse("D100 / 20 + 400 - noise(2) * 3", resolve, e);
+    ASSERT_TRUE(x.has_value());
+    // load, divide_number, add_number, noise_number, multiply_number, subtract
+    EXPECT_EQ(x->program().size(), 6u);
+    Context c;
+    c.values[100] = 3000;
+    EXPECT_DOUBLE_EQ(x->evaluate(c), 3000.0 / 20 + 400 - 2.0 * 2 * 3);
+    EXPECT_DOUBLE_EQ(eval("1 - 2 - 3"), -4);
+    EXPECT_DOUBLE_EQ(eval("64 / 4 / 2"), 8);
+    EXPECT_DOUBLE_EQ(eval("2 - (3 - 4)"), 3);
+    EXPECT_DOUBLE_EQ(eval("2 * -3"), -6);  // negate in between: not fused
+    EXPECT_DOUBLE_EQ(eval("10 - 2 ^ 2"), 6);
+    EXPECT_TRUE(std::isinf(eval("1 / 0")));
+}
+
 TEST(ScenarioExpression, ComparisonsAndLogicGiveOneOrZero) {
     EXPECT_EQ(eval("1 < 2 && 3 >= 3"), 1);
     EXPECT_EQ(eval("1 == 2 || 2 != 2"), 0);

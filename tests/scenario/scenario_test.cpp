@@ -4,7 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <numbers>
+#include <utility>
+#include <vector>
 
 #include "fins/values.hpp"
 #include "plc/plc.hpp"
@@ -55,6 +59,64 @@ TEST(Scenario, SineFollowsTheIssueFormulaAndLinksReadItInTheSameTick) {
     s->advance(5.0, now);  // t = 7.5
     EXPECT_EQ(dm(plc, 100), 0);
     EXPECT_DOUBLE_EQ(s->time(), 7.6);
+}
+
+// Values are rounded half away from zero (std::llround) and clamped to the type.
+TEST(Scenario, ValuesAreRoundedHalfAwayFromZeroAndClampedToTheType) {
+    const std::vector<std::pair<double, std::int32_t>> cases = {
+        {2.5, 3},           {-2.5, -3},   {0.49999999999999994, 0}, {-0.49999999999999994, 0},
+        {1.4999999, 1},     {-1.5, -2},   {32767.4, 32767},         {32767.6, 32767},
+        {-32768.6, -32768}, {1e9, 32767}, {-1e300, -32768},         {0.5, 1}};
+    for (const auto& [value, expected] : cases) {
+        plc::Plc plc;
+        ScenarioDef def;
+        TagDef c = tag("D10", SignalKind::constant);
+        c.value = value;
+        def.tags.push_back(c);
+        TagDef u = tag("D11", SignalKind::constant, ValueType::uint16);
+        u.value = value;
+        def.tags.push_back(u);
+        TagDef d = tag("D12", SignalKind::constant, ValueType::int32);
+        d.value = value;
+        def.tags.push_back(d);
+        auto s = compile(def, plc);
+        ASSERT_TRUE(s);
+        s->tick(now);
+        EXPECT_EQ(static_cast<std::int16_t>(dm(plc, 10)), expected) << value;
+        EXPECT_EQ(dm(plc, 11),
+                  std::clamp<std::int64_t>(std::llround(std::clamp(value, 0.0, 65535.0)), 0, 65535))
+            << value;
+        const auto w = plc.memory().words(Region::dm);
+        // The int32 read back as `fins --as int32` reads it.
+        const auto v32 = words_to_int32(Words(w.data() + 12, 2)).value_or(0);
+        EXPECT_EQ(v32, std::llround(std::clamp(value, -2147483648.0, 2147483647.0))) << value;
+    }
+}
+
+// The sine is its own polynomial on the phase as a fraction of the period: the issue's
+// formula within 1e-9 over a long run, and quarter periods exact.
+TEST(Scenario, SineMatchesTheFormulaOverALongRun) {
+    plc::Plc plc;
+    ScenarioDef def;
+    TagDef sine = tag("D200", SignalKind::sine, ValueType::float64);
+    sine.min = -3.5;
+    sine.max = 1234.25;
+    sine.period_s = 7.3;
+    sine.phase_s = 0.45;
+    def.tags.push_back(sine);
+    auto s = compile(def, plc);
+    ASSERT_TRUE(s);
+    const auto w = plc.memory().words(Region::dm);
+    for (int i = 0; i < 3000; ++i) {
+        s->tick(now);
+        const double t = 0.1 * i;
+        const double expected =
+            (sine.min + sine.max) / 2 +
+            (sine.max - sine.min) / 2 *
+                std::sin(2 * std::numbers::pi * (t + sine.phase_s) / sine.period_s);
+        EXPECT_NEAR(words_to_double(Words(w.data() + 200, 4)).value_or(1e300), expected, 1e-9)
+            << "t = " << t;
+    }
 }
 
 TEST(Scenario, WaveformsAndSteps) {
@@ -202,6 +264,34 @@ TEST(Scenario, AForcedBitIsNotChangedAndWritesAreLoggedAsTheCpuUnits) {
 // Word tags are written straight on the area's words (not through IoMemory::write): a
 // forced bit inside a word tag keeps its state, the other bits take the value, and a
 // client's write to a stateful tag is still seen.
+// The scenario's record (node 0.0.0) is written at the first tick that writes in each
+// second of the host clock: a client's write in that second stays after it until the next.
+TEST(Scenario, TheWriteAccessRecordIsWrittenOncePerHostSecond) {
+    plc::Plc plc;
+    ScenarioDef def;
+    def.tags.push_back(tag("D10", SignalKind::sine));
+    def.tags.back().max = 100;
+    auto s = compile(def, plc);
+    auto& log = plc.write_access_log();
+    s->tick(now);
+    ASSERT_EQ(log.size(), 1u);
+    const auto first = log.at(0).time;
+    log.record(NodeAddress{0, 5, 0}, CommandCode{0x01, 0x02}, EndCode::normal_completion, now);
+    s->tick(now + std::chrono::milliseconds(500));  // same second: no record
+    ASSERT_EQ(log.size(), 2u);
+    EXPECT_EQ(log.at(0).time, first);
+    // Fill the log: the least recently written goes first. Node 0's record is older than
+    // node 5's, so it goes before node 5's.
+    for (std::uint8_t n = 6; n < 24; ++n)
+        log.record(NodeAddress{0, n, 0}, CommandCode{0x01, 0x02}, EndCode::normal_completion, now);
+    log.record(NodeAddress{0, 30, 0}, CommandCode{0x01, 0x02}, EndCode::normal_completion, now);
+    EXPECT_EQ(log.at(0).source.node, 5);
+    // The next second: the scenario's record again, with that second's time.
+    s->tick(now + std::chrono::milliseconds(1200));
+    EXPECT_EQ(log.at(19).source.node, 0);
+    EXPECT_NE(log.at(19).time, first);
+}
+
 TEST(Scenario, WordTagsKeepForcedBitsAndSeeClientWrites) {
     plc::Plc plc;
     ScenarioDef def;

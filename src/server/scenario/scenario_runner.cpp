@@ -18,17 +18,31 @@ std::chrono::system_clock::time_point host_now() {
 
 ScenarioRunner::ScenarioRunner(asio::io_context& io, std::unique_ptr<scenario::Scenario> scenario,
                                Reloader reload, std::string source, ScenarioWorker* worker)
-    : io_(io),
-      scenario_(std::move(scenario)),
+    : scenario_(std::move(scenario)),
+      ticker_(asio::use_service<ScenarioTicker>(io)),
+      worker_(worker),
+      io_(io),
       reload_(std::move(reload)),
       source_(std::move(source)),
-      timer_(io),
-      worker_(worker),
       drops_(scenario_->definition().seed ^ 0xD809D809D809D809ULL),
-      delay_timer_(io) {}
+      delay_timer_(io) {
+    adopt_scenario();
+}
+
+void ScenarioRunner::adopt_scenario() noexcept {
+    virtual_time_ = scenario_->definition().virtual_time;
+    offloadable_ = scenario_->offloadable();
+    prefetch_ = scenario_->prefetch_addresses();
+}
+
+void ScenarioRunner::prefetch() const noexcept {
+    for (const void* p : prefetch_)
+        if (p != nullptr) __builtin_prefetch(p);
+}
 
 ScenarioRunner::~ScenarioRunner() {
     settle();
+    ticker_.cancel(*this);
     *alive_ = false;
 }
 
@@ -75,24 +89,24 @@ void ScenarioRunner::start(std::optional<double> phase) {
 void ScenarioRunner::stop() {
     settle();
     running_ = false;
-    timer_.cancel();
+    ticker_.cancel(*this);
     delay_timer_.cancel();
     delayed_.clear();
 }
 
 void ScenarioRunner::schedule() {
-    timer_.expires_at(next_);
-    timer_.async_wait([this, alive = alive_](boost::system::error_code ec) {
-        if (!*alive) return;
-        on_tick(ec);
-    });
+    ticker_.schedule(*this, next_);
 }
 
-void ScenarioRunner::on_tick(boost::system::error_code ec) {
-    if (ec || !running_ || paused_ || scenario_->definition().virtual_time) return;
+void ScenarioRunner::due() noexcept {
+    on_tick();
+}
+
+void ScenarioRunner::on_tick() {
+    if (!running_ || paused_ || virtual_time_) return;
     if (in_flight_) return;  // its finish() schedules the next
     const auto now = std::chrono::steady_clock::now();
-    if (worker_ != nullptr && scenario_->offloadable()) {
+    if (worker_ != nullptr && offloadable_) {
         // One tick per hand-over; a backlog beyond max_catch_up periods is dropped.
         if (next_ > now) {
             schedule();
@@ -133,7 +147,7 @@ ScenarioRunStatus ScenarioRunner::run_status() const {
 void ScenarioRunner::pause() {
     settle();
     paused_ = true;
-    timer_.cancel();
+    ticker_.cancel(*this);
 }
 
 void ScenarioRunner::resume() {
@@ -162,8 +176,9 @@ tl::expected<void, std::string> ScenarioRunner::reload() {
     auto fresh = reload_();
     if (!fresh) return tl::unexpected(fresh.error());
     settle();
-    timer_.cancel();
+    ticker_.cancel(*this);
     scenario_ = std::move(*fresh);
+    adopt_scenario();
     ++reloads_;
     spdlog::info("finsd: scenario reloaded from {}", source_);
     if (running_) {

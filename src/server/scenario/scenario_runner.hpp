@@ -1,6 +1,6 @@
-// A CPU Unit's running scenario on the server's io_context (issue 19): the steady timer
-// that ticks it, the control verbs (ScenarioControl) and the unit faults the network side
-// consults (FaultHook). One per CPU Unit; everything runs on the io_context's one thread.
+// A CPU Unit's running scenario on the server's io_context (issue 19): its ticks on the
+// io_context's ScenarioTicker, the control verbs (ScenarioControl) and the unit faults the network
+// side consults (FaultHook). One per CPU Unit; everything runs on the io_context's one thread.
 //
 // Real time: ticks every tick_s / time_scale wall-clock seconds, drift-free (each expiry
 // is the previous one plus the period, not "now" plus the period). A late timer (a busy
@@ -16,6 +16,7 @@
 // in flight first, so it sees (and changes) the scenario between ticks.
 #pragma once
 
+#include <array>
 #include <chrono>
 #include <deque>
 #include <functional>
@@ -31,12 +32,16 @@
 #include "scenario/scenario.hpp"
 #include "server/scenario/fault_hook.hpp"
 #include "server/scenario/scenario_control.hpp"
+#include "server/scenario/scenario_ticker.hpp"
 #include "server/scenario/scenario_worker.hpp"
 #include "transport/asio.hpp"
 
 namespace fins::server {
 
-class ScenarioRunner final : public ScenarioControl, public FaultHook, private ScenarioWorker::Job {
+class ScenarioRunner final : public ScenarioControl,
+                             public FaultHook,
+                             private ScenarioWorker::Job,
+                             private ScenarioTicker::Client {
   public:
     using Compiled = tl::expected<std::unique_ptr<scenario::Scenario>, std::string>;
     // Reads and compiles the scenario again (for reload).
@@ -92,21 +97,37 @@ class ScenarioRunner final : public ScenarioControl, public FaultHook, private S
     void compute() noexcept override;
     void finish() noexcept override;
 
+    // ScenarioTicker::Client (and ScenarioWorker::Job's prefetch)
+    void due() noexcept override;
+    void prefetch() const noexcept override;
+    // The scenario's virtual_time, offloadable() and prefetch addresses (at start and
+    // after a reload).
+    void adopt_scenario() noexcept;
+
     void schedule();
-    void on_tick(boost::system::error_code ec);
+    void on_tick();
     void flush_delayed();
 
-    asio::io_context& io_;
+    // What a tick reads of the runner first, on the object's first lines (the ticker
+    // prefetches them a unit ahead): the scenario, the schedule, the flags, and where the
+    // scenario's tick starts reading (Scenario::prefetch_addresses).
     std::unique_ptr<scenario::Scenario> scenario_;
-    Reloader reload_;
-    std::string source_;
-    asio::steady_timer timer_;
+    // The io_context's one timer for scenario ticks (ScenarioTicker, a service).
+    ScenarioTicker& ticker_;
+    ScenarioWorker* worker_ = nullptr;
     std::chrono::steady_clock::duration period_{};
     std::chrono::steady_clock::time_point next_{};
-    ScenarioWorker* worker_ = nullptr;
+    // The scenario's virtual_time and offloadable(), kept here: a plant's on_tick reads
+    // them for every unit every period, and the scenario's own lines are cold then.
+    bool virtual_time_ = false;
+    bool offloadable_ = false;
     bool in_flight_ = false;  // a tick handed to the worker, not yet ended
     bool running_ = false;
     bool paused_ = false;
+    std::array<const void*, scenario::Scenario::prefetch_count> prefetch_{};
+    asio::io_context& io_;
+    Reloader reload_;
+    std::string source_;
     std::uint64_t reloads_ = 0;
     // Draws for the drop fraction: its own generator, so that client traffic never
     // changes the scenario's random numbers (and memory stays deterministic).

@@ -104,7 +104,9 @@ void ScenarioWorker::run() {
         Job* job = s.queue.front();
         s.queue.pop_front();
         s.computing = job;
+        Job* next = s.queue.empty() ? nullptr : s.queue.front();
         lock.unlock();
+        if (next != nullptr) next->prefetch();
         job->compute();
         lock.lock();
         s.computing = nullptr;

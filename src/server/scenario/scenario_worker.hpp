@@ -32,6 +32,10 @@ class ScenarioWorker {
     struct Job {
         virtual void compute() noexcept = 0;  // on the worker thread
         virtual void finish() noexcept = 0;   // on the io_context's thread, after compute
+        // Asks for the lines compute() reads first (a hint, on the worker thread, for the
+        // next queued job while one computes).
+        virtual void prefetch() const noexcept {}
+
       protected:
         virtual ~Job() = default;
     };
