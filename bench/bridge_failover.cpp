@@ -22,7 +22,7 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-std::uint16_t finsd_port(const tb::Proc& p) {
+std::uint16_t finsd_port(const tb::Child& p) {
     const std::regex listening("listening ([0-9]+)");
     for (int i = 0; i < 200; ++i) {
         std::smatch m;
@@ -67,7 +67,7 @@ int main(int argc, char** argv) {
         const auto rdir = dir / fmt::format("round{}", round + 1);
         std::filesystem::create_directories(rdir);
         tb::Mosquitto broker(rdir);
-        tb::Proc finsd({tb::finsd_exe, "--port", "0", "--log-level", "warn"}, rdir / "finsd.log");
+        tb::Child finsd({tb::finsd_exe, "--port", "0", "--log-level", "warn"}, rdir / "finsd.log");
         const auto port = finsd_port(finsd);
         if (!broker.started() || port == 0) {
             std::fprintf(stderr, "mosquitto or finsd did not start\n");
@@ -88,10 +88,10 @@ int main(int argc, char** argv) {
         std::ofstream(conf_path) << conf;
         tb::Recorder rec(broker.port(), {"fo/+/g"});
         std::vector<std::string> names;
-        std::vector<std::unique_ptr<tb::Proc>> bridges;
+        std::vector<std::unique_ptr<tb::Child>> bridges;
         for (int i = 0; i < instances; ++i) {
             names.push_back(fmt::format("i{}", i));
-            bridges.push_back(std::make_unique<tb::Proc>(
+            bridges.push_back(std::make_unique<tb::Child>(
                 std::vector<std::string>{tb::bridge_path, "--config", conf_path.string(),
                                          "--instance", names.back()},
                 rdir / (names.back() + ".log")));

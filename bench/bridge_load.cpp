@@ -40,8 +40,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using nlohmann::json;
 
-using fins::test::bridge::free_tcp_port;
-
 std::string unit_ip(std::size_t i) {
     return fmt::format("127.0.{}.{}", 40 + i / 250, 1 + i % 250);
 }
@@ -147,21 +145,22 @@ int main(int argc, char** argv) {
             "  bind = \"{}\"\n  port = {}\n",
             i, 1 + i / 250, unit_ip(i), plc_port);
     std::ofstream(dir / "plant.toml") << plant;
+    // Children log to files: a pipe nobody reads would block them once full.
     fins::test::Child finsd(
-        {bin + "/finsd", "--config", (dir / "plant.toml").string(), "--log-level", "warn"});
-    const auto listening = finsd.read_line(std::chrono::seconds(30));
-    if (listening.rfind("listening", 0) != 0) {
+        {bin + "/finsd", "--config", (dir / "plant.toml").string(), "--log-level", "warn"},
+        dir / "finsd.log");
+    if (!finsd.wait_for_stderr("listening", std::chrono::seconds(30))) {
         fmt::print(stderr, "finsd did not start: {}\n", finsd.wait(std::chrono::seconds(5)).err);
         return 1;
     }
 
-    const std::uint16_t mqtt_port = free_tcp_port();
-    std::ofstream(dir / "mosquitto.conf") << fmt::format(
-        "log_dest none\npersistence false\nmax_queued_messages 100000\nlistener {} 127.0.0.1\n"
-        "allow_anonymous true\n",
-        mqtt_port);
-    fins::test::Child broker({"/usr/sbin/mosquitto", "-c", (dir / "mosquitto.conf").string()});
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    // The tests' broker (bridge_processes.hpp), with room for the whole run's messages.
+    fins::test::bridge::Mosquitto broker(dir, "max_queued_messages 100000\n");
+    if (!broker.started()) {
+        fmt::print(stderr, "mosquitto did not start (log in {})\n", dir.string());
+        return 1;
+    }
+    const std::uint16_t mqtt_port = broker.port();
 
     Model model;
     mosquitto_lib_init();
@@ -222,7 +221,8 @@ int main(int argc, char** argv) {
                         i, unit_ip(i), plc_port, 1 + i % 250, group);
     std::ofstream(dir / "bridge.toml") << config;
     fins::test::Child bridge({bin + "/fins-bridge", "--config", (dir / "bridge.toml").string(),
-                              "--instance", "load", "--log-level", "warn"});
+                              "--instance", "load", "--log-level", "warn"},
+                             dir / "bridge.log");
 
     // The writer: one UDP socket, MEMORY AREA WRITE of one word, waits for the answer.
     const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
@@ -353,10 +353,10 @@ int main(int argc, char** argv) {
     fmt::print("bridge RSS            {:.1f} MiB (peak {:.1f} MiB)\n",
                static_cast<double>(rss) / 1024.0, static_cast<double>(hwm) / 1024.0);
     mosquitto_loop_stop(sub, true);
+    mosquitto_destroy(sub);
+    mosquitto_lib_cleanup();
     bridge.terminate(SIGTERM);
     bridge.wait(std::chrono::seconds(10));
-    broker.terminate(SIGTERM);
-    broker.wait(std::chrono::seconds(10));
     finsd.terminate(SIGTERM);
     finsd.wait(std::chrono::seconds(20));
     std::filesystem::remove_all(dir);

@@ -8,10 +8,7 @@
 // in an interval), its RSS grew more than --max-rss-growth-mib over the first
 // interval's, or it did not shut down cleanly (exit 0) on SIGTERM at the end.
 // Timing and rates are reported, never judged: that belongs to fins_load.
-#include <fcntl.h>
-#include <poll.h>
 #include <signal.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -27,6 +24,7 @@
 #include <fmt/core.h>
 #include <CLI/CLI.hpp>
 
+#include "integration/process.hpp"
 #include "soak_clients.hpp"
 
 namespace {
@@ -51,51 +49,19 @@ struct Options {
     std::string keep_log;            // finsd's log kept at this path (else a removed temp file)
 };
 
-// finsd as a child: stdout on a pipe (for "listening <port>"), stderr in a file that is
-// shown when the run fails. After the port, a thread copies stdout into that file too:
-// finsd logs to stdout, and a full pipe would block its one I/O thread.
+// finsd as a child (tests/integration/process.hpp's Child): stdout and stderr in a log file
+// that is shown when the run fails (a file, not a pipe: finsd logs to stdout, and a full
+// pipe would block its one I/O thread).
 class Finsd {
   public:
-    Finsd(const Options& o, unsigned max_connections) {
-        char path[] = "/tmp/fins_soak_finsd.XXXXXX";
-        keep_ = !o.keep_log.empty();
-        log_fd_ = keep_ ? ::open(o.keep_log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644)
-                        : ::mkstemp(path);
-        log_path_ = keep_ ? o.keep_log : std::string(path);
-        int out[2];
-        if (log_fd_ < 0 || ::pipe(out) != 0) return;
-        const std::vector<std::string> argv{o.finsd,
-                                            "--bind",
-                                            "127.0.0.1",
-                                            "--port",
-                                            "0",
-                                            "--log-level",
-                                            o.log_level,
-                                            "--max-connections",
-                                            std::to_string(max_connections)};
-        pid_ = ::fork();
-        if (pid_ == 0) {
-            ::dup2(out[1], 1);
-            ::dup2(log_fd_, 2);
-            ::close(out[0]);
-            std::vector<char*> args;
-            for (const auto& a : argv)
-                args.push_back(const_cast<char*>(a.c_str()));
-            args.push_back(nullptr);
-            ::execv(args[0], args.data());
-            ::_exit(127);
-        }
-        ::close(out[1]);
-        out_fd_ = out[0];
-    }
+    Finsd(const Options& o, unsigned max_connections)
+        : keep_(!o.keep_log.empty()),
+          log_path_(keep_ ? o.keep_log : temp_path()),
+          child_({o.finsd, "--bind", "127.0.0.1", "--port", "0", "--log-level", o.log_level,
+                  "--max-connections", std::to_string(max_connections)},
+                 log_path_) {}
     ~Finsd() {
-        if (running()) {
-            ::kill(pid_, SIGKILL);
-            ::waitpid(pid_, nullptr, 0);
-        }
-        if (drain_.joinable()) drain_.join();
-        if (out_fd_ >= 0) ::close(out_fd_);
-        if (log_fd_ >= 0) ::close(log_fd_);
+        child_.kill(SIGKILL);
         if (!keep_) ::unlink(log_path_.c_str());
     }
     Finsd(const Finsd&) = delete;
@@ -103,49 +69,33 @@ class Finsd {
 
     // The port from the "listening <port>" line; 0 when it does not come within 30 s.
     std::uint16_t wait_listening() {
-        std::string line;
         const auto deadline = Clock::now() + std::chrono::seconds(30);
         while (Clock::now() < deadline) {
-            pollfd p{out_fd_, POLLIN, 0};
-            if (::poll(&p, 1, 100) <= 0) continue;
-            char c = 0;
-            if (::read(out_fd_, &c, 1) != 1) return 0;
-            if (c == '\n') break;
-            line += c;
+            const auto left =
+                std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+            const std::string line = child_.read_line(left);
+            unsigned port = 0;
+            if (std::sscanf(line.c_str(), "listening %u", &port) == 1 && port <= 65535)
+                return static_cast<std::uint16_t>(port);
+            if (!child_.running()) return 0;
         }
-        unsigned port = 0;
-        if (std::sscanf(line.c_str(), "listening %u", &port) != 1 || port > 65535) return 0;
-        drain_ = std::thread([this] {
-            char buf[4096];
-            for (ssize_t n; (n = ::read(out_fd_, buf, sizeof buf)) > 0;)
-                if (::write(log_fd_, buf, static_cast<std::size_t>(n)) != n) break;
-        });
-        return static_cast<std::uint16_t>(port);
+        return 0;
     }
-    [[nodiscard]] pid_t pid() const { return pid_; }
-    [[nodiscard]] bool running() {
-        if (pid_ <= 0 || exited_) return false;
-        if (::waitpid(pid_, &status_, WNOHANG) == pid_) exited_ = true;
-        return !exited_;
-    }
+    [[nodiscard]] pid_t pid() const { return child_.pid(); }
+    [[nodiscard]] bool running() { return child_.running(); }
     [[nodiscard]] std::string how_it_ended() const {
-        if (WIFSIGNALED(status_)) return fmt::format("killed by signal {}", WTERMSIG(status_));
-        return fmt::format("exit status {}", WEXITSTATUS(status_));
+        const int code = child_.exit_code();
+        if (code > 128) return fmt::format("killed by signal {}", code - 128);
+        return fmt::format("exit status {}", code);
     }
-    [[nodiscard]] bool clean_exit() const {
-        return exited_ && WIFEXITED(status_) && WEXITSTATUS(status_) == 0;
-    }
-    // SIGTERM, then up to 20 s for a clean exit.
+    [[nodiscard]] bool clean_exit() const { return child_.exit_code() == 0; }
+    // SIGTERM, then up to 20 s for a clean exit (SIGKILL after).
     void terminate() {
-        if (!running()) return;
-        ::kill(pid_, SIGTERM);
-        const auto deadline = Clock::now() + std::chrono::seconds(20);
-        while (running() && Clock::now() < deadline)
-            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        if (running()) child_.kill(SIGTERM, std::chrono::seconds(20));
     }
     // Resident set size in KiB, 0 when unknown.
     [[nodiscard]] std::uint64_t rss_kib() const {
-        std::ifstream in(fmt::format("/proc/{}/status", pid_));
+        std::ifstream in(fmt::format("/proc/{}/status", pid()));
         std::string key;
         while (in >> key) {
             if (key == "VmRSS:") {
@@ -169,14 +119,16 @@ class Finsd {
     }
 
   private:
-    pid_t pid_ = -1;
-    int out_fd_ = -1;
-    int log_fd_ = -1;
+    static std::string temp_path() {
+        char path[] = "/tmp/fins_soak_finsd.XXXXXX";
+        const int fd = ::mkstemp(path);
+        if (fd >= 0) ::close(fd);
+        return path;
+    }
+
+    bool keep_;
     std::string log_path_;
-    int status_ = 0;
-    bool exited_ = false;
-    bool keep_ = false;
-    std::thread drain_;  // ends at EOF, when finsd exits
+    fins::test::Child child_;
 };
 
 double mib(std::uint64_t kib) {

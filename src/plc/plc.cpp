@@ -44,6 +44,14 @@ bool Plc::network_write_protected_from(const NodeAddress& source) const noexcept
     return true;
 }
 
+void Plc::power_on(std::chrono::system_clock::time_point now) noexcept {
+    if (scan_cycle_.powered()) return;
+    if (mode_ == OperatingMode::program)
+        scan_cycle_.stop(now);
+    else
+        scan_cycle_.start(now);
+}
+
 void Plc::change_mode(OperatingMode mode, std::chrono::system_clock::time_point now) noexcept {
     if (mode == OperatingMode::program) {
         scan_cycle_.stop(now);

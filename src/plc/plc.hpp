@@ -81,6 +81,12 @@ class Plc {
     FileMemory& files() noexcept { return files_; }
     [[nodiscard]] const FileMemory& files() const noexcept { return files_; }
 
+    // Power-on at `now` in the current mode (RUN unless set_mode() said otherwise): the
+    // scan cycle runs from here whether anyone asks or not (scan_cycle.hpp). The server
+    // calls it when it starts serving; the dispatcher before every request, for a Plc no
+    // server started (tests). Nothing once powered.
+    void power_on(std::chrono::system_clock::time_point now) noexcept;
+
     [[nodiscard]] OperatingMode mode() const noexcept { return mode_; }
     // Sets the mode without touching the scan cycle (tests and power-on only).
     void set_mode(OperatingMode mode) noexcept { mode_ = mode; }

@@ -81,12 +81,12 @@ bool ScanCycle::condition_flag(ConditionFlag flag) noexcept {
     return flag == ConditionFlag::always_on;
 }
 
-void ScanCycle::advance(TimePoint now) noexcept {
-    if (state_.powered == 0) {
-        start(now);  // power-on in RUN mode (plc.hpp)
-        return;
-    }
-    state_.latest = to_ticks(now);
+void ScanCycle::power_on(TimePoint now) noexcept {
+    if (state_.powered == 0) start(now);  // power-on in RUN mode (plc.hpp)
+}
+
+bool ScanCycle::powered() const noexcept {
+    return state_.powered != 0;
 }
 
 void ScanCycle::start(TimePoint now) noexcept {
@@ -103,6 +103,8 @@ void ScanCycle::stop(TimePoint now) noexcept {
     const Ticks tick = to_ticks(now);
     state_.latest = tick;
     if (state_.stopped != 0) return;
+    // Powered up in PROGRAM mode: no program cycle has run.
+    if (state_.powered == 0) state_.first = state_.stats_first = cycle_at(base_, tick) + 1;
     state_.powered = 1;
     state_.stopped = 1;
     state_.stopped_at = tick;
@@ -117,20 +119,21 @@ void ScanCycle::initialize(TimePoint now) noexcept {
     state_.stats_first = std::max(state_.first, cycle_at(base_, state_.latest));
 }
 
-std::uint64_t ScanCycle::end_cycle() const noexcept {
-    const Ticks until =
-        state_.stopped != 0 ? std::min(state_.latest, state_.stopped_at) : state_.latest;
+std::uint64_t ScanCycle::end_cycle(Ticks now) const noexcept {
+    const Ticks until = state_.stopped != 0 ? std::min(now, state_.stopped_at) : now;
     return cycle_at(base_, until);
 }
 
-std::uint64_t ScanCycle::cycles() const noexcept {
-    const auto end = end_cycle();
+std::uint64_t ScanCycle::cycles(TimePoint now) const noexcept {
+    if (state_.powered == 0) return 0;
+    const auto end = end_cycle(to_ticks(now));
     return end > state_.first ? end - state_.first : 0;
 }
 
-CycleTimes ScanCycle::times() const noexcept {
+CycleTimes ScanCycle::times(TimePoint now) const noexcept {
     CycleTimes t;
-    const auto end = end_cycle();
+    if (state_.powered == 0) return t;
+    const auto end = end_cycle(to_ticks(now));
     if (end <= state_.first) return t;
     const auto m = std::min<std::uint64_t>(end - state_.first, history);
     const Ticks span = cycle_start(base_, end) - cycle_start(base_, end - m);

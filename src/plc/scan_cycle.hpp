@@ -18,7 +18,10 @@
 // Program execution. Only RUN and MONITOR execute the program; the statistics count
 // those cycles only. Operation starts (start(), PROGRAM -> RUN/MONITOR) at the next
 // cycle boundary, which also initializes the maximum and minimum (5-3-18 "Comments").
-// The Plc powers up in RUN: the first advance() starts operation. 06 20 is refused in
+// The CPU Unit powers up (power_on()) when its server starts, and cycles from then on
+// whether anyone asks or not: every read (times(), cycles()) is a pure function of the
+// time point it is given and of the last power-on, start, stop or initialize, so 06 20,
+// the page's status and anything else read the same running unit. 06 20 is refused in
 // PROGRAM mode by the 5-1-2 table before it gets here.
 #pragma once
 
@@ -43,10 +46,10 @@ class ScanCycle {
 
     ScanCycle(const Profile& profile, Storage& storage);
 
-    // Brings the simulated cycle up to `now`; the dispatcher calls it before every
-    // request. O(1), never allocates. A time point earlier than the previous one (host
-    // clock set back) is taken as is: cycles before the start are simply not counted.
-    void advance(TimePoint now) noexcept;
+    // Power-on in RUN mode at `now` (operation starts, as start()); nothing once powered
+    // (the power stays on until the process ends: the state is cleared at every start).
+    void power_on(TimePoint now) noexcept;
+    [[nodiscard]] bool powered() const noexcept;
     // Operation starts (mode leaves PROGRAM): the program runs from the next cycle
     // boundary; the statistics restart. Idempotent while running.
     void start(TimePoint now) noexcept;
@@ -56,11 +59,13 @@ class ScanCycle {
     // 06 20 00: the maximum and minimum restart with the cycle in progress.
     void initialize(TimePoint now) noexcept;
 
-    // 06 20 01 as of the last advance(): average of the last (up to) 8 completed program
-    // cycles; maximum and minimum since initialize()/start(); 0 where nothing completed.
-    [[nodiscard]] CycleTimes times() const noexcept;
-    // Program cycles completed since operation started, as of the last advance().
-    [[nodiscard]] std::uint64_t cycles() const noexcept;
+    // 06 20 01 at `now`: average of the last (up to) 8 program cycles completed by then;
+    // maximum and minimum since initialize()/start(); 0 where nothing completed (also
+    // before power-on, and at a time point before the start: host clock set back). O(1),
+    // never allocates.
+    [[nodiscard]] CycleTimes times(TimePoint now) const noexcept;
+    // Program cycles completed at `now` since operation started.
+    [[nodiscard]] std::uint64_t cycles(TimePoint now) const noexcept;
 
     // ---- the timeline (pure functions of the profile and the time point) ----
     [[nodiscard]] static Ticks base_cycle(const Profile& profile) noexcept;
@@ -80,15 +85,15 @@ class ScanCycle {
   private:
     // Cleared at power-on (Retention::cleared): statistics do not survive a restart.
     struct State {
-        Ticks latest = 0;               // last advance()
+        Ticks latest = 0;               // the last start(), stop() or initialize()
         Ticks stopped_at = 0;           // when stop() ran
         std::uint64_t first = 0;        // first program cycle of this operation
         std::uint64_t stats_first = 0;  // first cycle of maximum/minimum
-        std::uint8_t powered = 0;       // advance() or start() has run
+        std::uint8_t powered = 0;       // power_on(), start() or stop() has run
         std::uint8_t stopped = 0;       // PROGRAM mode
     };
-    // The cycle after the last completed program cycle.
-    [[nodiscard]] std::uint64_t end_cycle() const noexcept;
+    // The cycle after the last program cycle completed at `now`.
+    [[nodiscard]] std::uint64_t end_cycle(Ticks now) const noexcept;
 
     Ticks base_;
     State& state_;

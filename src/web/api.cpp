@@ -289,7 +289,8 @@ Json events_object(const server::ControlTarget& target) {
     return Json{{"access_log", records}};
 }
 
-Json status_object(const WebContext& context, const server::ControlTarget& target) {
+Json status_object(const WebContext& context, const server::ControlTarget& target,
+                   std::chrono::system_clock::time_point now) {
     Json answer = server::handle_control_request(*target.plc, Json{{"cmd", "status"}});
     Json status = std::move(answer["status"]);
     if (!target.name.empty()) status["plc"] = target.name;
@@ -307,7 +308,7 @@ Json status_object(const WebContext& context, const server::ControlTarget& targe
     status["access_log"] = events_object(target)["access_log"];
     status["connections"] = Json::array();
     status["udp_peers"] = Json::array();
-    add_cpu_facts(*target.plc, status, std::chrono::system_clock::now());
+    add_cpu_facts(*target.plc, status, now);
     if (context.network_status) context.network_status(target, status);
     // The page's Scenario panel: what `finsd ctl scenario status` answers.
     if (target.scenario != nullptr)
@@ -342,7 +343,7 @@ void handle_request(WebContext& context, std::string_view method, std::string_vi
         HttpAnswer error;
         const auto* t = target_of(context, plc_param(*q), error);
         if (t == nullptr) return done(error);
-        return done(json_answer(200, status_object(context, *t)));
+        return done(json_answer(200, status_object(context, *t, std::chrono::system_clock::now())));
     }
     if (path == "/api/plcs") {
         if (!get) return only("GET");

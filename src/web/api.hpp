@@ -54,8 +54,11 @@ std::optional<HttpAnswer> check_request(const WebOptions& options, const Request
 void handle_request(WebContext& context, std::string_view method, std::string_view target,
                     std::string_view body, const std::function<void(HttpAnswer)>& done);
 
-// GET /api/status's object for `target` (also the WebSocket "status" topic).
-nlohmann::json status_object(const WebContext& context, const server::ControlTarget& target);
+// GET /api/status's object for `target` (also the WebSocket "status" topic) at the wall
+// time `now`: what changes with time (the clock offset, the cycle times) is as of `now`,
+// so a caller that passes its time gets the same object for the same PLC state.
+nlohmann::json status_object(const WebContext& context, const server::ControlTarget& target,
+                             std::chrono::system_clock::time_point now);
 // The "errors" and "events" topics: active errors and the error log; the write access log.
 nlohmann::json errors_object(const server::ControlTarget& target);
 nlohmann::json events_object(const server::ControlTarget& target);

@@ -41,9 +41,7 @@ Json memory_areas(const plc::Profile& profile) {
 void add_cpu_facts(plc::Plc& plc, Json& status, std::chrono::system_clock::time_point now) {
     const auto utc = std::chrono::duration_cast<std::chrono::seconds>(now.time_since_epoch());
     status["clock_offset_s"] = plc.clock().civil(now) - utc.count();
-    auto& cycle = plc.scan_cycle();
-    cycle.advance(now);
-    const auto times = cycle.times();
+    const auto times = plc.scan_cycle().times(now);
     status["cycle_time"] = {{"base_ms", tenths_to_ms(plc::ScanCycle::base_cycle(plc.profile()))},
                             {"max_ms", tenths_to_ms(times.maximum)},
                             {"min_ms", tenths_to_ms(times.minimum)}};

@@ -25,8 +25,8 @@ nlohmann::json memory_areas(const plc::Profile& profile);
 
 // Adds "clock_offset_s" (the CPU Unit clock minus UTC, seconds: the page shows
 // now + offset as a UTC time) and "cycle_time": {"base_ms", "max_ms", "min_ms"} (0 until
-// a cycle completed) to `status`. Brings the simulated scan cycle up to `now` first, as
-// the dispatcher does before a request.
+// a cycle completed) to `status`, as of `now`: what 06 20 answers at that time. Reads
+// only: the scan cycle runs from the CPU Unit's power-on whether anyone asks or not.
 void add_cpu_facts(plc::Plc& plc, nlohmann::json& status,
                    std::chrono::system_clock::time_point now);
 

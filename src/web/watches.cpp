@@ -29,7 +29,7 @@ void Watch::refresh(const WebContext& context, SteadyTime now,
     if (topic_.empty())
         refresh_values(wall);
     else
-        refresh_topic(context);
+        refresh_topic(context, wall);
 }
 
 void Watch::set_error(std::string message) {
@@ -122,8 +122,8 @@ bool Watch::print_tokens() {
     return true;
 }
 
-void Watch::refresh_topic(const WebContext& context) {
-    const nlohmann::json value = topic_ == "status"   ? status_object(context, *target_)
+void Watch::refresh_topic(const WebContext& context, std::chrono::system_clock::time_point wall) {
+    const nlohmann::json value = topic_ == "status"   ? status_object(context, *target_, wall)
                                  : topic_ == "errors" ? errors_object(*target_)
                                                       : events_object(*target_);
     next_text_.clear();

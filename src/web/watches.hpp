@@ -66,7 +66,7 @@ class Watch {
 
   private:
     void refresh_values(std::chrono::system_clock::time_point wall);
-    void refresh_topic(const WebContext& context);
+    void refresh_topic(const WebContext& context, std::chrono::system_clock::time_point wall);
     bool print_tokens();  // raw_ -> next_text_/next_ends_; false with error_ set
     void set_error(std::string message);
 

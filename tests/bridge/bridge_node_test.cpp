@@ -29,7 +29,7 @@ struct NodeRig {
     ScratchDir dir{"bridge-node"};
     Mosquitto broker{dir.path()};
     Finsd finsd{{"--node", "12"}};
-    Subscriber sub{broker.port(), "t/#"};
+    Recorder sub{broker.port(), "t/#"};
     std::unique_ptr<BridgeProcess> bridge;
     explicit NodeRig(const std::string& dest) {
         bridge = std::make_unique<BridgeProcess>(
@@ -55,7 +55,7 @@ TEST(BridgeNode, AnswersFromAnotherNodeAreCountedAndTheStatusNamesTheDestToSet) 
     EXPECT_EQ(status->json().value("error", ""), expected_error);
     {
         // Retained: a subscriber that comes later is told at once.
-        Subscriber later(rig.broker.port(), "t/press1/status");
+        Recorder later(rig.broker.port(), "t/press1/status");
         auto st = later.wait_topic("t/press1/status", [](const json&) { return true; });
         ASSERT_TRUE(st);
         EXPECT_TRUE(st->retain);

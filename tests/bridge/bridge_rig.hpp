@@ -37,7 +37,7 @@ struct Rig {
     ScratchDir dir{"bridge"};
     Mosquitto broker{dir.path()};
     Finsd finsd{{}};
-    Subscriber sub{broker.port(), "t/#"};
+    Recorder sub{broker.port(), "t/#"};
     std::unique_ptr<BridgeProcess> bridge;
     explicit Rig(const std::string& plc_extra = "", const std::string& group = tags) {
         bridge = std::make_unique<BridgeProcess>(
@@ -47,7 +47,7 @@ struct Rig {
 };
 
 // The first answer to the write command `id`, if one comes.
-inline std::optional<nlohmann::json> response(Subscriber& sub, const std::string& id) {
+inline std::optional<nlohmann::json> response(Recorder& sub, const std::string& id) {
     auto r = sub.wait_topic("t/press1/write/response",
                             [&](const nlohmann::json& j) { return j.value("id", "") == id; });
     if (!r) return std::nullopt;
@@ -55,7 +55,7 @@ inline std::optional<nlohmann::json> response(Subscriber& sub, const std::string
 }
 
 // How many answers to `id` came so far.
-inline std::size_t responses(Subscriber& sub, const std::string& id) {
+inline std::size_t responses(Recorder& sub, const std::string& id) {
     std::size_t n = 0;
     for (const auto& m : sub.messages())
         if (m.topic == "t/press1/write/response" && m.json().value("id", "") == id) ++n;

@@ -19,12 +19,12 @@ TEST(BridgeRun, PublishesStatusSnapshotAndThenOnlyChanges) {
                                    [](const json& j) { return j["state"] == "online"; }));
     {
         // Both statuses are retained: a subscriber that comes later gets them at once.
-        Subscriber later(rig.broker.port(), "t/+/status");
+        Recorder later(rig.broker.port(), "t/+/status");
         auto st = later.wait_topic("t/press1/status",
                                    [](const json& j) { return j["state"] == "online"; });
         ASSERT_TRUE(st);
         EXPECT_TRUE(st->retain);
-        Subscriber later2(rig.broker.port(), "t/$bridge/+/status");
+        Recorder later2(rig.broker.port(), "t/$bridge/+/status");
         auto me = later2.wait_topic("t/$bridge/test/status",
                                     [](const json& j) { return j["state"] == "online"; });
         ASSERT_TRUE(me);
@@ -71,7 +71,7 @@ TEST(BridgeRun, AKilledBridgesPlcStatusNamesItsOwnerWhoseStatusSaysOffline) {
     ASSERT_TRUE(status);
     EXPECT_EQ(status->json()["instance"], "test");
     rig.bridge->stop(SIGKILL);
-    Subscriber later(rig.broker.port(), "t/#");
+    Recorder later(rig.broker.port(), "t/#");
     ASSERT_TRUE(later.connected());
     auto owner = later.wait_topic("t/$bridge/test/status",
                                   [](const json& j) { return j["state"] == "offline"; });
@@ -89,7 +89,7 @@ TEST(BridgeRun, EndCodesAreCarriedPerTag) {
     Mosquitto broker{dir.path()};
     // A CJ1M has no EM (1101 area missing) and refuses network writes (protected).
     Finsd finsd{{"--profile", "cj1m", "--network-write-protection", "all"}};
-    Subscriber sub(broker.port(), "t/#");
+    Recorder sub(broker.port(), "t/#");
     ASSERT_TRUE(broker.started() && finsd.started() && sub.connected());
     BridgeProcess bridge(
         dir, mqtt_section(broker.port()) + plc("press1", finsd.port()) + R"([[plc.group]]
@@ -145,7 +145,7 @@ TEST(BridgeRun, TlsAndPasswordBroker) {
                                      d + "/passwd\n"};
     Finsd finsd{{}};
     ASSERT_TRUE(broker.started() && finsd.started());
-    Subscriber sub(broker.port(), "t/#", {d + "/ca.crt", "bridge", "s3cret"});
+    Recorder sub(broker.port(), "t/#", {d + "/ca.crt", "bridge", "s3cret"});
     ASSERT_TRUE(sub.connected());
     BridgeProcess bridge(dir, mqtt_section(broker.port(), "ca_file = \"" + d +
                                                               "/ca.crt\"\nusername = \"bridge\"\n"
@@ -155,7 +155,7 @@ TEST(BridgeRun, TlsAndPasswordBroker) {
         return j.value("full", false);
     })) << bridge.stop().err;
     // A wrong password is refused by the broker: nothing is published.
-    Subscriber wrong(broker.port(), "t/#", {d + "/ca.crt", "bridge", "wrong"});
+    Recorder wrong(broker.port(), "t/#", {d + "/ca.crt", "bridge", "wrong"});
     EXPECT_FALSE(wrong.connected());
 }
 
@@ -163,7 +163,7 @@ TEST(BridgeRun, SecondBrokerIsTriedWhenTheFirstIsDown) {
     ScratchDir dir{"bridge"};
     Mosquitto broker{dir.path()};
     Finsd finsd{{}};
-    Subscriber sub(broker.port(), "t/#");
+    Recorder sub(broker.port(), "t/#");
     ASSERT_TRUE(broker.started() && finsd.started() && sub.connected());
     const auto down = free_port();
     BridgeProcess bridge(
@@ -260,7 +260,7 @@ name = "line-2"
 )");
     Finsd finsd{{"--config", plant}};
     Mosquitto broker{dir.path()};
-    Subscriber sub(broker.port(), "t/#");
+    Recorder sub(broker.port(), "t/#");
     ASSERT_TRUE(finsd.started() && broker.started() && sub.connected()) << finsd.result().err;
     BridgeProcess bridge(dir, mqtt_section(broker.port()) +
                                   "[[plc]]\nname = \"line2\"\nhost = \"127.0.61.1\"\nport = 9611\n"

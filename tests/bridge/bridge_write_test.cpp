@@ -112,11 +112,11 @@ TEST(BridgeRun, RetainedCommandsAreRefused) {
     Finsd finsd{{}};
     ASSERT_TRUE(broker.started() && finsd.started());
     {
-        Subscriber pub(broker.port(), "none");
-        pub.publish("t/press1/write", R"({"id":"r1","tag":"temp","value":9})", true);
+        Recorder pub(broker.port(), "none");
+        pub.publish("t/press1/write", R"({"id":"r1","tag":"temp","value":9})", 1, true);
         std::this_thread::sleep_for(std::chrono::milliseconds(200));
     }
-    Subscriber sub(broker.port(), "t/#");
+    Recorder sub(broker.port(), "t/#");
     BridgeProcess bridge(dir, mqtt_section(broker.port()) + plc("press1", finsd.port()) + tags);
     auto r = response(sub, "r1");
     ASSERT_TRUE(r);
@@ -130,7 +130,7 @@ TEST(BridgeRun, StoppedPlcIsOfflineWritesFailAtOnceOthersGoOn) {
     ScratchDir dir{"bridge"};
     Mosquitto broker{dir.path()};
     Finsd finsd{{}};
-    Subscriber sub(broker.port(), "t/#");
+    Recorder sub(broker.port(), "t/#");
     ASSERT_TRUE(broker.started() && finsd.started() && sub.connected());
     const std::uint16_t nobody = free_port();
     BridgeProcess bridge(dir, mqtt_section(broker.port()) + plc("press1", nobody) + tags +

@@ -2,6 +2,8 @@
 // `finsd ctl sendcmd` to a node that is finsd's FINS/TCP client travels on that client's
 // connection, server to client, and its answer client to server. Wireshark's dissector
 // must read both frames (command code, ICF direction, end code) and flag nothing.
+#include <poll.h>
+
 #include <string>
 #include <vector>
 
@@ -30,8 +32,17 @@ TEST(TsharkInstructions, SendCmdOnAFinsTcpClientsConnectionIsDissectedBothWays) 
     const auto hello = client.handshake();
     ASSERT_EQ(hello.size(), 24u);
     const std::uint8_t node = hello[19];
+    // The instruction waits for the answer as long as this test waits for anything (30 s),
+    // not its 2 s default: the answer comes from this process, which a loaded machine may
+    // not schedule for seconds.
     Child cmd({finsd_path, "ctl", "--socket", socket, "sendcmd", "--dest",
-               "0." + std::to_string(node) + ".0", "--command", "0101 82000A00 0001", "--json"});
+               "0." + std::to_string(node) + ".0", "--command", "0101 82000A00 0001", "--timeout",
+               "30", "--json"});
+    // The command comes once `finsd ctl` has started and asked finsd: a process start, which
+    // on a loaded machine takes seconds (10 s seen at nice 19), longer than a receive's 5 s.
+    // Wait for that event as long as ctl's own bound (Child::wait's 30 s).
+    pollfd readable{client.native_handle(), POLLIN, 0};
+    ::poll(&readable, 1, 30'000);
     const auto packet = client.receive_packet();
     ASSERT_GE(packet.size(), tcp_header_size + 12u) << "no command on the connection";
     const std::vector<std::uint8_t> command(packet.begin() + tcp_header_size, packet.end());

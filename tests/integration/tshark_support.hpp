@@ -4,7 +4,8 @@
 // Capturing needs root or the wireshark group (as CI has); a test checks ready() and
 // skips with the reason otherwise. The kernel hands packets to dumpcap in blocks and
 // dumpcap drops an unfinished block when stopped, so read_until() re-reads the growing
-// file (bounded) until the test's last exchange is in it, and only then stops.
+// file (bounded) until the test's last exchange is in it, and only then stops and reads
+// the finished file.
 #pragma once
 
 #include <signal.h>
@@ -100,17 +101,17 @@ class Capture {
     [[nodiscard]] bool ready() const { return ready_; }
     [[nodiscard]] const std::string& port() const { return port_; }
 
-    // Decodes the capture until `done` says the test's traffic is all in it (at most 60
-    // reads), stops capturing and returns the last decode.
+    // Decodes the growing capture until `done` says the test's traffic is all in it (at
+    // most 60 reads), then stops capturing and decodes the finished file once more: that
+    // last decode is the one returned. A read of the file while dumpcap writes it may end
+    // in a block cut short (tshark then exits 2: "cut short in the middle of a packet"),
+    // however complete the test's frames before it are; the stopped file has no such end.
     RunResult read_until(const std::vector<std::string>& fields,
                          const std::function<bool(const RunResult&)>& done) {
-        RunResult decoded;
-        for (int attempt = 0; attempt < 60; ++attempt) {
-            decoded = decode(file_, port_, fields);
-            if (done(decoded)) break;
-        }
+        for (int attempt = 0; attempt < 60; ++attempt)
+            if (done(decode(file_, port_, fields))) break;
         stop();
-        return decoded;
+        return decode(file_, port_, fields);
     }
 
   private:

@@ -81,15 +81,15 @@ TEST(ScanCycle, W342_5_3_18_StatisticsMatchEveryCycleWalkedByHand) {
     const Ticks base = ScanCycle::base_cycle(p);
     Storage storage;
     ScanCycle cycle(p, storage);
-    const Ticks t0 = 17'000'000'000;  // ~2023-11, 0.1 ms ticks
-    cycle.advance(at_tick(t0));       // power-on in RUN: operation starts
+    const Ticks t0 = 17'000'000'000;                           // ~2023-11, 0.1 ms ticks
+    EXPECT_EQ(cycle.times(at_tick(t0 + 1000)), CycleTimes{});  // not powered: nothing ran
+    cycle.power_on(at_tick(t0));                               // power-on in RUN: operation starts
     const auto first = ScanCycle::cycle_at(base, t0) + 1;
-    EXPECT_EQ(cycle.times(), CycleTimes{});
+    EXPECT_EQ(cycle.times(at_tick(t0)), CycleTimes{});
     for (Ticks dt : {0, 10, 20, 31, 45, 100, 119, 240, 241, 1000, 12345}) {
-        cycle.advance(at_tick(t0 + dt));
         const auto end = ScanCycle::cycle_at(base, t0 + dt);
-        EXPECT_EQ(cycle.times(), brute_force(base, first, first, end)) << dt;
-        EXPECT_EQ(cycle.cycles(), end > first ? end - first : 0) << dt;
+        EXPECT_EQ(cycle.times(at_tick(t0 + dt)), brute_force(base, first, first, end)) << dt;
+        EXPECT_EQ(cycle.cycles(at_tick(t0 + dt)), end > first ? end - first : 0) << dt;
     }
 }
 
@@ -99,15 +99,15 @@ TEST(ScanCycle, W342_5_3_18_AverageIsTheLastEightCycles) {
     Storage storage;
     ScanCycle cycle(p, storage);
     cycle.start(at_tick(0));
-    cycle.advance(at_tick(base * 100));
+    const auto now = at_tick(base * 100);
     const auto end = ScanCycle::cycle_at(base, base * 100);
     Ticks sum = 0;
     for (auto k = end - 8; k < end; ++k)
         sum += ScanCycle::cycle_length(base, k);
-    EXPECT_EQ(cycle.times().average, static_cast<std::uint32_t>(sum / 8));
+    EXPECT_EQ(cycle.times(now).average, static_cast<std::uint32_t>(sum / 8));
     // Over 16+ cycles every jitter value has been seen.
-    EXPECT_EQ(cycle.times().maximum, static_cast<std::uint32_t>(base + 3));
-    EXPECT_EQ(cycle.times().minimum, static_cast<std::uint32_t>(base - 2));
+    EXPECT_EQ(cycle.times(now).maximum, static_cast<std::uint32_t>(base + 3));
+    EXPECT_EQ(cycle.times(now).minimum, static_cast<std::uint32_t>(base - 2));
 }
 
 TEST(ScanCycle, DeterministicForTheSameTimePoints) {
@@ -116,11 +116,10 @@ TEST(ScanCycle, DeterministicForTheSameTimePoints) {
     Storage s2;
     ScanCycle a(p, s1);
     ScanCycle b(p, s2);
-    for (Ticks t : {1000, 1003, 1500, 9999, 123456}) {
-        a.advance(at_tick(t));
-        b.advance(at_tick(t));
-        EXPECT_EQ(a.times(), b.times()) << t;
-    }
+    a.power_on(at_tick(1000));
+    b.power_on(at_tick(1000));
+    for (Ticks t : {1000, 1003, 1500, 9999, 123456})
+        EXPECT_EQ(a.times(at_tick(t)), b.times(at_tick(t))) << t;
 }
 
 TEST(ScanCycle, W342_5_3_18_InitializeRestartsMaximumAndMinimum) {
@@ -130,15 +129,13 @@ TEST(ScanCycle, W342_5_3_18_InitializeRestartsMaximumAndMinimum) {
     ScanCycle cycle(p, storage);
     cycle.start(at_tick(0));
     const Ticks init = 5 * 16 * base + 40;
-    cycle.advance(at_tick(init));
     cycle.initialize(at_tick(init));
     const auto stats_first = ScanCycle::cycle_at(base, init);
-    EXPECT_EQ(cycle.times().maximum, 0U);  // nothing measured since the request yet
-    EXPECT_NE(cycle.times().average, 0U);  // the average is of the last 8 cycles regardless
+    EXPECT_EQ(cycle.times(at_tick(init)).maximum, 0U);  // nothing measured since the request yet
+    EXPECT_NE(cycle.times(at_tick(init)).average, 0U);  // the last 8 cycles regardless
     for (Ticks dt : {5, 20, 33, 60, 200}) {
-        cycle.advance(at_tick(init + dt));
         const auto end = ScanCycle::cycle_at(base, init + dt);
-        EXPECT_EQ(cycle.times(), brute_force(base, 1, stats_first, end)) << dt;
+        EXPECT_EQ(cycle.times(at_tick(init + dt)), brute_force(base, 1, stats_first, end)) << dt;
     }
 }
 
@@ -148,48 +145,56 @@ TEST(ScanCycle, W342_5_3_18_MaxMinInitializedWhenOperationStarts) {
     Storage storage;
     ScanCycle cycle(p, storage);
     cycle.start(at_tick(0));
-    cycle.advance(at_tick(1000));
-    const auto before = cycle.times();
+    const auto before = cycle.times(at_tick(1000));
     EXPECT_NE(before.maximum, 0U);
 
     cycle.stop(at_tick(1000));  // PROGRAM: frozen
     EXPECT_FALSE(cycle.running());
-    cycle.advance(at_tick(5000));
-    EXPECT_EQ(cycle.times(), before);
+    EXPECT_EQ(cycle.times(at_tick(5000)), before);
 
     cycle.start(at_tick(5000));  // RUN again: starts over at the next cycle
     EXPECT_TRUE(cycle.running());
-    EXPECT_EQ(cycle.times(), CycleTimes{});
-    EXPECT_EQ(cycle.cycles(), 0U);
-    cycle.advance(at_tick(5100));
+    EXPECT_EQ(cycle.times(at_tick(5000)), CycleTimes{});
+    EXPECT_EQ(cycle.cycles(at_tick(5000)), 0U);
     const auto first = ScanCycle::cycle_at(base, 5000) + 1;
-    EXPECT_EQ(cycle.times(), brute_force(base, first, first, ScanCycle::cycle_at(base, 5100)));
+    EXPECT_EQ(cycle.times(at_tick(5100)),
+              brute_force(base, first, first, ScanCycle::cycle_at(base, 5100)));
     // start() while running changes nothing (RUN <-> MONITOR).
-    const auto running = cycle.times();
+    const auto running = cycle.times(at_tick(5100));
     cycle.start(at_tick(5100));
-    EXPECT_EQ(cycle.times(), running);
+    EXPECT_EQ(cycle.times(at_tick(5100)), running);
+}
+
+TEST(ScanCycle, W342_5_3_18_PoweredUpInProgramModeNothingRan) {
+    Storage storage;
+    ScanCycle cycle(with_program(100), storage);
+    cycle.stop(at_tick(1'000'000));  // Plc::power_on in PROGRAM mode
+    EXPECT_TRUE(cycle.powered());
+    EXPECT_EQ(cycle.times(at_tick(2'000'000)), CycleTimes{});
+    EXPECT_EQ(cycle.cycles(at_tick(2'000'000)), 0U);
+    cycle.power_on(at_tick(2'000'000));  // already on: changes nothing
+    EXPECT_FALSE(cycle.running());
 }
 
 TEST(ScanCycle, HostClockSetBackCountsNoCyclesAndDoesNotCrash) {
     Storage storage;
     ScanCycle cycle(with_program(100), storage);
-    cycle.advance(at_tick(1'000'000));
-    cycle.advance(at_tick(2'000'000));
-    EXPECT_NE(cycle.cycles(), 0U);
-    cycle.advance(at_tick(10));
-    EXPECT_EQ(cycle.cycles(), 0U);
-    EXPECT_EQ(cycle.times(), CycleTimes{});
-    cycle.advance(TimePoint{std::chrono::seconds{-5}});
-    EXPECT_EQ(cycle.times(), CycleTimes{});
+    cycle.power_on(at_tick(1'000'000));
+    EXPECT_NE(cycle.cycles(at_tick(2'000'000)), 0U);
+    EXPECT_EQ(cycle.cycles(at_tick(10)), 0U);
+    EXPECT_EQ(cycle.times(at_tick(10)), CycleTimes{});
+    EXPECT_EQ(cycle.times(TimePoint{std::chrono::seconds{-5}}), CycleTimes{});
 }
 
-TEST(ScanCycle, AdvanceDoesNotAllocate) {
+TEST(ScanCycle, ReadingDoesNotAllocate) {
     Storage storage;
     ScanCycle cycle(cj2h(), storage);
-    cycle.advance(at_tick(1));
+    cycle.power_on(at_tick(1));
     const auto before = ::mallinfo2();
+    std::uint64_t sum = 0;
     for (Ticks t = 0; t < 1000; ++t)
-        cycle.advance(at_tick(1'000'000 + t * 37));
+        sum += cycle.times(at_tick(1'000'000 + t * 37)).average + cycle.cycles(at_tick(t));
+    EXPECT_NE(sum, 0U);
     const auto after = ::mallinfo2();
     EXPECT_EQ(after.uordblks, before.uordblks);
     EXPECT_EQ(after.hblkhd, before.hblkhd);

@@ -142,8 +142,8 @@ TEST_F(OperatingModeTest, RunToMonitorKeepsTheProgramRunning) {
     h.context.now = t0 + milliseconds(100);
     EXPECT_EQ(send("0401 FFFF 02"), 0x0000);
     // A restart would have cleared the statistics (nothing measured at this instant).
-    EXPECT_NE(h.plc.scan_cycle().times().maximum, 0U);
-    EXPECT_NE(h.plc.scan_cycle().cycles(), 0U);
+    EXPECT_NE(h.plc.scan_cycle().times(h.context.now).maximum, 0U);
+    EXPECT_NE(h.plc.scan_cycle().cycles(h.context.now), 0U);
 }
 
 }  // namespace

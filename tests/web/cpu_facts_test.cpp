@@ -8,6 +8,8 @@
 
 #include "fins/commands/clock.hpp"
 #include "plc/plc.hpp"
+#include "server/sessions/server.hpp"
+#include "transport/asio.hpp"
 #include "web/cpu_facts.hpp"
 
 namespace fins::test {
@@ -60,6 +62,51 @@ TEST(CpuFacts, ClockIsAnOffsetThatMovesOnlyWhenTheClockIsSet) {
     web::add_cpu_facts(plc, after, now);
     EXPECT_EQ(after["clock_offset_s"].get<std::int64_t>(),
               plc::Clock::to_civil(2030, 1, 1, 0, 0, 0) - utc.count());
+}
+
+// W342 5-3-18: the CPU Unit cycles from power-on whether anyone asks or not. Its server
+// powers it up when it starts; a minute later, with not one request in between, 06 20 and
+// the page's status show what a unit that ran that minute shows, and showing it changes
+// nothing.
+TEST(CpuFacts, W342_5_3_18_CycleTimesRunFromPowerOnWhetherAnyoneAsksOrNot) {
+    using std::chrono::minutes;
+    using std::chrono::seconds;
+    asio::io_context io;
+    plc::Plc plc;
+    server::ServerOptions options;
+    options.bind_address = "127.0.0.1";
+    options.port = 0;
+    const auto before = std::chrono::system_clock::now();
+    auto server = server::Server::start(io, plc, options);
+    ASSERT_TRUE(server) << server.error().message();
+    const auto after = std::chrono::system_clock::now();
+    EXPECT_TRUE(plc.scan_cycle().powered());
+
+    const auto later = after + minutes(1);
+    const auto& cycle = plc.scan_cycle();
+    const auto base = plc::ScanCycle::base_cycle(plc.profile());
+    const auto at = [&](auto t) {
+        return plc::ScanCycle::cycle_at(base, plc::ScanCycle::to_ticks(t));
+    };
+    // Every cycle since power-on (between `before` and `after`) has run.
+    EXPECT_GE(cycle.cycles(later) + 1, at(later) - at(after));
+    EXPECT_LE(cycle.cycles(later), at(later) - at(before));
+    // A minute holds every jitter value: the maximum and minimum have settled.
+    const auto times = cycle.times(later);
+    EXPECT_EQ(times.maximum, static_cast<std::uint32_t>(base + 3));
+    EXPECT_EQ(times.minimum, static_cast<std::uint32_t>(base - 2));
+    EXPECT_NE(times.average, 0U);
+
+    Json status;
+    web::add_cpu_facts(plc, status, later);
+    EXPECT_EQ(status["cycle_time"]["max_ms"].get<double>(), times.maximum / 10.0);
+    EXPECT_EQ(status["cycle_time"]["min_ms"].get<double>(), times.minimum / 10.0);
+    // Statuses built at other times leave what 06 20 reads at `later` as it was.
+    Json other;
+    web::add_cpu_facts(plc, other, later + minutes(5));
+    web::add_cpu_facts(plc, other, after + seconds(1));
+    EXPECT_EQ(cycle.times(later), times);
+    server->get()->stop();
 }
 
 TEST(CpuFacts, CycleTimeSettlesOnAnIdlePlc) {

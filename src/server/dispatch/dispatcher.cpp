@@ -116,7 +116,7 @@ std::size_t Dispatcher::handle(Bytes request, MutableBytes out, const RequestCon
         return reply.answer(code);
 
     // 3. Command: its parameters (the codec's 10xx, 11xx) and who serves it (0401).
-    plc_.scan_cycle().advance(context.now);
+    plc_.power_on(context.now);  // a Plc no server started (tests): powers up now
     reply.cpu_reached = true;
     const auto decoded = decode_request(request);
     if (!decoded) return reply.answer(handlers::to_end_code(decoded.error()));

@@ -22,19 +22,6 @@ namespace fins::server::handlers {
 
 namespace {
 
-// The end code for a PROGRAM-mode-only operation in the current mode (0000 in PROGRAM).
-EndCode program_mode_only(plc::OperatingMode mode) noexcept {
-    switch (mode) {
-        case plc::OperatingMode::program:
-            return EndCode::normal_completion;
-        case plc::OperatingMode::monitor:
-            return EndCode::wrong_mode_monitor;
-        case plc::OperatingMode::run:
-            return EndCode::wrong_mode_run;
-    }
-    return EndCode::wrong_mode_run;
-}
-
 // Writes the read header and the records [first, first + n) given by `at(i)`.
 template <class At>
 void write_records(ByteWriter& out, std::size_t stored, std::size_t first, std::size_t n,

@@ -31,4 +31,16 @@ EndCode check_execution_conditions(const ExecutionConditions& conditions, const 
     return EndCode::normal_completion;
 }
 
+EndCode program_mode_only(plc::OperatingMode mode) noexcept {
+    switch (mode) {
+        case plc::OperatingMode::run:
+            return EndCode::wrong_mode_run;
+        case plc::OperatingMode::monitor:
+            return EndCode::wrong_mode_monitor;
+        case plc::OperatingMode::program:
+            break;
+    }
+    return EndCode::normal_completion;
+}
+
 }  // namespace fins::server::handlers

@@ -21,7 +21,8 @@
 
 namespace fins::plc {
 class Plc;
-}
+enum class OperatingMode : std::uint8_t;
+}  // namespace fins::plc
 
 namespace fins::server {
 class SerialGatewayPort;
@@ -73,6 +74,7 @@ std::span<const HandlerEntry> access_right_handlers() noexcept;    // 0C xx  acc
 std::span<const HandlerEntry> error_log_handlers() noexcept;       // 21 xx  error_log.cpp
 std::span<const HandlerEntry> forced_handlers() noexcept;          // 23 xx  forced.cpp
 std::span<const HandlerEntry> file_memory_handlers() noexcept;     // 22 xx  file_memory.cpp
+                                                                   //  (0A-0C file_transfer.cpp)
 std::span<const HandlerEntry> serial_gateway_handlers() noexcept;  // 28 xx  serial_gateway.cpp
 
 // Host Link FINS conversion (W342 5-1-1, host_link_relay.cpp): sends the whole request
@@ -88,6 +90,11 @@ std::size_t relay_to_host_link(SerialGatewayPort& port, Bytes request, const Hea
 // UM read protection (2002), DIP switch UM write protection (2101).
 EndCode check_execution_conditions(const ExecutionConditions& conditions, const plc::Plc& plc,
                                    const NodeAddress& source, Link link) noexcept;
+
+// An operation only PROGRAM mode allows (file -> parameter or program area, I/O table
+// write and clear, error log clear): its end code in `mode`, the mode that refused it
+// (W342 5-1-3: 2206 RUN, 2205 MONITOR), 0000 in PROGRAM.
+EndCode program_mode_only(plc::OperatingMode mode) noexcept;
 
 // FINS end codes pass through; any other error (not expected from a decoder) is 1004.
 EndCode to_end_code(const std::error_code& error) noexcept;

@@ -21,16 +21,7 @@ namespace {
 // 5-3-8 / 5-3-9: "Data can be written to [cleared from] the I/O table only when the
 // CPU Unit is in PROGRAM mode." The mode codes of 5-1-3 say which mode refused it.
 EndCode io_table_mode(const plc::ParameterRange& range, plc::OperatingMode mode) noexcept {
-    if (!range.io_table) return EndCode::normal_completion;
-    switch (mode) {
-        case plc::OperatingMode::run:
-            return EndCode::wrong_mode_run;
-        case plc::OperatingMode::monitor:
-            return EndCode::wrong_mode_monitor;
-        case plc::OperatingMode::program:
-            break;
-    }
-    return EndCode::normal_completion;
+    return range.io_table ? program_mode_only(mode) : EndCode::normal_completion;
 }
 
 }  // namespace

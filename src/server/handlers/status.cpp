@@ -1,9 +1,9 @@
 // 06 xx status reading: CYCLE TIME READ 06 20 (W342 5-3-18). (06 01 CPU UNIT STATUS
 // READ is registered by its own group file.)
 //
-// The dispatcher refuses 06 20 in PROGRAM mode (5-1-2: 2203) and has brought the scan
-// cycle up to the request's time; the codec has answered 1002/1001 and 110C for a
-// parameter other than 00/01.
+// The dispatcher refuses 06 20 in PROGRAM mode (5-1-2: 2203); the scan cycle has run
+// since power-on and is read at the request's time; the codec has answered 1002/1001 and
+// 110C for a parameter other than 00/01.
 #include "fins/commands/status.hpp"
 #include "plc/plc.hpp"
 #include "server/handlers/handlers.hpp"
@@ -18,7 +18,7 @@ EndCode execute(HandlerContext& context, const CycleTimeRead& command, ByteWrite
         cycle.initialize(context.request.now);
         return EndCode::normal_completion;
     }
-    CycleTimeReadResponse{cycle.times()}.encode(out);
+    CycleTimeReadResponse{cycle.times(context.request.now)}.encode(out);
     return EndCode::normal_completion;
 }
 

@@ -15,6 +15,7 @@
 #include <boost/asio/steady_timer.hpp>
 
 #include "fins/node_address.hpp"
+#include "plc/plc.hpp"
 #include "server/dispatch/dispatcher.hpp"
 #include "server/scenario/fault_hook.hpp"
 #include "server/sessions/tcp_session.hpp"
@@ -177,6 +178,8 @@ Result<std::unique_ptr<Server>> Server::start(asio::io_context& io, plc::Plc& pl
     const std::uint8_t node = options.node != 0 ? options.node : derive_node(options.bind_address);
     const NodeAddress self{options.network, node, cpu_unit};
     auto impl = std::make_unique<Impl>(io, plc, self, options);
+    // The CPU Unit is on from here: its scan cycle runs whether anyone asks or not.
+    plc.power_on(std::chrono::system_clock::now());
 
     std::uint16_t port = options.port;
     if (options.tcp) {

@@ -117,10 +117,10 @@ void run_cluster(int instances) {
     tb::Recorder rec(broker.port(), {prefix + "/#"});
 
     std::vector<std::string> names;
-    std::vector<std::unique_ptr<tb::Proc>> bridges;
+    std::vector<std::unique_ptr<tb::Child>> bridges;
     for (int i = 0; i < instances; ++i) {
         names.push_back("edge-" + std::to_string(i + 1));
-        bridges.push_back(std::make_unique<tb::Proc>(
+        bridges.push_back(std::make_unique<tb::Child>(
             std::vector<std::string>{tb::bridge_path, "--config", conf, "--instance", names.back()},
             dir.path() / (names.back() + ".log")));
     }
@@ -194,10 +194,10 @@ TEST(ClusterFailover, AFrozenInstanceIsReplacedAndRejoinsWhenItContinues) {
     const auto conf = dir.write("bridge.toml", config_text(relay, broker.port()));
     tb::Recorder rec(broker.port(), {prefix + "/#"});
     const std::vector<std::string> names{"edge-1", "edge-2"};
-    tb::Proc a({tb::bridge_path, "--config", conf, "--instance", names[0]},
-               dir.path() / "edge-1.log");
-    tb::Proc b({tb::bridge_path, "--config", conf, "--instance", names[1]},
-               dir.path() / "edge-2.log");
+    tb::Child a({tb::bridge_path, "--config", conf, "--instance", names[0]},
+                dir.path() / "edge-1.log");
+    tb::Child b({tb::bridge_path, "--config", conf, "--instance", names[1]},
+                dir.path() / "edge-2.log");
     ASSERT_TRUE(wait_stable(rec, names)) << a.log();
 
     ::kill(a.pid(), SIGSTOP);

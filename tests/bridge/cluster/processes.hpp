@@ -1,124 +1,28 @@
-// Real parts for the Sparkplug and multi-instance tests: an MQTT recorder (libmosquitto) and
-// a UDP relay in front of finsd that counts the requests of each sender (which instance polls
-// which PLC). Child processes, ports and the mosquitto broker are bridge_processes.hpp's.
+// Real parts for the Sparkplug and multi-instance tests: a UDP relay in front of finsd that
+// counts the requests of each sender (which instance polls which PLC). Child processes, ports
+// and the mosquitto broker are bridge_processes.hpp's; the MQTT Recorder mqtt_recorder.hpp's.
 // Every wait is bounded.
 #pragma once
 
 #include <arpa/inet.h>
-#include <fcntl.h>
-#include <mosquitto.h>
 #include <netinet/in.h>
 #include <poll.h>
-#include <signal.h>
-#include <sys/prctl.h>
 #include <sys/socket.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
-#include <chrono>
-#include <condition_variable>
 #include <cstdint>
-#include <filesystem>
-#include <fstream>
-#include <functional>
 #include <map>
 #include <mutex>
-#include <set>
-#include <sstream>
-#include <string>
 #include <thread>
 #include <vector>
 
 #include "bridge/bridge_processes.hpp"
+#include "bridge/mqtt_recorder.hpp"
 
 namespace fins::test::bridge {
 
 using namespace std::chrono_literals;
-
-struct Received {
-    std::string topic;
-    std::string payload;
-    bool retain = false;
-    std::chrono::steady_clock::time_point at;
-};
-
-// An MQTT client that records everything on its subscriptions and can publish.
-class Recorder {
-  public:
-    Recorder(std::uint16_t port, const std::vector<std::string>& filters, std::string id = {}) {
-        static std::once_flag once;
-        std::call_once(once, [] { mosquitto_lib_init(); });
-        static std::atomic<int> n{0};
-        if (id.empty()) id = "recorder-" + std::to_string(::getpid()) + "-" + std::to_string(n++);
-        m_ = mosquitto_new(id.c_str(), true, this);
-        mosquitto_connect_callback_set(m_, [](mosquitto* m, void* self, int rc) {
-            auto* r = static_cast<Recorder*>(self);
-            if (rc != 0) return;
-            for (const auto& f : r->filters_)
-                mosquitto_subscribe(m, nullptr, f.c_str(), 1);
-        });
-        mosquitto_subscribe_callback_set(m_, [](mosquitto*, void* self, int, int, const int*) {
-            auto* r = static_cast<Recorder*>(self);
-            std::lock_guard lock(r->mu_);
-            ++r->subacks_;
-            r->cv_.notify_all();
-        });
-        mosquitto_message_callback_set(
-            m_, [](mosquitto*, void* self, const mosquitto_message* msg) {
-                auto* r = static_cast<Recorder*>(self);
-                Received rec{msg->topic,
-                             std::string(static_cast<const char*>(msg->payload),
-                                         static_cast<std::size_t>(msg->payloadlen)),
-                             msg->retain, std::chrono::steady_clock::now()};
-                std::lock_guard lock(r->mu_);
-                r->messages_.push_back(std::move(rec));
-                r->cv_.notify_all();
-            });
-        filters_ = filters;
-        mosquitto_connect(m_, "127.0.0.1", port, 10);
-        mosquitto_loop_start(m_);
-        std::unique_lock lock(mu_);
-        cv_.wait_for(lock, 10s, [&] { return subacks_ >= filters_.size(); });
-    }
-    ~Recorder() {
-        mosquitto_disconnect(m_);
-        mosquitto_loop_stop(m_, false);
-        mosquitto_destroy(m_);
-    }
-    Recorder(const Recorder&) = delete;
-    Recorder& operator=(const Recorder&) = delete;
-
-    void publish(const std::string& topic, const std::string& payload, int qos = 1,
-                 bool retain = false) {
-        mosquitto_publish(m_, nullptr, topic.c_str(), static_cast<int>(payload.size()),
-                          payload.data(), qos, retain);
-    }
-
-    // Waits until pred(messages) holds (at most timeout); the last answer of pred. pred runs
-    // with the recorder locked: it must use its argument, not messages() or count().
-    bool wait(const std::function<bool(const std::vector<Received>&)>& pred,
-              std::chrono::milliseconds timeout) {
-        std::unique_lock lock(mu_);
-        return cv_.wait_for(lock, timeout, [&] { return pred(messages_); });
-    }
-    std::vector<Received> messages() const {
-        std::lock_guard lock(mu_);
-        return messages_;
-    }
-    std::size_t count() const {
-        std::lock_guard lock(mu_);
-        return messages_.size();
-    }
-
-  private:
-    mosquitto* m_ = nullptr;
-    std::vector<std::string> filters_;
-    mutable std::mutex mu_;
-    std::condition_variable cv_;
-    std::size_t subacks_ = 0;
-    std::vector<Received> messages_;
-};
 
 // UDP relays in front of one finsd: relay i listens on its own loopback port (a PLC of the
 // bridge's config) and forwards to finsd's port, each sender through its own upstream socket

@@ -85,7 +85,7 @@ TEST(SparkplugMqtt, BirthSequenceSeqWrapRebirthDcmdOnceAndNdeathOnKill) {
     }
     const auto conf_path = dir.write("bridge.toml", conf);
     tb::Recorder rec(broker.port(), {"spBv1.0/#"});
-    tb::Proc bridge({tb::bridge_path, "--config", conf_path}, dir.path() / "bridge.log");
+    tb::Child bridge({tb::bridge_path, "--config", conf_path}, dir.path() / "bridge.log");
 
     // 1. NBIRTH (seq 0), then DBIRTH of both devices, then DDATA; seq +1 mod 256 throughout.
     ASSERT_TRUE(
