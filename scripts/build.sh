@@ -16,8 +16,8 @@ case "$kind" in
   fuzz) dir=build-fuzz; args=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DFINS_FUZZ=ON -DFINS_TESTS=OFF -DCMAKE_CXX_COMPILER=clang++-14) ;;
   *) echo "usage: $0 [release|asan|fuzz]" >&2; exit 2 ;;
 esac
-# ccache (optional, not a dependency) makes rebuilds in several work trees cheap.
-if command -v ccache >/dev/null; then args+=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
+source "$root/scripts/ccache.sh"
+args+=("${fins_ccache_args[@]}")
 dir=${FINS_BUILD_DIR:-$root/$dir}
 cmake -S "$root" -B "$dir" -G Ninja "${args[@]}" >/dev/null
 # The fuzz tree's "everything" would also build the libraries' other programs: its

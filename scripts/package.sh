@@ -17,7 +17,8 @@ args=(-DCMAKE_BUILD_TYPE=Release -DCMAKE_INSTALL_PREFIX=/usr -DFINS_TESTS=OFF -D
   -DFINS_EXAMPLES=OFF -DFINS_MAN=ON)
 # The .deb's Python module is for Debian's own interpreter, whatever else is on PATH.
 if [[ -x /usr/bin/python3 ]]; then args+=(-DPython3_EXECUTABLE=/usr/bin/python3); fi
-if command -v ccache >/dev/null; then args+=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
+source "$root/scripts/ccache.sh"
+args+=("${fins_ccache_args[@]}")
 cmake -S "$root" -B "$build" -G Ninja "${args[@]}" >/dev/null
 ninja -C "$build" -j "$jobs"
 rm -f "$build"/*.deb
