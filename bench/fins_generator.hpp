@@ -102,6 +102,19 @@ inline int connect_to(bool tcp, std::uint16_t port, bool nodelay = true) {
     return fd;
 }
 
+// The rate since `start` and the p50/p99 of `latencies` (sorted here).
+inline Stats stats_of(std::vector<double>& latencies, Clock::time_point start) {
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    Stats s;
+    s.count = latencies.size();
+    if (latencies.empty()) return s;
+    std::sort(latencies.begin(), latencies.end());
+    s.rate = static_cast<double>(latencies.size()) / elapsed;
+    s.p50_us = latencies[latencies.size() / 2];
+    s.p99_us = latencies[std::min(latencies.size() - 1, latencies.size() * 99 / 100)];
+    return s;
+}
+
 // Keeps `depth` requests outstanding for `seconds`; a request's latency is measured
 // from its send to the arrival of the next response (responses come back in order).
 // `split`: each request goes out in two writes, the FINS/TCP header, then the frame.
@@ -141,15 +154,7 @@ inline Stats drive(int fd, bool tcp, const Frames& f, unsigned depth, double sec
             sending = false;
         }
     }
-    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-    Stats s;
-    s.count = latencies.size();
-    if (latencies.empty()) return s;
-    std::sort(latencies.begin(), latencies.end());
-    s.rate = static_cast<double>(latencies.size()) / elapsed;
-    s.p50_us = latencies[latencies.size() / 2];
-    s.p99_us = latencies[std::min(latencies.size() - 1, latencies.size() * 99 / 100)];
-    return s;
+    return stats_of(latencies, start);
 }
 
 }  // namespace fins_bench
@@ -228,15 +233,7 @@ inline Stats drive_batched(int fd, bool tcp, const Frames& f, unsigned depth, do
             sending = false;
         }
     }
-    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-    Stats s;
-    s.count = latencies.size();
-    if (latencies.empty()) return s;
-    std::sort(latencies.begin(), latencies.end());
-    s.rate = static_cast<double>(latencies.size()) / elapsed;
-    s.p50_us = latencies[latencies.size() / 2];
-    s.p99_us = latencies[std::min(latencies.size() - 1, latencies.size() * 99 / 100)];
-    return s;
+    return stats_of(latencies, start);
 }
 
 }  // namespace fins_bench
