@@ -19,6 +19,13 @@ std::int64_t now_ms() {
     return duration_cast<milliseconds>(system_clock::now().time_since_epoch()).count();
 }
 
+template <class... F>
+struct overloaded : F... {
+    using F::operator()...;
+};
+template <class... F>
+overloaded(F...) -> overloaded<F...>;
+
 std::uint64_t ms(std::int64_t t) {
     return t < 0 ? 0 : static_cast<std::uint64_t>(t);
 }
@@ -206,51 +213,70 @@ void SparkplugPayload::write_response(const Plc& plc, const WriteResponse& r, co
     }
 }
 
+void SparkplugPayload::rejected(std::string_view topic, std::string_view reason) {
+    ++rejected_;
+    spdlog::warn("sparkplug: {} refused: {}", topic, reason);
+}
+
 std::optional<ParsedCommand> SparkplugPayload::parse(std::string_view topic,
                                                      std::string_view payload, bool retained) {
     const auto parts = parse_topic(topic);
     if (!parts || parts->group_id != node_.group_id() ||
         parts->edge_node_id != node_.edge_node_id())
         return std::nullopt;
-    ParsedCommand pc;
-    pc.plc = std::string(parts->device_id);
     if (retained) {
         // NCMD and DCMD are never retained (chapter 6): a retained one is stale, not executed.
-        ++rejected_;
-        spdlog::warn("sparkplug: retained {} on {} refused", parts->verb, topic);
-        return pc;
+        return Rejected{fmt::format("retained {} (a command is executed once, when sent)",
+                                    parts->verb)};
     }
     std::vector<Command> cmds;
     node_.on_command(topic, payload, cmds);
-    // The write path takes one command per message (ParsedCommand::write): a DCMD that sets
-    // several metrics executes the first and refuses the rest, logged (a host application
-    // writing one tag sends one metric).
-    bool have_write = false;
+    // One command per message: the first Rebirth or write is the answer, every other part of
+    // the message is rejected (logged and counted) here; a message with nothing to execute is
+    // Rejected with its first reason. A DCMD that sets several metrics executes the first (a
+    // host application writing one tag sends one metric).
+    std::optional<ParsedCommand> result;
+    std::optional<std::string> first_error;
+    const auto reject = [&](std::string reason) {
+        if (!first_error)
+            first_error = std::move(reason);
+        else
+            rejected(topic, reason);
+    };
     for (auto& c : cmds) {
-        if (std::holds_alternative<Rebirth>(c)) {
-            pc.rebirth = true;
-        } else if (auto* w = std::get_if<DeviceWrite>(&c)) {
-            if (have_write) {
-                ++rejected_;
-                spdlog::warn("sparkplug: DCMD on {}: one metric per DCMD, {} ignored", topic,
-                             w->metric);
-                continue;
-            }
-            const auto& dev = devices_.find(w->device)->second;
-            const auto [g, t] = dev.tags[w->index];
-            WriteCommand wc;
-            wc.plc = w->device;
-            wc.id = fmt::format("dcmd-{}-{}", node_.bd_seq(), ++next_id_);
-            wc.tag = dev.plc->groups[g].tags[t].name;
-            wc.value = to_json(w->value);
-            pc.write = std::move(wc);
-            have_write = true;
-        } else if (auto* e = std::get_if<CommandError>(&c)) {
-            ++rejected_;
-            spdlog::warn("sparkplug: {} refused: {}", topic, e->reason);
-        }
+        std::visit(overloaded{
+                       [&](const Rebirth&) {
+                           if (!result)
+                               result = NodeRebirth{};
+                           else
+                               reject("one command per NCMD: a second Rebirth ignored");
+                       },
+                       [&](const DeviceWrite& w) {
+                           if (result) {
+                               reject(fmt::format("one metric per DCMD: {} ignored", w.metric));
+                               return;
+                           }
+                           const auto dev = devices_.find(w.device);
+                           if (dev == devices_.end() || w.index >= dev->second.tags.size()) {
+                               reject(fmt::format("no metric {} on device {}", w.metric,
+                                                  w.device));
+                               return;
+                           }
+                           const auto [g, t] = dev->second.tags[w.index];
+                           WriteCommand wc;
+                           wc.plc = w.device;
+                           wc.id = fmt::format("dcmd-{}-{}", node_.bd_seq(), ++next_id_);
+                           wc.tag = dev->second.plc->groups[g].tags[t].name;
+                           wc.value = to_json(w.value);
+                           result = std::move(wc);
+                       },
+                       [&](const CommandError& e) { reject(e.reason); },
+                   },
+                   c);
     }
-    return pc;
+    if (!result) return Rejected{first_error.value_or(fmt::format("{} sets no metric", parts->verb))};
+    if (first_error) rejected(topic, *first_error);
+    return result;
 }
 
 }  // namespace fins::bridge::sparkplug

@@ -92,6 +92,11 @@ TEST(SparkplugPayload, DcmdBecomesTheBridgesWriteCommandAndRetainedOnesAreRefuse
     (void)fmt.session_will();
     (void)collect([&](const fb::Sink& s) { fmt.connected(s); });
     (void)collect([&](const fb::Sink& s) { fmt.status({&c.plcs[0], true, "", 5}, s); });
+    std::vector<fb::TagSample> tags(2);
+    (void)collect([&](const fb::Sink& s) {
+        fmt.values({&c.plcs[0], &c.plcs[0].groups[0], tags, 6, true}, s);
+    });
+    ASSERT_TRUE(fmt.node().attached("p"));
     pb::Payload p;
     p.set_timestamp(10);
     auto* m = p.add_metrics();
@@ -100,23 +105,29 @@ TEST(SparkplugPayload, DcmdBecomesTheBridgesWriteCommandAndRetainedOnesAreRefuse
     const auto bytes = p.SerializeAsString();
     auto pc = fmt.parse("spBv1.0/plant/DCMD/test/p", bytes, false);
     ASSERT_TRUE(pc);
-    ASSERT_TRUE(pc->write);
-    EXPECT_EQ(pc->plc, "p");
-    EXPECT_EQ(pc->write->plc, "p");
-    EXPECT_EQ(pc->write->tag, "temp");
-    EXPECT_EQ(pc->write->value, nlohmann::json(2.5));
-    EXPECT_FALSE(pc->write->id.empty());
+    const auto* w = std::get_if<fb::WriteCommand>(&*pc);
+    ASSERT_TRUE(w);
+    EXPECT_EQ(w->plc, "p");
+    EXPECT_EQ(w->tag, "temp");
+    EXPECT_EQ(w->value, nlohmann::json(2.5));
+    EXPECT_FALSE(w->id.empty());
     const auto again = fmt.parse("spBv1.0/plant/DCMD/test/p", bytes, false);
-    EXPECT_NE(again->write->id, pc->write->id);  // each DCMD is its own command
+    ASSERT_TRUE(again && std::holds_alternative<fb::WriteCommand>(*again));
+    EXPECT_NE(std::get<fb::WriteCommand>(*again).id, w->id);  // each DCMD is its own command
 
     pc = fmt.parse("spBv1.0/plant/DCMD/test/p", bytes, true);
     ASSERT_TRUE(pc);
-    EXPECT_FALSE(pc->write);
+    EXPECT_TRUE(std::holds_alternative<fb::Rejected>(*pc));
     m->set_name("g/speed");  // not writable
     m->set_int_value(3);
     pc = fmt.parse("spBv1.0/plant/DCMD/test/p", p.SerializeAsString(), false);
     ASSERT_TRUE(pc);
-    EXPECT_FALSE(pc->write);
-    EXPECT_EQ(fmt.rejected_commands(), 2U);
+    ASSERT_TRUE(std::holds_alternative<fb::Rejected>(*pc));
+    EXPECT_EQ(std::get<fb::Rejected>(*pc).reason, "g/speed is not writable");
+    // The format counts what the bridge hands back (Bridge::command), not what it parses.
+    EXPECT_EQ(fmt.rejected_commands(), 0U);
+    fmt.rejected("spBv1.0/plant/DCMD/test/p", "g/speed is not writable");
+    EXPECT_EQ(fmt.rejected_commands(), 1U);
     EXPECT_FALSE(fmt.parse("finskit/p/write", "{}", false));  // not Sparkplug's
+    EXPECT_FALSE(fmt.parse("spBv1.0/plant/DCMD/other/p", bytes, false));  // another Edge Node's
 }
