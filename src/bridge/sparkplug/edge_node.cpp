@@ -173,14 +173,14 @@ void EdgeNode::detach(const std::string& device, std::uint64_t now_ms, std::vect
 void EdgeNode::data(const std::string& device, std::span<const MetricUpdate> updates,
                     std::uint64_t now_ms, std::vector<Message>& out) {
     const auto it = devices_.find(device);
-    if (it == devices_.end() || !it->second.attached || updates.empty()) return;
+    if (it == devices_.end() || updates.empty()) return;
     auto& d = it->second;
     for (const auto& u : updates) {
         if (u.index >= d.metrics.size()) continue;
         d.last[u.index] = u.value;
         d.last_ts[u.index] = u.timestamp_ms;
     }
-    if (!born_) return;
+    if (!born_ || !d.attached) return;  // kept for the DBIRTH
     scratch_.Clear();
     scratch_.set_timestamp(now_ms);
     scratch_.set_seq(take_seq());

@@ -1,5 +1,6 @@
 #include "bridge/sparkplug/sparkplug_payload.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <utility>
@@ -119,6 +120,7 @@ SparkplugPayload::SparkplugPayload(const BridgeConfig& config, std::string group
                 d.tags.emplace_back(g, t);
             }
         }
+        d.seen.assign(plc.groups.size(), false);
         node_.define_device(plc.name, std::move(defs));
         devices_.emplace(plc.name, std::move(d));
     }
@@ -163,16 +165,23 @@ void SparkplugPayload::status(const PlcStatus& st, const Sink& out) {
     if (!st.plc) return;
     if (awaiting_birth_) node_.connection_lost();
     // Device online/offline is DBIRTH/DDEATH (chapter 5: a Device that cannot be reached is
-    // DDEATH, its metrics stale for host applications, until its next DBIRTH).
-    if (st.online)
-        node_.attach(st.plc->name, ms(st.ts_ms), scratch_);
-    else
+    // DDEATH, its metrics stale for host applications, until its next DBIRTH). The DBIRTH
+    // waits for the first values of every group (values()): a DBIRTH of nulls with Quality
+    // BAD would tell host applications the PLC's values are bad when they are only not read
+    // yet.
+    const auto it = devices_.find(st.plc->name);
+    if (it != devices_.end()) std::fill(it->second.seen.begin(), it->second.seen.end(), false);
+    if (!st.online)
         node_.detach(st.plc->name, ms(st.ts_ms), scratch_);
+    else if (it != devices_.end() && it->second.seen.empty())
+        node_.attach(st.plc->name, ms(st.ts_ms), scratch_);  // no group: nothing to wait for
     emit(scratch_, out);
 }
 
 void SparkplugPayload::released(const Plc& plc, const Sink& out) {
     if (awaiting_birth_) node_.connection_lost();
+    const auto it = devices_.find(plc.name);
+    if (it != devices_.end()) std::fill(it->second.seen.begin(), it->second.seen.end(), false);
     node_.detach(plc.name, ms(now_ms()), scratch_);
     emit(scratch_, out);
 }
@@ -182,13 +191,12 @@ void SparkplugPayload::values(const GroupSample& s, const Sink& out) {
     if (awaiting_birth_) node_.connection_lost();  // keep the values, publish nothing
     const auto it = devices_.find(s.plc->name);
     if (it == devices_.end()) return;
-    const auto& d = it->second;
+    auto& d = it->second;
     std::size_t g = 0;
     while (g < s.plc->groups.size() && &s.plc->groups[g] != s.group)
         ++g;
     if (g == s.plc->groups.size()) return;
-    // A PLC that answers is online: born if it was not (its first values ride in the DBIRTH).
-    if (!node_.attached(s.plc->name)) node_.attach(s.plc->name, ms(s.ts_ms), scratch_);
+    d.seen[g] = true;
     updates_.clear();
     for (std::size_t t = 0; t < s.tags.size() && t < s.group->tags.size(); ++t) {
         const auto& sample = s.tags[t];
@@ -199,7 +207,12 @@ void SparkplugPayload::values(const GroupSample& s, const Sink& out) {
         if (!sample.error) u.value = to_metric_value(s.group->tags[t].type, sample.value);
         updates_.push_back(std::move(u));
     }
-    node_.data(s.plc->name, updates_, ms(s.ts_ms), scratch_);
+    node_.data(s.plc->name, updates_, ms(s.ts_ms), scratch_);  // kept while not attached
+    // A PLC that answers is online: born once every group has values, which ride in the
+    // DBIRTH (the values above were kept for it, not published).
+    if (!node_.attached(s.plc->name) &&
+        std::all_of(d.seen.begin(), d.seen.end(), [](bool b) { return b; }))
+        node_.attach(s.plc->name, ms(s.ts_ms), scratch_);
     emit(scratch_, out);
 }
 

@@ -73,6 +73,8 @@ class SparkplugPayload final : public PayloadFormat {
         std::vector<std::pair<std::size_t, std::size_t>> tags;
         std::vector<std::size_t> group_base;  // first metric index of each group
         const Plc* plc = nullptr;
+        // The groups with values since the device came online: its DBIRTH waits for all.
+        std::vector<bool> seen;
     };
     void emit(std::vector<sparkplug::Message>& msgs, const Sink& out);
 
