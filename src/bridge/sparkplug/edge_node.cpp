@@ -12,7 +12,7 @@ namespace {
 // k << 20 .. (k << 20) + 2^20 - 1, so an alias is unique across the Edge Node (chapter 6,
 // "alias") and stays the same across rebirths and ownership moves within one process.
 constexpr unsigned alias_shift = 20;
-constexpr std::size_t max_metrics_per_device = std::size_t{1} << alias_shift;
+[[maybe_unused]] constexpr std::size_t max_metrics_per_device = std::size_t{1} << alias_shift;
 
 void add_node_metric_bool(PbPayload& p, std::string_view name, bool v, std::uint64_t ts) {
     auto* m = p.add_metrics();
