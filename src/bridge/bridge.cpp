@@ -13,6 +13,15 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// One handler per alternative for std::visit: a ParsedCommand alternative without one does not
+// compile.
+template <class... F>
+struct overloaded : F... {
+    using F::operator()...;
+};
+template <class... F>
+overloaded(F...) -> overloaded<F...>;
+
 std::int64_t epoch_ms() {
     return std::chrono::duration_cast<std::chrono::milliseconds>(
                std::chrono::system_clock::now().time_since_epoch())
@@ -178,49 +187,124 @@ void Bridge::incoming(std::string topic, std::string payload, bool retained) {
         ++dropped_commands_;
         return;
     }
-    asio::post(io_, [this, topic = std::move(topic), payload = std::move(payload), retained,
-                     arrival = Clock::now()] {
+    try {
+        asio::post(io_, [this, topic = std::move(topic), payload = std::move(payload), retained,
+                         arrival = Clock::now()] {
+            pending_commands_.fetch_sub(1);
+            if (!stopped_) handle(topic, payload, retained, arrival);
+        });
+    } catch (...) {
+        // Not queued (out of memory): dropped, like a message beyond the bound.
         pending_commands_.fetch_sub(1);
-        if (!stopped_) command(topic, payload, retained, arrival);
-    });
+        ++dropped_commands_;
+    }
+}
+
+void Bridge::handle(const std::string& topic, const std::string& payload, bool retained,
+                    Clock::time_point arrival) noexcept {
+    // The failure boundary of one message: whatever handling it throws ends here, as a
+    // refusal where one can be answered, a log line and a count (docs/bridge.md).
+    std::optional<ParsedCommand> parsed;
+    try {
+        command(topic, payload, retained, arrival, parsed);
+    } catch (const std::exception& e) {
+        failed(topic, retained, parsed, e.what());
+    } catch (...) {
+        failed(topic, retained, parsed, "unknown exception");
+    }
+}
+
+void Bridge::failed(const std::string& topic, bool retained,
+                    const std::optional<ParsedCommand>& parsed, std::string_view what) noexcept {
+    ++failed_commands_;
+    try {
+        const auto now = Clock::now();
+        if (now - last_failure_log_ >= std::chrono::seconds(1)) {
+            spdlog::error("handling a message on {} failed: {} ({} more failures not logged)",
+                          topic, what, failures_unlogged_);
+            last_failure_log_ = now;
+            failures_unlogged_ = 0;
+        } else {
+            ++failures_unlogged_;
+        }
+        if (!parsed) return;  // it failed before it was understood: nothing to answer
+        const auto reason = fmt::format("internal error: {}", what);
+        std::visit(overloaded{
+                       [&](const WriteCommand& w) {
+                           // Not answered when the write was started (its answer will come);
+                           // a repeated id gets the first answer (refuse()).
+                           if (const auto m = ids_.find(w.plc); m != ids_.end())
+                               if (const auto e = m->second.entries.find(w.id);
+                                   e != m->second.entries.end() && !e->second.done)
+                                   return;
+                           refuse(Refusal{w.plc, WriteResponse{w.id, false, std::nullopt,
+                                                               std::nullopt, reason}},
+                                  retained);
+                       },
+                       [&](const Refusal& r) {
+                           refuse(Refusal{r.plc, WriteResponse{r.response.id, false,
+                                                               std::nullopt, std::nullopt,
+                                                               reason}},
+                                  retained);
+                       },
+                       [&](const NodeRebirth&) { format_->rejected(topic, reason); },
+                       [&](const Rejected&) { format_->rejected(topic, reason); },
+                   },
+                   *parsed);
+    } catch (...) {
+        // The refusal failed too: the count above is all that is left of it.
+    }
 }
 
 void Bridge::command(const std::string& topic, const std::string& payload, bool retained,
-                     Clock::time_point arrival) {
+                     Clock::time_point arrival, std::optional<ParsedCommand>& parsed) {
     if (ownership_->on_message(topic, payload)) return;  // membership
-    auto parsed = format_->parse(topic, payload, retained);
+    parsed = format_->parse(topic, payload, retained);
     if (!parsed) return;
+    if (command_hook_) command_hook_(*parsed);
+    std::visit(overloaded{
+                   [&](const WriteCommand& w) { execute(w, arrival); },
+                   [&](const Refusal& r) { refuse(r, retained); },
+                   [&](const NodeRebirth&) { rebirth(); },
+                   [&](const Rejected& r) { format_->rejected(topic, r.reason); },
+               },
+               *parsed);
+}
+
+void Bridge::rebirth() {
+    // A host application asks for the whole birth sequence again (Sparkplug NCMD). The
+    // topic is this instance's own: no ownership check.
+    format_->connected(sink_);
+    for (const auto& [name, st] : statuses_)
+        format_->status(st, sink_);
+}
+
+void Bridge::refuse(const Refusal& r, bool retained) {
     // Its owner answers. A retained command arrives as this instance subscribes, before it
     // has joined; it is refused, never executed, by the instance that owns the PLC once
     // joined (docs/bridge.md "Several instances").
-    if (!parsed->rebirth && !ownership_->owns(parsed->plc) &&
-        !(retained && parsed->refuse && ownership_->owns_once_joined(parsed->plc)))
-        return;
-    auto it = pollers_.find(parsed->plc);
+    if (!ownership_->owns(r.plc) && !(retained && ownership_->owns_once_joined(r.plc))) return;
+    const auto it = pollers_.find(r.plc);
     Plc unknown;
-    unknown.name = parsed->plc;
+    unknown.name = r.plc;
     const Plc& plc = it != pollers_.end() ? it->second->plc() : unknown;
-    if (parsed->rebirth) {
-        // A host application asks for the whole birth sequence again (Sparkplug NCMD).
-        format_->connected(sink_);
-        for (const auto& [name, st] : statuses_)
-            format_->status(st, sink_);
-        return;
-    }
-    if (parsed->refuse) {
-        // A repeated id is answered as the first time, even when refused.
-        if (!parsed->refuse->id.empty()) {
-            auto& m = ids_[plc.name];
-            if (auto e = m.entries.find(parsed->refuse->id);
-                e != m.entries.end() && e->second.done) {
-                format_->write_response(plc, e->second.response, sink_);
-                return;
-            }
+    // A repeated id is answered as the first time, even when refused.
+    if (!r.response.id.empty()) {
+        auto& m = ids_[plc.name];
+        if (auto e = m.entries.find(r.response.id); e != m.entries.end() && e->second.done) {
+            format_->write_response(plc, e->second.response, sink_);
+            return;
         }
-        answer(plc, *parsed->refuse);
-        return;
     }
-    const WriteCommand& w = *parsed->write;
+    answer(plc, r.response);
+}
+
+void Bridge::execute(const WriteCommand& w, Clock::time_point arrival) {
+    if (!ownership_->owns(w.plc)) return;  // its owner answers
+    auto it = pollers_.find(w.plc);
+    Plc unknown;
+    unknown.name = w.plc;
+    const Plc& plc = it != pollers_.end() ? it->second->plc() : unknown;
     {
         auto& m = ids_[plc.name];
         if (auto e = m.entries.find(w.id); e != m.entries.end()) {
@@ -269,7 +353,12 @@ void Bridge::report() {
         }
         const auto now = Clock::now();
         const double seconds = std::chrono::duration<double>(now - last_report_).count();
-        const auto m = mqtt_ ? mqtt_->stats() : MqttStats{};
+        auto m = mqtt_ ? mqtt_->stats() : MqttStats{};
+        // The format's own session (Sparkplug) carries its births and data: they count as
+        // published like JSON messages do; its connects are counted apart.
+        const auto s = session_ ? session_->stats() : MqttStats{};
+        m.published += s.published;
+        m.dropped += s.dropped;
         nlohmann::json j{
             {"instance", config_.instance},
             {"ts", epoch_ms()},
@@ -287,7 +376,10 @@ void Bridge::report() {
             {"published", m.published},
             {"dropped", m.dropped},
             {"connects", m.connects},
-            {"commands_dropped", dropped_commands_.load()}};
+            {"commands_dropped", dropped_commands_.load()},
+            {"commands_rejected", format_->rejected_commands()},
+            {"commands_failed", failed_commands_}};
+        if (session_) j["session_connects"] = s.connects;
         last_totals_ = t;
         last_report_ = now;
         spdlog::info("stats {}", j.dump());

@@ -15,14 +15,24 @@
 // [write] id_memory ids per PLC): a repeated id is answered again with the first answer,
 // never executed again; while the first is still running the repeat gets no answer of
 // its own (the first one's answer is on the same topic).
+//
+// Commands: the format parses a message into one ParsedCommand alternative (payload.hpp) and
+// command() visits it whole: a write to execute, a refusal to answer, a Sparkplug rebirth, a
+// Sparkplug command rejected (logged and counted by the format). Each message is handled
+// inside a failure boundary (handle()): an exception becomes a refusal where one can be
+// answered, a log line (at most one a second) and a count ("commands_failed"), never the end
+// of the process.
 #pragma once
 
 #include <atomic>
 #include <chrono>
 #include <deque>
+#include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <unordered_map>
 
 #include <boost/asio/io_context.hpp>
@@ -61,6 +71,15 @@ class Bridge final : public PollerEvents {
     [[nodiscard]] MqttClient* mqtt() noexcept { return mqtt_.get(); }
     [[nodiscard]] asio::io_context& io() noexcept { return io_; }
 
+    // Test hook: called with every parsed command before it is handled (a test makes it
+    // throw to prove the failure boundary below).
+    void set_command_hook(std::function<void(const ParsedCommand&)> hook) {
+        command_hook_ = std::move(hook);
+    }
+    // Messages whose handling threw (each one refused where it can be answered, logged at
+    // most once a second, and counted here: "commands_failed" in the stats).
+    [[nodiscard]] std::uint64_t failed_commands() const noexcept { return failed_commands_; }
+
     void group_done(const GroupSample& sample) override;
     void status_changed(const PlcStatus& status) override;
     void write_done(const Plc& plc, const WriteResponse& response) override;
@@ -75,8 +94,17 @@ class Bridge final : public PollerEvents {
         std::deque<std::string> order;  // oldest first
     };
 
+    // One MQTT message, inside the failure boundary: nothing it throws leaves handle().
+    void handle(const std::string& topic, const std::string& payload, bool retained,
+                std::chrono::steady_clock::time_point arrival) noexcept;
     void command(const std::string& topic, const std::string& payload, bool retained,
-                 std::chrono::steady_clock::time_point arrival);
+                 std::chrono::steady_clock::time_point arrival,
+                 std::optional<ParsedCommand>& parsed);
+    void execute(const WriteCommand& w, std::chrono::steady_clock::time_point arrival);
+    void refuse(const Refusal& r, bool retained);
+    void rebirth();
+    void failed(const std::string& topic, bool retained, const std::optional<ParsedCommand>& parsed,
+                std::string_view what) noexcept;
     void answer(const Plc& plc, const WriteResponse& r);
     IdMemory::Entry& remember(const std::string& plc, const std::string& id);
     void publish(Message&& m);
@@ -94,6 +122,10 @@ class Bridge final : public PollerEvents {
     std::map<std::string, IdMemory, std::less<>> ids_;
     std::atomic<std::size_t> pending_commands_{0};
     std::atomic<std::uint64_t> dropped_commands_{0};
+    std::uint64_t failed_commands_ = 0;
+    std::uint64_t failures_unlogged_ = 0;  // since the last failure log line
+    std::chrono::steady_clock::time_point last_failure_log_{};
+    std::function<void(const ParsedCommand&)> command_hook_;
     asio::steady_timer report_timer_;
     std::chrono::steady_clock::time_point last_report_;
     PollerStats last_totals_{};

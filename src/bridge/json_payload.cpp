@@ -73,13 +73,12 @@ std::optional<ParsedCommand> JsonPayload::parse(std::string_view topic, std::str
     if (topic.size() <= prefix_.size() + 1 + suffix.size() || !topic.starts_with(prefix_) ||
         topic[prefix_.size()] != '/' || !topic.ends_with(suffix))
         return std::nullopt;
-    ParsedCommand c;
-    c.plc = std::string(
+    std::string plc(
         topic.substr(prefix_.size() + 1, topic.size() - prefix_.size() - 1 - suffix.size()));
-    const auto refuse = [&](std::string id, std::string error) {
-        c.refuse =
-            WriteResponse{std::move(id), false, std::nullopt, std::nullopt, std::move(error)};
-        return c;
+    const auto refuse = [&](std::string id, std::string error) -> std::optional<ParsedCommand> {
+        return Refusal{plc,
+                       WriteResponse{std::move(id), false, std::nullopt, std::nullopt,
+                                     std::move(error)}};
     };
     auto j = nlohmann::json::parse(payload, nullptr, false);
     if (j.is_discarded() || !j.is_object()) return refuse("", "the command is not a JSON object");
@@ -104,7 +103,7 @@ std::optional<ParsedCommand> JsonPayload::parse(std::string_view topic, std::str
     auto value = j.find("value");
     if (value == j.end()) return refuse(id, "the command has no value");
     WriteCommand w;
-    w.plc = c.plc;
+    w.plc = plc;
     w.id = id;
     w.tag = tag->get<std::string>();
     w.value = *value;
@@ -113,8 +112,7 @@ std::optional<ParsedCommand> JsonPayload::parse(std::string_view topic, std::str
             return refuse(id, "ts must be an integer (ms since the epoch)");
         w.ts_ms = ts->get<std::int64_t>();
     }
-    c.write = std::move(w);
-    return c;
+    return w;
 }
 
 }  // namespace fins::bridge

@@ -93,17 +93,22 @@ void MqttClient::loop() {
         std::lock_guard lock(mutex_);
         return closing_;
     };
+    // A new Will (Sparkplug: the next bdSeq) only once the last one went out in a CONNECT:
+    // an attempt that reached no broker sent none.
+    bool will_sent = true;
     while (!closing()) {
         const Broker& b = config_.brokers[broker % config_.brokers.size()];
         accepted_ = false;
-        if (handlers_.will) {
+        if (handlers_.will && will_sent) {
             will_ = handlers_.will();
             mosquitto_will_set(mosq_, will_.topic.c_str(), static_cast<int>(will_.payload.size()),
                                will_.payload.data(), will_.qos, will_.retain);
+            will_sent = false;
         }
         int rc = mosquitto_connect(mosq_, b.host.c_str(), b.port,
                                    static_cast<int>(config_.keepalive.count()));
         if (rc == MOSQ_ERR_SUCCESS) {
+            will_sent = true;  // connected: the CONNECT with this Will is on its way
             while (rc == MOSQ_ERR_SUCCESS && !closing())
                 rc = mosquitto_loop(mosq_, 100, 1);
             if (closing() && connected_) {

@@ -48,8 +48,9 @@ class MqttClient {
         std::function<void(std::string topic, std::string payload, bool retained)> message;
         // On the MQTT thread when an accepted connection is lost (not after stop()).
         std::function<void()> disconnected;
-        // When set, the Will for each CONNECT, asked for before every attempt (Sparkplug's
-        // NDEATH carries a bdSeq that changes per CONNECT); the constructor's `will` is then
+        // When set, the Will for each CONNECT, asked for before the first attempt and again
+        // after every attempt that sent a CONNECT (Sparkplug's NDEATH carries a bdSeq that
+        // changes per CONNECT, not per unreachable broker); the constructor's `will` is then
         // only the default.
         std::function<Message()> will;
     };

@@ -14,6 +14,7 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <variant>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -84,13 +85,23 @@ struct WriteResponse {
     std::string error;                      // empty when ok
 };
 
-// What an incoming message turned out to be.
-struct ParsedCommand {
-    std::optional<WriteCommand> write;    // a command to execute
-    std::optional<WriteResponse> refuse;  // or an answer at once (bad message)
-    std::string plc;                      // the PLC it concerns (for the answer topic)
-    bool rebirth = false;                 // Sparkplug: NCMD Node Control/Rebirth
+// What an incoming message turned out to be: exactly one of these, and the bridge handles
+// every alternative (Bridge::command visits it; a new alternative does not compile until it
+// is handled there).
+//   WriteCommand  a write to execute (the write path still checks tag, value, TTL, PLC);
+//   Refusal       a bad write command, answered at once on its PLC's response topic (JSON);
+//   NodeRebirth   Sparkplug NCMD "Node Control/Rebirth" = true: the birth sequence again;
+//   Rejected      a command addressed to this instance that is not executed and has no
+//                 response topic (Sparkplug): PayloadFormat::rejected() logs and counts it.
+struct Refusal {
+    std::string plc;          // the PLC it concerns (for the answer topic)
+    WriteResponse response;   // ok false, the reason in error
 };
+struct NodeRebirth {};
+struct Rejected {
+    std::string reason;
+};
+using ParsedCommand = std::variant<WriteCommand, Refusal, NodeRebirth, Rejected>;
 
 class PayloadFormat {
   public:
@@ -122,6 +133,14 @@ class PayloadFormat {
     // Parses a message on one of subscriptions(); nullopt when it is not for this format.
     virtual std::optional<ParsedCommand> parse(std::string_view topic, std::string_view payload,
                                                bool retained) = 0;
+    // A command on `topic` that is not executed and has no answer topic (a Rejected, or a
+    // NodeRebirth/Rejected whose handling failed): the format logs and counts it.
+    virtual void rejected(std::string_view topic, std::string_view reason) {
+        (void)topic;
+        (void)reason;
+    }
+    // Commands refused or failed so far, for the bridge's stats ("commands_rejected").
+    [[nodiscard]] virtual std::uint64_t rejected_commands() const { return 0; }
 };
 
 }  // namespace fins::bridge

@@ -33,7 +33,8 @@ int run(const BridgeConfig& given, const std::string& log_level) {
     asio::io_context io(1);
     Bridge bridge(
         io, config, make_format(config),
-        std::make_unique<cluster::ClusterOwnership>(config.instance, config.mqtt.topic_prefix));
+        std::make_unique<cluster::ClusterOwnership>(config.instance, config.mqtt.topic_prefix,
+                                                    config.payload));
     std::string error;
     if (!bridge.start(error)) {
         spdlog::error("{}", error);

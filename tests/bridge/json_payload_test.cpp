@@ -11,12 +11,14 @@ namespace {
 TEST(JsonPayload, ParsesAWriteCommand) {
     JsonPayload f("pre", "edge");
     auto c = f.parse("pre/press1/write", R"({"id":"a","tag":"temp","value":1.5,"ts":5})", false);
-    ASSERT_TRUE(c && c->write);
-    EXPECT_EQ(c->plc, "press1");
-    EXPECT_EQ(c->write->id, "a");
-    EXPECT_EQ(c->write->tag, "temp");
-    EXPECT_EQ(c->write->value, 1.5);
-    EXPECT_EQ(c->write->ts_ms, 5);
+    ASSERT_TRUE(c);
+    const auto* w = std::get_if<WriteCommand>(&*c);
+    ASSERT_TRUE(w);
+    EXPECT_EQ(w->plc, "press1");
+    EXPECT_EQ(w->id, "a");
+    EXPECT_EQ(w->tag, "temp");
+    EXPECT_EQ(w->value, 1.5);
+    EXPECT_EQ(w->ts_ms, 5);
     EXPECT_FALSE(f.parse("other/press1/write", "{}", false));
     EXPECT_FALSE(f.parse("pre/press1/write/response", "{}", false));
 }
@@ -25,8 +27,12 @@ TEST(JsonPayload, RefusesBadCommands) {
     JsonPayload f("pre", "edge");
     const auto refusal = [&](const std::string& text, bool retained = false) {
         auto c = f.parse("pre/p/write", text, retained);
-        EXPECT_TRUE(c && c->refuse && !c->write) << text;
-        return c && c->refuse ? c->refuse->error : std::string();
+        const auto* r = c ? std::get_if<Refusal>(&*c) : nullptr;
+        EXPECT_TRUE(r) << text;
+        if (r) {
+            EXPECT_EQ(r->plc, "p") << text;
+        }
+        return r ? r->response.error : std::string();
     };
     EXPECT_EQ(refusal("nope"), "the command is not a JSON object");
     EXPECT_EQ(refusal("[1]"), "the command is not a JSON object");

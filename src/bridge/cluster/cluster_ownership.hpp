@@ -5,6 +5,11 @@
 // on_status_message(), a lost connection to connection_lost(). Whenever the owner of some PLC
 // may have changed it calls the Ownership change handler; the bridge then starts polling what
 // it gained and stops what it lost (Bridge::reconcile()).
+//
+// A cluster is the instances of one payload kind: a status's "payload" ("sparkplug"; absent:
+// "json") is part of a member's identity. An instance of the other kind on the same prefix is
+// no member (logged): a JSON and a Sparkplug instance would otherwise split the PLCs between
+// them, and each PLC's data would appear in only one of the two forms.
 #pragma once
 
 #include <string>
@@ -17,7 +22,9 @@ namespace fins::bridge::cluster {
 
 class ClusterOwnership final : public Ownership {
   public:
-    ClusterOwnership(std::string instance, std::string topic_prefix);
+    // payload_kind: this instance's [bridge] payload ("json" or "sparkplug").
+    ClusterOwnership(std::string instance, std::string topic_prefix,
+                     std::string payload_kind = "json");
 
     [[nodiscard]] bool owns(std::string_view plc) const override { return membership_.owns(plc); }
     [[nodiscard]] bool owns_once_joined(std::string_view plc) const override {
@@ -34,6 +41,7 @@ class ClusterOwnership final : public Ownership {
 
   private:
     std::string prefix_;
+    std::string kind_;
     std::string filter_;
     Membership membership_;
 };

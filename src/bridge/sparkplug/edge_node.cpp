@@ -12,7 +12,7 @@ namespace {
 // k << 20 .. (k << 20) + 2^20 - 1, so an alias is unique across the Edge Node (chapter 6,
 // "alias") and stays the same across rebirths and ownership moves within one process.
 constexpr unsigned alias_shift = 20;
-constexpr std::size_t max_metrics_per_device = std::size_t{1} << alias_shift;
+[[maybe_unused]] constexpr std::size_t max_metrics_per_device = std::size_t{1} << alias_shift;
 
 void add_node_metric_bool(PbPayload& p, std::string_view name, bool v, std::uint64_t ts) {
     auto* m = p.add_metrics();
@@ -173,14 +173,14 @@ void EdgeNode::detach(const std::string& device, std::uint64_t now_ms, std::vect
 void EdgeNode::data(const std::string& device, std::span<const MetricUpdate> updates,
                     std::uint64_t now_ms, std::vector<Message>& out) {
     const auto it = devices_.find(device);
-    if (it == devices_.end() || !it->second.attached || updates.empty()) return;
+    if (it == devices_.end() || updates.empty()) return;
     auto& d = it->second;
     for (const auto& u : updates) {
         if (u.index >= d.metrics.size()) continue;
         d.last[u.index] = u.value;
         d.last_ts[u.index] = u.timestamp_ms;
     }
-    if (!born_) return;
+    if (!born_ || !d.attached) return;  // kept for the DBIRTH
     scratch_.Clear();
     scratch_.set_timestamp(now_ms);
     scratch_.set_seq(take_seq());

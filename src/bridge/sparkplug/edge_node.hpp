@@ -106,8 +106,9 @@ class EdgeNode {
     void detach(const std::string& device, std::uint64_t now_ms, std::vector<Message>& out);
     bool attached(const std::string& device) const;
 
-    // New values of an attached device: one DDATA (nothing if not born, not attached, or
-    // updates is empty). The values are also kept for the next DBIRTH.
+    // New values of a device: one DDATA (nothing if not born, not attached, or updates is
+    // empty). The values are also kept for the next DBIRTH, also while the device is detached:
+    // attach() after data() births it with them.
     void data(const std::string& device, std::span<const MetricUpdate> updates,
               std::uint64_t now_ms, std::vector<Message>& out);
 

@@ -1,5 +1,6 @@
 #include "bridge/sparkplug/sparkplug_payload.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <utility>
@@ -18,6 +19,13 @@ std::int64_t now_ms() {
     using namespace std::chrono;
     return duration_cast<milliseconds>(system_clock::now().time_since_epoch()).count();
 }
+
+template <class... F>
+struct overloaded : F... {
+    using F::operator()...;
+};
+template <class... F>
+overloaded(F...) -> overloaded<F...>;
 
 std::uint64_t ms(std::int64_t t) {
     return t < 0 ? 0 : static_cast<std::uint64_t>(t);
@@ -112,6 +120,7 @@ SparkplugPayload::SparkplugPayload(const BridgeConfig& config, std::string group
                 d.tags.emplace_back(g, t);
             }
         }
+        d.seen.assign(plc.groups.size(), false);
         node_.define_device(plc.name, std::move(defs));
         devices_.emplace(plc.name, std::move(d));
     }
@@ -156,16 +165,23 @@ void SparkplugPayload::status(const PlcStatus& st, const Sink& out) {
     if (!st.plc) return;
     if (awaiting_birth_) node_.connection_lost();
     // Device online/offline is DBIRTH/DDEATH (chapter 5: a Device that cannot be reached is
-    // DDEATH, its metrics stale for host applications, until its next DBIRTH).
-    if (st.online)
-        node_.attach(st.plc->name, ms(st.ts_ms), scratch_);
-    else
+    // DDEATH, its metrics stale for host applications, until its next DBIRTH). The DBIRTH
+    // waits for the first values of every group (values()): a DBIRTH of nulls with Quality
+    // BAD would tell host applications the PLC's values are bad when they are only not read
+    // yet.
+    const auto it = devices_.find(st.plc->name);
+    if (it != devices_.end()) std::fill(it->second.seen.begin(), it->second.seen.end(), false);
+    if (!st.online)
         node_.detach(st.plc->name, ms(st.ts_ms), scratch_);
+    else if (it != devices_.end() && it->second.seen.empty())
+        node_.attach(st.plc->name, ms(st.ts_ms), scratch_);  // no group: nothing to wait for
     emit(scratch_, out);
 }
 
 void SparkplugPayload::released(const Plc& plc, const Sink& out) {
     if (awaiting_birth_) node_.connection_lost();
+    const auto it = devices_.find(plc.name);
+    if (it != devices_.end()) std::fill(it->second.seen.begin(), it->second.seen.end(), false);
     node_.detach(plc.name, ms(now_ms()), scratch_);
     emit(scratch_, out);
 }
@@ -175,13 +191,12 @@ void SparkplugPayload::values(const GroupSample& s, const Sink& out) {
     if (awaiting_birth_) node_.connection_lost();  // keep the values, publish nothing
     const auto it = devices_.find(s.plc->name);
     if (it == devices_.end()) return;
-    const auto& d = it->second;
+    auto& d = it->second;
     std::size_t g = 0;
     while (g < s.plc->groups.size() && &s.plc->groups[g] != s.group)
         ++g;
     if (g == s.plc->groups.size()) return;
-    // A PLC that answers is online: born if it was not (its first values ride in the DBIRTH).
-    if (!node_.attached(s.plc->name)) node_.attach(s.plc->name, ms(s.ts_ms), scratch_);
+    d.seen[g] = true;
     updates_.clear();
     for (std::size_t t = 0; t < s.tags.size() && t < s.group->tags.size(); ++t) {
         const auto& sample = s.tags[t];
@@ -192,7 +207,12 @@ void SparkplugPayload::values(const GroupSample& s, const Sink& out) {
         if (!sample.error) u.value = to_metric_value(s.group->tags[t].type, sample.value);
         updates_.push_back(std::move(u));
     }
-    node_.data(s.plc->name, updates_, ms(s.ts_ms), scratch_);
+    node_.data(s.plc->name, updates_, ms(s.ts_ms), scratch_);  // kept while not attached
+    // A PLC that answers is online: born once every group has values, which ride in the
+    // DBIRTH (the values above were kept for it, not published).
+    if (!node_.attached(s.plc->name) &&
+        std::all_of(d.seen.begin(), d.seen.end(), [](bool b) { return b; }))
+        node_.attach(s.plc->name, ms(s.ts_ms), scratch_);
     emit(scratch_, out);
 }
 
@@ -206,51 +226,70 @@ void SparkplugPayload::write_response(const Plc& plc, const WriteResponse& r, co
     }
 }
 
+void SparkplugPayload::rejected(std::string_view topic, std::string_view reason) {
+    ++rejected_;
+    spdlog::warn("sparkplug: {} refused: {}", topic, reason);
+}
+
 std::optional<ParsedCommand> SparkplugPayload::parse(std::string_view topic,
                                                      std::string_view payload, bool retained) {
     const auto parts = parse_topic(topic);
     if (!parts || parts->group_id != node_.group_id() ||
         parts->edge_node_id != node_.edge_node_id())
         return std::nullopt;
-    ParsedCommand pc;
-    pc.plc = std::string(parts->device_id);
     if (retained) {
         // NCMD and DCMD are never retained (chapter 6): a retained one is stale, not executed.
-        ++rejected_;
-        spdlog::warn("sparkplug: retained {} on {} refused", parts->verb, topic);
-        return pc;
+        return Rejected{fmt::format("retained {} (a command is executed once, when sent)",
+                                    parts->verb)};
     }
     std::vector<Command> cmds;
     node_.on_command(topic, payload, cmds);
-    // The write path takes one command per message (ParsedCommand::write): a DCMD that sets
-    // several metrics executes the first and refuses the rest, logged (a host application
-    // writing one tag sends one metric).
-    bool have_write = false;
+    // One command per message: the first Rebirth or write is the answer, every other part of
+    // the message is rejected (logged and counted) here; a message with nothing to execute is
+    // Rejected with its first reason. A DCMD that sets several metrics executes the first (a
+    // host application writing one tag sends one metric).
+    std::optional<ParsedCommand> result;
+    std::optional<std::string> first_error;
+    const auto reject = [&](std::string reason) {
+        if (!first_error)
+            first_error = std::move(reason);
+        else
+            rejected(topic, reason);
+    };
     for (auto& c : cmds) {
-        if (std::holds_alternative<Rebirth>(c)) {
-            pc.rebirth = true;
-        } else if (auto* w = std::get_if<DeviceWrite>(&c)) {
-            if (have_write) {
-                ++rejected_;
-                spdlog::warn("sparkplug: DCMD on {}: one metric per DCMD, {} ignored", topic,
-                             w->metric);
-                continue;
-            }
-            const auto& dev = devices_.find(w->device)->second;
-            const auto [g, t] = dev.tags[w->index];
-            WriteCommand wc;
-            wc.plc = w->device;
-            wc.id = fmt::format("dcmd-{}-{}", node_.bd_seq(), ++next_id_);
-            wc.tag = dev.plc->groups[g].tags[t].name;
-            wc.value = to_json(w->value);
-            pc.write = std::move(wc);
-            have_write = true;
-        } else if (auto* e = std::get_if<CommandError>(&c)) {
-            ++rejected_;
-            spdlog::warn("sparkplug: {} refused: {}", topic, e->reason);
-        }
+        std::visit(overloaded{
+                       [&](const Rebirth&) {
+                           if (!result)
+                               result = NodeRebirth{};
+                           else
+                               reject("one command per NCMD: a second Rebirth ignored");
+                       },
+                       [&](const DeviceWrite& w) {
+                           if (result) {
+                               reject(fmt::format("one metric per DCMD: {} ignored", w.metric));
+                               return;
+                           }
+                           const auto dev = devices_.find(w.device);
+                           if (dev == devices_.end() || w.index >= dev->second.tags.size()) {
+                               reject(fmt::format("no metric {} on device {}", w.metric,
+                                                  w.device));
+                               return;
+                           }
+                           const auto [g, t] = dev->second.tags[w.index];
+                           WriteCommand wc;
+                           wc.plc = w.device;
+                           wc.id = fmt::format("dcmd-{}-{}", node_.bd_seq(), ++next_id_);
+                           wc.tag = dev->second.plc->groups[g].tags[t].name;
+                           wc.value = to_json(w.value);
+                           result = std::move(wc);
+                       },
+                       [&](const CommandError& e) { reject(e.reason); },
+                   },
+                   c);
     }
-    return pc;
+    if (!result) return Rejected{first_error.value_or(fmt::format("{} sets no metric", parts->verb))};
+    if (first_error) rejected(topic, *first_error);
+    return result;
 }
 
 }  // namespace fins::bridge::sparkplug

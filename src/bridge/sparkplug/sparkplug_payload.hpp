@@ -6,13 +6,17 @@
 //   session_will()         the NDEATH for the next CONNECT (bdSeq + 1): the Will of the
 //                          Sparkplug session, a connection of its own (QoS 1, not retained);
 //   connected()            NBIRTH and the DBIRTH of every PLC this instance publishes;
-//   status()               a PLC coming online: DBIRTH; going offline: DDEATH;
-//   values()               DDATA (the changed metrics; a failed read is null + Quality BAD);
-//   parse()                NCMD "Node Control/Rebirth" -> rebirth; DCMD -> one write command
-//                          per metric, into the same write path as JSON writes;
+//   status()               a PLC going offline: DDEATH; coming online: its DBIRTH waits for
+//                          values;
+//   values()               the first values of every group of a PLC (after start, or after it
+//                          was offline): its DBIRTH, carrying them; then DDATA (the changed
+//                          metrics; a failed read is null + Quality BAD);
+//   parse()                NCMD "Node Control/Rebirth" = true -> NodeRebirth; DCMD -> a write
+//                          command (one metric per DCMD), into the same write path as JSON
+//                          writes; anything else addressed to this Edge Node -> Rejected;
 //   released()             a PLC now owned by another instance: DDEATH.
 // Sparkplug has no write response: the read-back value is published as DDATA, a refused or
-// failed write is logged and counted (rejected_commands()).
+// failed command is logged and counted (rejected(), rejected_commands()), never executed.
 #pragma once
 
 #include <atomic>
@@ -58,7 +62,9 @@ class SparkplugPayload final : public PayloadFormat {
     // The PLC is now another instance's: DDEATH.
     void released(const Plc& plc, const Sink& out) override;
 
-    [[nodiscard]] std::uint64_t rejected_commands() const noexcept { return rejected_; }
+    // Logs and counts a command that is not executed.
+    void rejected(std::string_view topic, std::string_view reason) override;
+    [[nodiscard]] std::uint64_t rejected_commands() const override { return rejected_; }
     [[nodiscard]] const EdgeNode& node() const noexcept { return node_; }
 
   private:
@@ -67,6 +73,8 @@ class SparkplugPayload final : public PayloadFormat {
         std::vector<std::pair<std::size_t, std::size_t>> tags;
         std::vector<std::size_t> group_base;  // first metric index of each group
         const Plc* plc = nullptr;
+        // The groups with values since the device came online: its DBIRTH waits for all.
+        std::vector<bool> seen;
     };
     void emit(std::vector<sparkplug::Message>& msgs, const Sink& out);
 

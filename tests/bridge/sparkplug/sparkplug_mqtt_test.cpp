@@ -39,7 +39,10 @@ std::vector<Decoded> decode_all(const std::vector<tb::Received>& ms) {
         Decoded d;
         d.verb = parts[2];
         d.device = parts.size() > 4 ? parts[4] : "";
-        EXPECT_TRUE(d.payload.ParseFromString(m.payload)) << m.topic;
+        // Every message of the bridge decodes; a command a test sent may be junk on purpose.
+        if (!d.payload.ParseFromString(m.payload)) {
+            EXPECT_TRUE(d.verb == "NCMD" || d.verb == "DCMD") << m.topic;
+        }
         out.push_back(std::move(d));
     }
     return out;
@@ -186,4 +189,133 @@ TEST(SparkplugMqtt, BirthSequenceSeqWrapRebirthDcmdOnceAndNdeathOnKill) {
         EXPECT_EQ(bdseq_of(d.payload), bdseq);
         EXPECT_FALSE(d.payload.has_seq());
     }
+}
+
+// Issue 25: commands the bridge refuses used to abort fins-bridge (bad_alloc, exit 134), and a
+// retained DCMD at every start. Now: a retained DCMD waiting at start, then every refused kind
+// of command, are logged and counted, none written, and the bridge goes on (a Rebirth after
+// them is answered). Also: the first DBIRTH carries the first poll's values, bdSeq counts
+// CONNECTs (an unreachable first broker costs none), the stats count Sparkplug publishes.
+TEST(SparkplugMqtt, RefusedAndRetainedCommandsEndNothingAndTheFirstDbirthCarriesValues) {
+    if (tb::mosquitto_path().empty()) GTEST_SKIP() << "mosquitto is not installed";
+    fins::test::ScratchDir dir("sparkplug-refused");
+    tb::Mosquitto broker(dir.path());
+    ASSERT_TRUE(broker.started());
+    fins::test::Finsd finsd({});
+    ASSERT_TRUE(finsd.started());
+    tb::CountingRelay relay(1, finsd.port());
+    const auto dead = tb::free_tcp_port();  // nothing listens: the first broker fails
+    const std::string conf =
+        "[bridge]\ninstance = \"edge-1\"\npayload = \"sparkplug\"\nstats_s = 1\n"
+        "[mqtt]\nhosts = [\"127.0.0.1:" +
+        std::to_string(dead) + "\", \"127.0.0.1:" + std::to_string(broker.port()) +
+        "\"]\ntopic_prefix = \"plant\"\nbackoff_min_ms = 50\nbackoff_max_ms = 200\n"
+        "[[plc]]\nname = \"press1\"\nhost = \"127.0.0.1\"\nport = " +
+        std::to_string(relay.port(0)) +
+        "\n[[plc.group]]\nname = \"fast\"\ninterval_ms = 100\n"
+        "tags = [ { name = \"speed\", address = \"D100\", type = \"int16\" },\n"
+        "         { name = \"temp\", address = \"D200\", type = \"float\", writable = true } ]\n"
+        "[[plc.group]]\nname = \"slow\"\ninterval_ms = 300\n"
+        "tags = [ { name = \"count\", address = \"D300\", type = \"uint32\" } ]\n";
+    const auto conf_path = dir.write("bridge.toml", conf);
+    tb::Recorder rec(broker.port(), {"spBv1.0/#", "plant/$bridge/+/stats"});
+    ASSERT_TRUE(rec.connected());
+
+    // A valid DCMD, retained: the broker hands it to the bridge as it subscribes, every start.
+    const auto metric = [](const std::function<void(pb::Payload::Metric&)>& set) {
+        pb::Payload p;
+        p.set_timestamp(1);
+        set(*p.add_metrics());
+        return p.SerializeAsString();
+    };
+    const auto temp = metric([](auto& m) {
+        m.set_name("fast/temp");
+        m.set_datatype(pb::Float);
+        m.set_float_value(7.5F);
+    });
+    const std::string dcmd = "spBv1.0/plant/DCMD/edge-1/press1";
+    const std::string ncmd = "spBv1.0/plant/NCMD/edge-1";
+    rec.publish(dcmd, temp, 1, true);
+    ASSERT_TRUE(rec.wait_for([&](const tb::Received& r) { return r.topic == dcmd; }, 10s));
+
+    tb::Child bridge({tb::bridge_path, "--config", conf_path}, dir.path() / "bridge.log");
+    ASSERT_TRUE(
+        rec.wait([](const auto& ms) { return count_verb(decode_all(ms), "DBIRTH") >= 1; }, 30s))
+        << bridge.log();
+    auto ds = decode_all(rec.messages());
+    // bdSeq 0: the attempt on the dead broker sent no CONNECT.
+    ASSERT_EQ(ds[0].verb, "DCMD");
+    ASSERT_EQ(ds[1].verb, "NBIRTH");
+    EXPECT_EQ(bdseq_of(ds[1].payload), 0);
+    // The DBIRTH waited for both groups' first values: none is null.
+    ASSERT_EQ(ds[2].verb, "DBIRTH");
+    ASSERT_EQ(ds[2].payload.metrics_size(), 3);
+    for (const auto& m : ds[2].payload.metrics())
+        EXPECT_FALSE(m.is_null()) << m.name();
+
+    // Every refused kind of command; then a Rebirth, answered: the bridge lived through them.
+    const std::vector<std::pair<std::string, std::string>> refused{
+        {dcmd, metric([](auto& m) {  // read-only
+             m.set_name("fast/speed");
+             m.set_int_value(3);
+         })},
+        {dcmd, metric([](auto& m) {  // unknown metric
+             m.set_name("fast/nope");
+             m.set_int_value(3);
+         })},
+        {dcmd, metric([](auto& m) {  // the wrong value field for a Float
+             m.set_name("fast/temp");
+             m.set_int_value(3);
+         })},
+        {"spBv1.0/plant/DCMD/edge-1/nope", temp},  // unknown device
+        {ncmd, metric([](auto& m) {
+             m.set_name("Node Control/Rebirth");
+             m.set_boolean_value(false);
+         })},
+        {ncmd, metric([](auto& m) {  // unknown node metric
+             m.set_name("Node Control/Reboot");
+             m.set_boolean_value(true);
+         })},
+        {ncmd, "\xff\xff\xff"},  // not protobuf
+        {dcmd, "\xff\xff\xff"},
+    };
+    for (const auto& [topic, payload] : refused)
+        rec.publish(topic, payload, 0);
+    const auto before = rec.count();
+    rec.publish(ncmd, metric([](auto& m) {
+                    m.set_name("Node Control/Rebirth");
+                    m.set_boolean_value(true);
+                }),
+                0);
+    ASSERT_TRUE(rec.wait(
+        [&](const auto& ms) {
+            return count_verb(
+                       decode_all({ms.begin() + static_cast<std::ptrdiff_t>(before), ms.end()}),
+                       "NBIRTH") >= 1;
+        },
+        10s))
+        << bridge.log();
+    EXPECT_TRUE(bridge.running()) << bridge.log();
+
+    // The stats: 1 retained + 8 refused, none failed; the Sparkplug messages counted as
+    // published (at least those seen so far on spBv1.0/).
+    std::size_t seen = 0;
+    for (const auto& m : rec.messages())
+        seen += m.topic.rfind("spBv1.0/plant/D", 0) == 0 || m.topic.rfind("spBv1.0/plant/N", 0) == 0
+                    ? 1U
+                    : 0U;
+    seen -= 1 + refused.size() + 1;  // the commands are the recorder's, not the bridge's
+    const auto stats = rec.wait_topic(
+        "plant/$bridge/edge-1/stats",
+        [&](const nlohmann::json& j) {
+            return j.value("commands_rejected", 0U) >= 1 + refused.size() &&
+                   j.value("published", std::size_t{0}) >= seen;
+        },
+        10s);
+    ASSERT_TRUE(stats) << bridge.log();
+    EXPECT_EQ(stats->json().value("commands_rejected", 0U), 1 + refused.size());
+    EXPECT_EQ(stats->json().value("commands_failed", 1U), 0U);
+    EXPECT_EQ(relay.writes(0), 0U);  // nothing was written
+    EXPECT_TRUE(bridge.running());
+    EXPECT_NE(bridge.log().find("retained DCMD"), std::string::npos);
 }
