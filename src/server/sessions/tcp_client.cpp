@@ -6,6 +6,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include "server/sessions/failure_boundary.hpp"
+
 namespace fins::server {
 
 namespace {
@@ -185,8 +187,8 @@ void TcpClient::serve(Bytes command) {
     if (request_[destination_node_offset] == client_node_)
         request_[destination_node_offset] = self_.node;
     const RequestContext context{Link::tcp, std::chrono::system_clock::now(), nullptr};
-    const std::size_t n = dispatcher_.handle(Bytes{request_.data(), command.size()},
-                                             MutableBytes{out_.data(), out_.size()}, context);
+    const std::size_t n = handle_guarded(dispatcher_, Bytes{request_.data(), command.size()},
+                                         MutableBytes{out_.data(), out_.size()}, context);
     if (n == 0) return;
     if (out_[source_node_offset] == self_.node) out_[source_node_offset] = client_node_;
     ++counters_.served;

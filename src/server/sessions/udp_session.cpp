@@ -11,6 +11,7 @@
 #include <boost/asio/post.hpp>
 
 #include "server/dispatch/dispatcher.hpp"
+#include "server/sessions/failure_boundary.hpp"
 #include "server/metrics/metrics.hpp"
 #include "transport/asio.hpp"
 
@@ -170,8 +171,9 @@ int UdpSession::serve_batch() {
             response_hook_(frame, reinterpret_cast<const sockaddr*>(context.peer),
                            request.msg_hdr.msg_namelen))
             continue;
-        const std::size_t n = dispatcher_.handle(
-            Bytes{s.in[static_cast<std::size_t>(i)].data(), size}, s.out[replies], context);
+        const std::size_t n = handle_guarded(
+            dispatcher_, Bytes{s.in[static_cast<std::size_t>(i)].data(), size}, s.out[replies],
+            context);
         if (n == 0) continue;
         s.out_iov[replies].iov_len = n;
         auto& reply = s.out_msgs[replies].msg_hdr;
