@@ -36,6 +36,25 @@ void note_failure(FailureChannel channel, std::string_view where, std::string_vi
 std::size_t handle_guarded(Dispatcher& dispatcher, Bytes request, MutableBytes out,
                            const RequestContext& context) noexcept;
 
+// An answer to one of this node's own instructions handed to the instruction engine
+// (a session's response hook) inside the boundary: hook()'s result, or true (taken, so
+// it is not dispatched as well) when it throws, counted and logged like a request.
+template <class Hook>
+bool take_response_guarded(Hook&& hook) noexcept {
+    try {
+        return hook();
+    } catch (...) {
+        std::string what = "an exception";
+        try {
+            what = describe_exception(std::current_exception());
+        } catch (...) {
+            // No memory for the text.
+        }
+        note_failure(FailureChannel::fins, "an answer to an instruction", what);
+        return true;
+    }
+}
+
 // Test seam: when set, called with each request inside the boundary before the
 // dispatcher, so a test can make a request throw what a handler could (std::bad_alloc,
 // nlohmann::json's exceptions, std::out_of_range). Null (the default): nothing.

@@ -176,7 +176,9 @@ void TcpClient::on_frame(Bytes frame) {
     if ((frame[0] & icf_response) == 0) return serve(frame);
     // The connection's identity: its answers come from the node it was opened to.
     const bool from_remote = frame[source_node_offset] == remote_.node;
-    if (!from_remote || !response_hook_ || !response_hook_(frame, *this)) ++counters_.unmatched;
+    if (!from_remote || !response_hook_ ||
+        !take_response_guarded([&] { return response_hook_(frame, *this); }))
+        ++counters_.unmatched;
 }
 
 void TcpClient::serve(Bytes command) {

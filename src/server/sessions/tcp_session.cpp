@@ -223,7 +223,7 @@ bool TcpSession::handle_packet(const TcpPacket& packet) {
     }
     // An answer to one of this node's own instructions, sent to the client's node.
     if (response_hook_ && !packet.data.empty() && (packet.data[0] & icf_response) != 0 &&
-        response_hook_(packet.data))
+        take_response_guarded([&] { return response_hook_(packet.data); }))
         return true;
     // Reserve the envelope header, let the dispatcher write the FINS response after it.
     const MutableBytes frame_out{out_.data() + tcp_header_size, max_frame_size};

@@ -119,6 +119,22 @@ TEST(FailureBoundary, NoAnswerWhereNoneIsWantedButStillCounted) {
     EXPECT_EQ(failures(), before + 1);
 }
 
+TEST(FailureBoundary, AnInstructionAnswerWhoseHookThrowsIsTakenAndCounted) {
+    for (const auto kind : kinds) {
+        SCOPED_TRACE(static_cast<int>(kind));
+        const auto before = failures();
+        EXPECT_TRUE(server::take_response_guarded([kind] {
+            throw_as(kind);
+            return false;
+        }));
+        EXPECT_EQ(failures(), before + 1);
+    }
+    const auto before = failures();
+    EXPECT_FALSE(server::take_response_guarded([] { return false; }));
+    EXPECT_TRUE(server::take_response_guarded([] { return true; }));
+    EXPECT_EQ(failures(), before);
+}
+
 // A real server: UDP and FINS/TCP on one I/O thread, as finsd runs them.
 class FailureBoundaryServer : public IoThread, public ::testing::Test {
   protected:
