@@ -222,9 +222,11 @@ void control_route(WebContext& context, std::string_view body,
     if (j.is_discarded()) return done(error_answer(400, "the body is not JSON"));
     server::dispatch_control_request(context.targets, j, [done, &context](Json reply) {
         context.watches->touch_topics();  // a mode, a fault, a FAL: shown at the next tick
-        // The channel's own answer, as the Unix socket gives it; a refusal is a 400.
+        // The channel's own answer, as the Unix socket gives it; a refusal is a 400, a
+        // failure of the server's (the boundary's "internal": true) a 500.
         const bool refused = reply.contains("error") && !reply.contains("result");
-        done(json_answer(refused ? 400 : 200, reply));
+        const bool internal = reply.contains("internal");
+        done(json_answer(internal ? 500 : refused ? 400 : 200, reply));
     });
 }
 
@@ -248,9 +250,10 @@ std::optional<HttpAnswer> check_request(const WebOptions& options, const Request
     if (changes && meta.origin && !allowed_origin(options, *meta.origin))
         return error_answer(403, fmt::format("Origin {} may not use this server", *meta.origin));
     if (meta.method == "POST" && !options.token.empty()) {
-        constexpr std::string_view bearer = "Bearer ";
+        // The scheme is case-insensitive (RFC 9110 11.1): "bearer", "BEARER" too.
+        constexpr std::string_view bearer = "bearer ";
         const auto auth = meta.authorization.value_or(std::string_view{});
-        if (auth.substr(0, bearer.size()) != bearer ||
+        if (lower(auth.substr(0, bearer.size())) != bearer ||
             !same_secret(auth.substr(bearer.size()), options.token))
             return error_answer(403,
                                 "this server needs \"Authorization: Bearer <token>\" "
@@ -350,7 +353,10 @@ void handle_request(WebContext& context, std::string_view method, std::string_vi
         Json plcs = Json::array();
         for (const auto& t : context.targets)
             plcs.push_back(plc_entry(context, t));
-        return done(json_answer(200, Json{{"plcs", plcs}, {"control", context.options.control}}));
+        // token_required: POSTs need --http-token-file's token (the page asks for it).
+        return done(json_answer(200, Json{{"plcs", plcs},
+                                          {"control", context.options.control},
+                                          {"token_required", !context.options.token.empty()}}));
     }
     if (path == "/metrics" && context.metrics) {
         if (!get) return only("GET");

@@ -27,6 +27,14 @@ CHROMEDRIVER = "/usr/bin/chromedriver"
 START_TIMEOUT = 20.0  # an ASan finsd on a busy 2-core machine
 
 
+def free_port(host="127.0.0.1"):
+    """A TCP port free on `host` now (for a server that must come back on the same one)."""
+    import socket
+    with socket.socket() as s:
+        s.bind((host, 0))
+        return s.getsockname()[1]
+
+
 def _need(path):
     if not Path(path).exists():
         pytest.skip(f"{path} is not installed (Debian packages chromium, chromium-driver)")
@@ -35,11 +43,16 @@ def _need(path):
 class Finsd:
     """One finsd process: FINS on a free port, HTTP on a free port, a control socket."""
 
-    def __init__(self, args, config=None):
+    def __init__(self, args, config=None, http="127.0.0.1:0", token=None):
         self.dir = Path(tempfile.mkdtemp(prefix="finsd-browser-"))
         self.control = self.dir / "finsd.sock"
         cmd = [str(BIN / "finsd"), "--port", "0", "--control", str(self.control),
-               "--http", "127.0.0.1:0"] + list(args)
+               "--http", http] + list(args)
+        if token is not None:  # POSTs need "Authorization: Bearer TOKEN"
+            token_file = self.dir / "token"
+            token_file.write_text(token + "\n")
+            token_file.chmod(0o600)
+            cmd += ["--http-token-file", str(token_file)]
         if config is not None:
             path = self.dir / "finsd.toml"
             path.write_text(config)
@@ -119,8 +132,8 @@ class Finsd:
 def finsd_factory():
     started = []
 
-    def start(*args, config=None):
-        f = Finsd(args, config)
+    def start(*args, config=None, http="127.0.0.1:0", token=None):
+        f = Finsd(args, config, http, token)
         started.append(f)
         return f
 

@@ -162,6 +162,10 @@ TEST_F(Api, ListsTheCpuUnits) {
     EXPECT_EQ(plcs["plcs"][0]["node"], 1);
     EXPECT_EQ(plcs["plcs"][0]["model"], plc_.profile().model);
     EXPECT_EQ(plcs["control"], false);
+    // Whether POSTs need --http-token-file's token: the page asks for it when they do.
+    EXPECT_EQ(plcs["token_required"], false);
+    context_.options.token = "s3cret";
+    EXPECT_EQ(json(call("GET", "/api/plcs"))["token_required"], true);
 }
 
 TEST_F(Api, ChoosesThePlantsCpuUnitByNameOrAddress) {
@@ -223,6 +227,17 @@ TEST(ApiSecurity, ChecksHostOriginAndToken) {
         check({"POST", "/api/write", "127.0.0.1:8080", std::nullopt, "Bearer s3creT"})->status,
         403u);
     EXPECT_FALSE(check({"POST", "/api/write", "127.0.0.1:8080", std::nullopt, "Bearer s3cret"}));
+    // The scheme is case-insensitive (RFC 9110 11.1); the token is not.
+    EXPECT_FALSE(check({"POST", "/api/write", "127.0.0.1:8080", std::nullopt, "bearer s3cret"}));
+    EXPECT_FALSE(check({"POST", "/api/write", "127.0.0.1:8080", std::nullopt, "BEARER s3cret"}));
+    EXPECT_EQ(
+        check({"POST", "/api/write", "127.0.0.1:8080", std::nullopt, "BEARER S3CRET"})->status,
+        403u);
+    EXPECT_EQ(
+        check({"POST", "/api/write", "127.0.0.1:8080", std::nullopt, "Basic s3cret"})->status,
+        403u);
+    EXPECT_EQ(check({"POST", "/api/write", "127.0.0.1:8080", std::nullopt, "Bearer"})->status,
+              403u);
     EXPECT_FALSE(check({"GET", "/api/read", "127.0.0.1:8080", std::nullopt, std::nullopt}));
 }
 

@@ -2,12 +2,24 @@
 // that move with what happened (a FINS request through the dispatcher, HTTP answers).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <new>
+#include <random>
+#include <sstream>
 #include <string>
+#include <vector>
 
+#include <fmt/core.h>
+
+#include "fins/command_table.hpp"
 #include "fins/frame.hpp"
+#include "plc/plc.hpp"
+#include "server/control/control_dispatch.hpp"
+#include "server/dispatch/dispatcher.hpp"
 #include "server/metrics/metrics.hpp"
 #include "web_server.hpp"
 
@@ -73,6 +85,83 @@ TEST(Metrics, ServedTextPassesPromtool) {
               std::string::npos);
     const auto [rc, out] = promtool(r.body());
     EXPECT_EQ(rc, 0) << out << "\n" << r.body();
+}
+
+// The series of fins_requests_total in `text`.
+std::vector<std::string> request_series(const std::string& text) {
+    std::vector<std::string> out;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);)
+        if (line.rfind("fins_requests_total{", 0) == 0) out.push_back(line.substr(0, line.find('}')));
+    return out;
+}
+
+TEST(Metrics, CommandCodesFinsdDoesNotKnowShareOneSeries) {
+    plc::Plc plc;
+    server::Dispatcher dispatcher(plc, NodeAddress{0, 1, 0});
+    const auto before = request_series(expose(server::metrics::process_metrics()));
+    // A client sending random command codes: each answered 0401, none a series of its own.
+    std::mt19937 random(25);
+    std::array<std::uint8_t, max_frame_size> frame{};
+    std::array<std::uint8_t, max_frame_size> out{};
+    Header h;
+    h.destination = {0, 1, 0};
+    h.source = {0, 2, 0};
+    std::size_t unknown = 0;
+    for (int i = 0; i < 3000; ++i) {
+        const CommandCode c{static_cast<std::uint8_t>(random()), static_cast<std::uint8_t>(random())};
+        if (find_command(c) != nullptr) continue;
+        h.service_id = static_cast<std::uint8_t>(i);
+        const auto n = encode_request(h, c, {}, frame);
+        ASSERT_TRUE(n);
+        ASSERT_GT(dispatcher.handle(Bytes{frame.data(), *n}, out, {}), 0u);
+        ++unknown;
+    }
+    ASSERT_GT(unknown, 2000u);
+    const auto after = request_series(expose(server::metrics::process_metrics()));
+    EXPECT_LE(after.size(), before.size() + 1);
+    EXPECT_NE(std::find(after.begin(), after.end(),
+                        "fins_requests_total{command=\"other\",end_code=\"0401\""),
+              after.end());
+    // A command of the table keeps its own series.
+    const auto n = encode_request(h, CommandCode{0x01, 0x01}, Bytes{}, frame);
+    ASSERT_TRUE(n);
+    dispatcher.handle(Bytes{frame.data(), *n}, out, {});
+    const auto known = request_series(expose(server::metrics::process_metrics()));
+    EXPECT_NE(std::find_if(known.begin(), known.end(),
+                           [](const std::string& s) {
+                               return s.rfind("fins_requests_total{command=\"0101\"", 0) == 0;
+                           }),
+              known.end());
+}
+
+void throw_bad_alloc(const nlohmann::json&) {
+    throw std::bad_alloc();
+}
+
+TEST(Metrics, ControlFailuresOverHttpAreAnsweredCountedAndExported) {
+    web::WebOptions o;
+    o.control = true;
+    WebServer s(o);
+    HttpClient c(s.port());
+    const auto before = server::metrics::process_metrics().control_failures.load();
+    server::set_control_fault_for_tests(throw_bad_alloc);
+    auto r = c.request(http::verb::post, "/api/control", R"({"cmd":"mode","mode":"program"})");
+    server::set_control_fault_for_tests(nullptr);
+    EXPECT_EQ(r.result_int(), 500u);
+    EXPECT_EQ(body_json(r)["error"], "internal error: std::bad_alloc (out of memory)") << r.body();
+    // The server goes on: the same connection, the next request.
+    r = c.request(http::verb::post, "/api/control", R"({"cmd":"mode","mode":"program"})");
+    EXPECT_EQ(r.result_int(), 200u) << r.body();
+    r = c.request(http::verb::get, "/metrics");
+    EXPECT_NE(r.body().find(fmt::format("fins_control_failures_total {}\n", before + 1)),
+              std::string::npos)
+        << r.body();
+    EXPECT_NE(r.body().find("fins_request_failures_total "), std::string::npos);
+    if (std::system("command -v promtool >/dev/null 2>&1") == 0) {
+        const auto [rc, out] = promtool(r.body());
+        EXPECT_EQ(rc, 0) << out << "\n" << r.body();
+    }
 }
 
 }  // namespace

@@ -27,6 +27,7 @@
 
 #include "server/control/control_dispatch.hpp"
 #include "server/control/control_requests.hpp"
+#include "server/sessions/failure_boundary.hpp"
 #include "transport/asio.hpp"
 
 namespace fins::server {
@@ -73,7 +74,7 @@ class Session : public std::enable_shared_from_this<Session> {
         asio::async_read_until(
             socket_, buffer_, '\n',
             [self = shared_from_this()](boost::system::error_code ec, std::size_t n) {
-                self->on_line(ec, n);
+                self->guarded([&] { self->on_line(ec, n); });
             });
     }
 
@@ -86,6 +87,29 @@ class Session : public std::enable_shared_from_this<Session> {
                 if (ec || generation != self->generation_ || self->waiting_) return;
                 self->close();
             });
+    }
+
+    // The failure boundary of a connection's own work (reading a line, parsing it,
+    // writing an answer; a request's verb has its own in dispatch_control_request):
+    // what throws is counted and logged, and closes this connection only.
+    template <class F>
+    void guarded(F&& f) noexcept {
+        try {
+            f();
+        } catch (...) {
+            std::string what = "an exception";
+            try {
+                what = describe_exception(std::current_exception());
+            } catch (...) {
+                // No memory for the text.
+            }
+            note_failure(FailureChannel::control, "a control connection", what);
+            try {
+                close();
+            } catch (...) {
+                // The socket goes with the session.
+            }
+        }
     }
 
     void on_line(boost::system::error_code ec, std::size_t n) {
@@ -126,7 +150,7 @@ class Session : public std::enable_shared_from_this<Session> {
             socket_, asio::buffer(reply_),
             [self = shared_from_this(), close_after](boost::system::error_code ec, std::size_t) {
                 if (ec || close_after || self->shared_->stopped) return self->close();
-                self->read();
+                self->guarded([&] { self->read(); });
             });
     }
 
@@ -167,10 +191,15 @@ struct ControlServer::Impl {
             [this, shared = shared](boost::system::error_code ec, stream::socket socket) {
                 if (shared->stopped || ec == asio::error::operation_aborted) return;
                 if (!ec) {
-                    make_room();
-                    auto session = std::make_shared<Session>(std::move(socket), shared);
-                    sessions.push_back(session);
-                    session->start();
+                    try {
+                        make_room();
+                        auto session = std::make_shared<Session>(std::move(socket), shared);
+                        sessions.push_back(session);
+                        session->start();
+                    } catch (...) {  // this client is not served; the channel goes on
+                        note_failure(FailureChannel::control, "accepting a control connection",
+                                     "out of memory or another exception");
+                    }
                 }
                 accept();
             });

@@ -2,17 +2,30 @@
 #include "server/control/control_dispatch.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <charconv>
 #include <exception>
+#include <memory>
 
 #include <fmt/core.h>
 
 #include "server/control/control_requests.hpp"
 #include "server/control/control_scenario.hpp"
+#include "server/sessions/failure_boundary.hpp"
 
 namespace fins::server {
 
 using Json = nlohmann::json;
+
+namespace {
+
+std::atomic<ControlFault> control_fault{nullptr};
+
+}  // namespace
+
+void set_control_fault_for_tests(ControlFault fault) noexcept {
+    control_fault.store(fault, std::memory_order_relaxed);
+}
 
 std::optional<std::pair<std::uint8_t, std::uint8_t>> parse_net_node(std::string_view text) {
     const auto dot = text.find('.');
@@ -51,8 +64,11 @@ const ControlTarget* find_control_target(std::span<const ControlTarget> targets,
     return nullptr;
 }
 
-void dispatch_control_request(std::span<const ControlTarget> targets, const Json& j,
-                              const ControlReply& reply) {
+namespace {
+
+void dispatch_unguarded(std::span<const ControlTarget> targets, const Json& j,
+                        const ControlReply& reply) {
+    if (const auto fault = control_fault.load(std::memory_order_relaxed)) fault(j);
     if (!j.is_object() || !j.contains("cmd") || !j["cmd"].is_string())
         return reply(control_error("expected an object with a string \"cmd\""));
     std::optional<std::string_view> wanted;
@@ -70,11 +86,67 @@ void dispatch_control_request(std::span<const ControlTarget> targets, const Json
         if (handle_instruction_request(target->instructions, target->schedule, j, reply)) return;
         answer = j["cmd"] == "scenario" ? handle_scenario_request(target->scenario, j)
                                         : handle_control_request(*target->plc, j);
-    } catch (const std::exception& e) {
+    } catch (const Json::exception& e) {
+        // A key of the wrong type (handle_control_request's contract): the client's
+        // mistake. Anything else a verb throws is this server's: the boundary below.
         answer = control_error(std::string("bad request: ") + e.what());
     }
     if (!target->name.empty() && answer.contains("status")) answer["status"]["plc"] = target->name;
     reply(std::move(answer));
+}
+
+std::string command_of(const Json& j) {
+    if (j.is_object())
+        if (const auto it = j.find("cmd"); it != j.end() && it->is_string())
+            return "control request \"" + it->get<std::string>() + "\"";
+    return "a control request";
+}
+
+}  // namespace
+
+void dispatch_control_request(std::span<const ControlTarget> targets, const Json& j,
+                              const ControlReply& reply) {
+    // The failure boundary (sessions/failure_boundary.hpp): `reply` is called exactly
+    // once whatever throws, and nothing thrown leaves this function, neither now nor
+    // when an instruction's answer comes later.
+    std::shared_ptr<bool> answered;
+    // Calls `reply` unless it was called; what the caller's reply throws is counted.
+    const auto answer_once = [](const ControlReply& to, bool& done, Json answer) noexcept {
+        if (done) return;
+        done = true;
+        try {
+            to(std::move(answer));
+        } catch (...) {
+            note_failure(FailureChannel::control, "the answer to a control request",
+                         "an exception while the answer was sent");
+        }
+    };
+    try {
+        answered = std::make_shared<bool>(false);
+        const ControlReply once = [reply, answered, answer_once](Json answer) {
+            answer_once(reply, *answered, std::move(answer));
+        };
+        dispatch_unguarded(targets, j, once);
+    } catch (...) {
+        std::string what = "an exception";
+        std::string where = "a control request";
+        try {
+            what = describe_exception(std::current_exception());
+            where = command_of(j);
+        } catch (...) {
+            // Out of memory for the text: the defaults say enough.
+        }
+        note_failure(FailureChannel::control, where, what);
+        bool never_answered = false;  // no memory even for the flag: nothing was answered
+        bool& done = answered != nullptr ? *answered : never_answered;
+        try {
+            Json answer = control_error("internal error: " + what);
+            answer["internal"] = true;
+            answer_once(reply, done, std::move(answer));
+        } catch (...) {
+            // No memory for the answer: the counter and the log line have it.
+        }
+    }
 }
 
 }  // namespace fins::server

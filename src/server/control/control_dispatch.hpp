@@ -30,7 +30,17 @@ const ControlTarget* find_control_target(std::span<const ControlTarget> targets,
 // once, at once for the PLC verbs and errors, when the instruction completes for send /
 // recv / sendcmd (later, on the io_context). A "status" answer of a named CPU Unit
 // carries its name as status.plc.
+//
+// The failure boundary of both channels (sessions/failure_boundary.hpp): whatever a verb
+// throws, other than nlohmann::json's exceptions for a mistyped key ({"error":"bad
+// request: ..."}), answers {"error":"internal error: WHAT","internal":true} (HTTP 500), counts in
+// fins_control_failures_total and logs (rate-limited); nothing escapes to the io_context.
 void dispatch_control_request(std::span<const ControlTarget> targets, const nlohmann::json& request,
                               const ControlReply& reply);
+
+// Test seam: when set, called with each request inside the boundary before the verb, so
+// a test can make a request throw. Null (the default): nothing.
+using ControlFault = void (*)(const nlohmann::json& request);
+void set_control_fault_for_tests(ControlFault fault) noexcept;
 
 }  // namespace fins::server

@@ -3,6 +3,8 @@
 
 #include <fmt/core.h>
 
+#include "fins/command_table.hpp"
+
 namespace fins::server::metrics {
 
 namespace {
@@ -89,7 +91,10 @@ void start_request() noexcept {
 void note_request(CommandCode command, EndCode code) noexcept {
     auto& m = process_metrics();
     const auto started = request_started;
-    m.requests.add(std::uint32_t{command.value()} << 16 | static_cast<std::uint16_t>(code));
+    if (find_command(command) != nullptr)
+        m.requests.add(std::uint32_t{command.value()} << 16 | static_cast<std::uint16_t>(code));
+    else
+        m.other_requests.add(static_cast<std::uint16_t>(code));
     m.request_duration.observe(Clock::now() - started);
 }
 
@@ -117,6 +122,14 @@ void note_websocket_resync() noexcept {
     process_metrics().websocket_resyncs.fetch_add(1, std::memory_order_relaxed);
 }
 
+void note_request_failure() noexcept {
+    process_metrics().request_failures.fetch_add(1, std::memory_order_relaxed);
+}
+
+void note_control_failure() noexcept {
+    process_metrics().control_failures.fetch_add(1, std::memory_order_relaxed);
+}
+
 std::string expose(const Metrics& m, std::span<const Family> extra) {
     std::string out;
     out.reserve(8192);
@@ -132,8 +145,11 @@ std::string expose(const Metrics& m, std::span<const Family> extra) {
         line("fins_requests_total",
              fmt::format("command=\"{:04X}\",end_code=\"{:04X}\"", key >> 16, key & 0xFFFF), n);
     });
-    if (m.requests.overflow() != 0)
-        line("fins_requests_total", "command=\"other\",end_code=\"other\"", m.requests.overflow());
+    m.other_requests.for_each([&](std::uint32_t key, std::uint64_t n) {
+        line("fins_requests_total", fmt::format("command=\"other\",end_code=\"{:04X}\"", key), n);
+    });
+    if (const auto n = m.requests.overflow() + m.other_requests.overflow(); n != 0)
+        line("fins_requests_total", "command=\"other\",end_code=\"other\"", n);
 
     const auto& h = m.request_duration;
     header(out, "fins_request_duration_seconds",
@@ -177,6 +193,15 @@ std::string expose(const Metrics& m, std::span<const Family> extra) {
     header(out, "fins_websocket_resyncs_total",
            "WebSocket clients that fell behind: queue dropped, snapshots sent", "counter");
     line("fins_websocket_resyncs_total", "", m.websocket_resyncs.load(std::memory_order_relaxed));
+
+    header(out, "fins_request_failures_total",
+           "FINS requests whose handling failed with an exception (answered 0301 or dropped)",
+           "counter");
+    line("fins_request_failures_total", "", m.request_failures.load(std::memory_order_relaxed));
+    header(out, "fins_control_failures_total",
+           "Control requests whose handling failed with an exception (answered an error)",
+           "counter");
+    line("fins_control_failures_total", "", m.control_failures.load(std::memory_order_relaxed));
 
     for (const auto& f : extra) {
         header(out, f.name, f.help, f.type);

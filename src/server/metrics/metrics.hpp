@@ -13,6 +13,7 @@
 //   UdpSession::note_dropped    note_datagrams_dropped(n)
 //   Router::forward / relay_error   note_relay() / note_relay_error(end code)
 //   NetworkInstructions::finish note_instruction(kind, completion code)
+//   sessions/failure_boundary.cpp  note_request_failure() / note_control_failure()
 // Gauges (connections by state, file memory bytes, serial ports) are read at scrape time
 // by the caller and passed to expose().
 #pragma once
@@ -75,7 +76,11 @@ class Histogram {
 };
 
 struct Metrics {
-    KeyedCounter requests;  // key: command code << 16 | end code (flag bits off)
+    // key: command code << 16 | end code (flag bits off), for the commands of
+    // command_table() only: any other code a client sends is counted in other_requests,
+    // so random command codes add no series (exposed as command="other").
+    KeyedCounter requests;
+    KeyedCounter other_requests;  // key: end code
     Histogram request_duration;
     std::atomic<std::uint64_t> datagrams_dropped{0};
     std::atomic<std::uint64_t> relays{0};
@@ -83,6 +88,9 @@ struct Metrics {
     KeyedCounter instructions;   // key: kind << 16 | completion code (0000 done)
     KeyedCounter http_requests;  // key: HTTP status
     std::atomic<std::uint64_t> websocket_resyncs{0};
+    // Requests whose handling threw (sessions/failure_boundary.hpp).
+    std::atomic<std::uint64_t> request_failures{0};
+    std::atomic<std::uint64_t> control_failures{0};
 };
 
 // The process's metrics (every Server, Router and engine of a plant shares them).
@@ -100,6 +108,8 @@ void note_relay_error(EndCode code) noexcept;
 void note_instruction(std::uint8_t kind, std::uint16_t completion) noexcept;
 void note_http_request(unsigned status) noexcept;
 void note_websocket_resync() noexcept;
+void note_request_failure() noexcept;
+void note_control_failure() noexcept;
 
 // A gauge (or a counter the caller keeps) for expose(): one sample per label set.
 struct Sample {

@@ -8,6 +8,7 @@
 #include <boost/asio/write.hpp>
 
 #include "server/dispatch/dispatcher.hpp"
+#include "server/sessions/failure_boundary.hpp"
 #include "transport/asio.hpp"
 #include "transport/serial_options.hpp"
 
@@ -153,8 +154,8 @@ void SerialSession::on_frame(Bytes frame) {
     }
     const RequestContext context{Link::serial, std::chrono::system_clock::now()};
     // The answer buffer holds Host Link's 538 data bytes: longer answers get 110B.
-    const auto n =
-        dispatcher_.handle(Bytes{fins_in_.data(), decoded->fins_size}, fins_out_, context);
+    const auto n = handle_guarded(dispatcher_, Bytes{fins_in_.data(), decoded->fins_size},
+                                  fins_out_, context);
     if (n == 0) return;  // no-response bit, or nothing to answer
     auto size =
         encode_host_link_response(options_.unit, decoded->form, Bytes{fins_out_.data(), n}, tx_);

@@ -6,6 +6,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include "server/sessions/failure_boundary.hpp"
+
 namespace fins::server {
 
 namespace {
@@ -174,7 +176,9 @@ void TcpClient::on_frame(Bytes frame) {
     if ((frame[0] & icf_response) == 0) return serve(frame);
     // The connection's identity: its answers come from the node it was opened to.
     const bool from_remote = frame[source_node_offset] == remote_.node;
-    if (!from_remote || !response_hook_ || !response_hook_(frame, *this)) ++counters_.unmatched;
+    if (!from_remote || !response_hook_ ||
+        !take_response_guarded([&] { return response_hook_(frame, *this); }))
+        ++counters_.unmatched;
 }
 
 void TcpClient::serve(Bytes command) {
@@ -185,8 +189,8 @@ void TcpClient::serve(Bytes command) {
     if (request_[destination_node_offset] == client_node_)
         request_[destination_node_offset] = self_.node;
     const RequestContext context{Link::tcp, std::chrono::system_clock::now(), nullptr};
-    const std::size_t n = dispatcher_.handle(Bytes{request_.data(), command.size()},
-                                             MutableBytes{out_.data(), out_.size()}, context);
+    const std::size_t n = handle_guarded(dispatcher_, Bytes{request_.data(), command.size()},
+                                         MutableBytes{out_.data(), out_.size()}, context);
     if (n == 0) return;
     if (out_[source_node_offset] == self_.node) out_[source_node_offset] = client_node_;
     ++counters_.served;

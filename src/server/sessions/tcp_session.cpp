@@ -15,6 +15,7 @@
 
 #include "fins/frame.hpp"
 #include "server/dispatch/dispatcher.hpp"
+#include "server/sessions/failure_boundary.hpp"
 #include "transport/asio.hpp"
 
 namespace fins::server {
@@ -222,12 +223,12 @@ bool TcpSession::handle_packet(const TcpPacket& packet) {
     }
     // An answer to one of this node's own instructions, sent to the client's node.
     if (response_hook_ && !packet.data.empty() && (packet.data[0] & icf_response) != 0 &&
-        response_hook_(packet.data))
+        take_response_guarded([&] { return response_hook_(packet.data); }))
         return true;
     // Reserve the envelope header, let the dispatcher write the FINS response after it.
     const MutableBytes frame_out{out_.data() + tcp_header_size, max_frame_size};
     const RequestContext context{Link::tcp, std::chrono::system_clock::now(), this};
-    const std::size_t n = dispatcher_.handle(packet.data, frame_out, context);
+    const std::size_t n = handle_guarded(dispatcher_, packet.data, frame_out, context);
     if (n > 0) {
         write_tcp_header(w, TcpCommand::frame, n);
         out_size_pending_ = tcp_header_size + n;

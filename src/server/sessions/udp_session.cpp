@@ -11,6 +11,7 @@
 #include <boost/asio/post.hpp>
 
 #include "server/dispatch/dispatcher.hpp"
+#include "server/sessions/failure_boundary.hpp"
 #include "server/metrics/metrics.hpp"
 #include "transport/asio.hpp"
 
@@ -167,11 +168,14 @@ int UdpSession::serve_batch() {
         // One it did not wait for goes on to the dispatcher: in a plant the router
         // relays answers for other nodes; a single node drops them there.
         if (response_hook_ && size > 0 && (frame[0] & icf_response) != 0 &&
-            response_hook_(frame, reinterpret_cast<const sockaddr*>(context.peer),
-                           request.msg_hdr.msg_namelen))
+            take_response_guarded([&] {
+                return response_hook_(frame, reinterpret_cast<const sockaddr*>(context.peer),
+                                      request.msg_hdr.msg_namelen);
+            }))
             continue;
-        const std::size_t n = dispatcher_.handle(
-            Bytes{s.in[static_cast<std::size_t>(i)].data(), size}, s.out[replies], context);
+        const std::size_t n = handle_guarded(
+            dispatcher_, Bytes{s.in[static_cast<std::size_t>(i)].data(), size}, s.out[replies],
+            context);
         if (n == 0) continue;
         s.out_iov[replies].iov_len = n;
         auto& reply = s.out_msgs[replies].msg_hdr;

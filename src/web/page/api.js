@@ -33,10 +33,41 @@ export async function getJson(path, params = {}) {
   return answer(await fetch(path + query(params), {headers: {Accept: 'application/json'}}));
 }
 
+// The bearer token of a finsd started with --http-token-file (docs/web.md "Remote
+// set-up"): asked for by the page, kept in this tab's sessionStorage only, sent on
+// every POST.
+const TOKEN_KEY = 'finsd-token';
+
+export function token() {
+  try {
+    return sessionStorage.getItem(TOKEN_KEY) || '';
+  } catch {
+    return '';
+  }
+}
+
+export function setToken(value) {
+  try {
+    if (value) sessionStorage.setItem(TOKEN_KEY, value);
+    else sessionStorage.removeItem(TOKEN_KEY);
+  } catch {
+    // storage off: the token lasts until the page is reloaded
+  }
+}
+
+// finsd's 403 for a POST without the right token (api.cpp check_request) names the
+// Authorization header; its other 403s (control off, Host, Origin) do not.
+export function isTokenRefusal(e) {
+  return e instanceof ApiError && e.status === 403 && /Authorization|Bearer|token/.test(e.message);
+}
+
 export async function postJson(path, body, params = {}) {
+  const headers = {'Content-Type': 'application/json', Accept: 'application/json'};
+  const t = token();
+  if (t) headers.Authorization = `Bearer ${t}`;
   return answer(await fetch(path + query(params), {
     method: 'POST',
-    headers: {'Content-Type': 'application/json', Accept: 'application/json'},
+    headers,
     body: JSON.stringify(body),
   }));
 }

@@ -1,6 +1,6 @@
 // finsd's page: wires the API (api.js) to the grid, the trend and the panels.
 // Nothing here is fetched from elsewhere (CSP default-src 'self').
-import {getJson, postJson, Live, ApiError} from './api.js';
+import {getJson, postJson, Live, ApiError, token, setToken, isTokenRefusal} from './api.js';
 import {Grid} from './grid.js';
 import {Trend} from './trend.js';
 import {VIEWS, view} from './values.js';
@@ -12,6 +12,7 @@ const state = {
   plcs: [],
   plc: null,          // the selected entry of /api/plcs
   control: null,      // null: not known yet (the first 403 says "off")
+  tokenRequired: false,  // POSTs need --http-token-file's token (/api/plcs token_required)
   status: null,
   statusLive: false,  // the WebSocket's status topic has answered: stop polling
 };
@@ -30,12 +31,79 @@ function toast(text, kind = 'bad') {
   toastTimer = setTimeout(() => { t.hidden = true; }, 4000);
 }
 
+const READ_ONLY = 'Read only: finsd was started without --http-control';
+
+// Every control of the page that changes the PLC: disabled, with the reason as its title,
+// on a read-only finsd (panels.js does the same for the switches it renders).
+function markControls() {
+  const off = state.control === false;
+  const controls = [...$('mode-buttons').querySelectorAll('button'),
+                    ...$('fal-form').querySelectorAll('input, select, button'),
+                    ...$('cpu-errors').querySelectorAll('button')];
+  for (const c of controls) {
+    c.disabled = off;
+    if (off) c.title = READ_ONLY;
+    else if (c.title === READ_ONLY) c.removeAttribute('title');
+  }
+  $('grid').setAttribute('aria-readonly', String(off));
+}
+
 function setControl(on) {
   state.control = on;
   const b = $('control-badge');
   b.textContent = on === false ? 'read only' : on ? 'control' : '—';
   b.className = `badge ${on === false ? 'muted' : on ? 'ok' : 'unknown'}`;
   document.body.classList.toggle('read-only', on === false);
+  markControls();
+  if (state.status) panels.renderSwitches(state.status, app);
+}
+
+// ---- the token (finsd --http-token-file) ---------------------------------------------------
+
+// Asks for the token in the page's dialog; resolves to it, or '' when cancelled.
+function askToken(refused) {
+  const dialog = $('token-dialog');
+  const input = $('token-input');
+  $('token-refused').hidden = !refused;
+  input.value = '';
+  return new Promise((resolve) => {
+    const done = () => {
+      dialog.removeEventListener('close', done);
+      resolve(dialog.returnValue === 'ok' ? input.value.trim() : '');
+    };
+    dialog.addEventListener('close', done);
+    dialog.returnValue = '';
+    dialog.showModal();
+    input.focus();
+  });
+}
+
+let asking = null;  // one dialog for the POSTs that need it at once
+async function ensureToken(refused) {
+  if (!asking) asking = askToken(refused).finally(() => { asking = null; });
+  const t = await asking;
+  setToken(t);
+  return t;
+}
+
+// A POST with the token when finsd needs one: asked for first when none is kept, asked
+// again (and the request sent again) when finsd says the token is wrong.
+async function post(path, body) {
+  let refused = false;
+  for (let attempt = 0; attempt < 3; attempt++) {
+    if (state.tokenRequired && !token() && !(await ensureToken(refused))) {
+      throw new ApiError(0, 'No token given: nothing was sent (finsd needs its --http-token-file token)');
+    }
+    try {
+      return await postJson(path, body, {plc: plcKey(state.plc)});
+    } catch (e) {
+      if (!isTokenRefusal(e)) throw e;
+      state.tokenRequired = true;  // a finsd restarted with a token since /api/plcs
+      refused = !!token();
+      setToken('');
+    }
+  }
+  throw new ApiError(403, 'finsd refused the token');
 }
 
 async function call(promise) {
@@ -44,7 +112,7 @@ async function call(promise) {
     if (state.control === null) setControl(true);
     return r;
   } catch (e) {
-    if (e instanceof ApiError && e.status === 403) setControl(false);
+    if (e instanceof ApiError && e.status === 403 && !isTokenRefusal(e)) setControl(false);
     toast(e.message);
     throw e;
   }
@@ -52,14 +120,14 @@ async function call(promise) {
 
 async function write(body) {
   try {
-    await call(postJson('/api/write', body, {plc: plcKey(state.plc)}));
+    await call(post('/api/write', body));
   } catch {
     // shown by call()
   }
 }
 
 async function control(cmd) {
-  const r = await call(postJson('/api/control', cmd, {plc: plcKey(state.plc)}));
+  const r = await call(post('/api/control', cmd));
   if (r && r.error) throw new Error(r.error);
   refreshStatus();
   return r;
@@ -75,10 +143,21 @@ const app = {
   addTrend: (tag) => trend.add(tag),
 };
 
+let wasOffline = false;
 app.live = new Live(onMessage, (s) => {
   $('link').dataset.state = s;
   document.body.dataset.link = s;  // stale values are dimmed while offline
   $('link-text').textContent = s;
+  // finsd may have restarted with other options (--http-control, a token, other CPU
+  // Units): what /api/plcs says is read again after every reconnect.
+  if (s === 'offline') wasOffline = true;
+  else if (s === 'live' && wasOffline) {
+    wasOffline = false;
+    loadPlcs().then(() => {
+      const p = state.plcs.find((x) => plcKey(x) === plcKey(state.plc));
+      if (p) selectPlc(p);
+    });
+  }
 });
 
 const grid = new Grid($('grid'), app);
@@ -253,6 +332,7 @@ function showStatus(s) {
   else if (typeof s.http_control === 'boolean') setControl(s.http_control);
   panels.renderCpu(s, state.plc);
   panels.renderSwitches(s, app);
+  markControls();
   panels.renderConnections(s);
   panels.renderLogs(s);
   panels.renderScenario(s);
@@ -321,9 +401,14 @@ function wire() {
   }
   document.addEventListener('visibilitychange', () => app.live.pause(document.hidden));
   $('help-button').addEventListener('click', () => $('help').showModal());
+  $('token-cancel').addEventListener('click', () => $('token-dialog').close('cancel'));
+  $('token-form').addEventListener('submit', (e) => {
+    // method=dialog closes the dialog with the button's value ("ok" or "cancel")
+    if (e.submitter?.value === 'ok' && !$('token-input').value.trim()) e.preventDefault();
+  });
   document.addEventListener('keydown', (e) => {
     const typing = e.target instanceof HTMLInputElement || e.target instanceof HTMLSelectElement;
-    if (typing || e.ctrlKey || e.metaKey || e.altKey || $('help').open) return;
+    if (typing || e.ctrlKey || e.metaKey || e.altKey || $('help').open || $('token-dialog').open) return;
     if (e.key === 'g' || e.key === '/') {
       e.preventDefault();
       $('goto').focus();
@@ -351,6 +436,18 @@ function wire() {
   });
 }
 
+// /api/plcs: the CPU Units, whether control is on and whether POSTs need the token.
+async function loadPlcs() {
+  try {
+    const j = await getJson('/api/plcs');
+    state.plcs = Array.isArray(j.plcs) ? j.plcs : [];
+    state.tokenRequired = j.token_required === true;
+    if (typeof j.control === 'boolean') setControl(j.control);
+  } catch (e) {
+    toast(`finsd did not list its CPU Units: ${e.message}`);
+  }
+}
+
 async function main() {
   wire();
   renderViews();
@@ -358,13 +455,7 @@ async function main() {
   if (h.as) grid.setView(h.as);
   markView();
   app.live.start();
-  try {
-    const j = await getJson('/api/plcs');
-    state.plcs = Array.isArray(j.plcs) ? j.plcs : [];
-    if (typeof j.control === 'boolean') setControl(j.control);
-  } catch (e) {
-    toast(`finsd did not list its CPU Units: ${e.message}`);
-  }
+  await loadPlcs();
   const wanted = h.plc && state.plcs.find((x) => plcKey(x) === h.plc || `${x.net}.${x.node}` === h.plc);
   selectPlc(wanted || state.plcs[0] || null, h.addr || 'D0');
   $('grid').focus({preventScroll: true});

@@ -129,7 +129,13 @@ export function renderSwitches(s, app) {
   for (const sw of SWITCHES) {
     if (!(sw.key in s) && !sw.value) continue;
     const on = sw.value ? sw.value(s) : s[sw.key];
-    ul.append(switchRow(sw.label, sw.hint, on, flip(sw.cmd), `switch-${sw.key}`, sw.kind));
+    const li = switchRow(sw.label, sw.hint, on, flip(sw.cmd), `switch-${sw.key}`, sw.kind);
+    if (!app.control()) {
+      const input = li.querySelector('input');
+      input.disabled = true;
+      input.title = 'Read only: finsd was started without --http-control';
+    }
+    ul.append(li);
   }
   // What cannot be switched at run time: shown, not offered.
   const p = s.protections && typeof s.protections === 'object' ? s.protections : {};
