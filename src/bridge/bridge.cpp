@@ -77,9 +77,13 @@ bool Bridge::start(std::string& error) {
         const auto more = format_->subscriptions();
         subscriptions.insert(subscriptions.end(), more.begin(), more.end());
     }
+    // The connection that carries JSON write commands is a persistent session: writes
+    // published while the bridge reconnects or is stopped are queued by the broker and
+    // delivered on the next connect (docs/bridge.md "Writes"). Sparkplug's Edge Node session
+    // must start clean (its specification); its status connection stays as it was.
     mqtt_ = std::make_unique<MqttClient>(config_.mqtt, format_->bridge_status(false),
                                          format_->bridge_status(true), std::move(subscriptions),
-                                         std::move(h));
+                                         std::move(h), !session);
     if (!mqtt_->start(error)) return false;
     if (session) {
         // Sparkplug's Edge Node session: its own client id, its NDEATH as the Will.
@@ -121,6 +125,8 @@ void Bridge::reconcile() {
             format_->released(p->plc(), sink_);
         }
     }
+    // After the pollers: a PLC this instance now owns is started before its writes.
+    release_held();
 }
 
 void Bridge::publish(Message&& m) {
@@ -185,9 +191,38 @@ void Bridge::incoming(std::string topic, std::string payload, bool retained) {
     });
 }
 
+std::size_t Bridge::remembered_ids() const noexcept {
+    std::size_t n = 0;
+    for (const auto& [plc, m] : ids_)
+        n += m.entries.size();
+    return n;
+}
+
+void Bridge::release_held() {
+    if (held_.empty() || !ownership_->joined()) return;
+    // In the order they came, before any command that comes after them.
+    while (!held_.empty() && ownership_->joined() && !stopped_) {
+        Held h = std::move(held_.front());
+        held_.pop_front();
+        command(h.topic, h.payload, h.retained, h.arrival);
+    }
+}
+
 void Bridge::command(const std::string& topic, const std::string& payload, bool retained,
                      Clock::time_point arrival) {
     if (ownership_->on_message(topic, payload)) return;  // membership
+    if (!ownership_->joined()) {
+        // Who owns the PLC is not known yet: the command waits (its time here counts against
+        // ttl_s), at most max_pending_commands of them.
+        if (held_.size() >= max_pending_commands) {
+            ++dropped_commands_;
+            spdlog::warn("command on {} dropped: {} commands wait for this instance to join",
+                         topic, held_.size());
+            return;
+        }
+        held_.push_back({topic, payload, retained, arrival});
+        return;
+    }
     auto parsed = format_->parse(topic, payload, retained);
     if (!parsed) return;
     // Its owner answers. A retained command arrives as this instance subscribes, before it
@@ -196,10 +231,6 @@ void Bridge::command(const std::string& topic, const std::string& payload, bool 
     if (!parsed->rebirth && !ownership_->owns(parsed->plc) &&
         !(retained && parsed->refuse && ownership_->owns_once_joined(parsed->plc)))
         return;
-    auto it = pollers_.find(parsed->plc);
-    Plc unknown;
-    unknown.name = parsed->plc;
-    const Plc& plc = it != pollers_.end() ? it->second->plc() : unknown;
     if (parsed->rebirth) {
         // A host application asks for the whole birth sequence again (Sparkplug NCMD).
         format_->connected(sink_);
@@ -207,6 +238,22 @@ void Bridge::command(const std::string& topic, const std::string& payload, bool 
             format_->status(st, sink_);
         return;
     }
+    auto it = pollers_.find(parsed->plc);
+    if (it == pollers_.end()) {
+        // A PLC the configuration does not have (the topic is the sender's): refused, and
+        // nothing is remembered for it (the id memory is per configured PLC, bounded).
+        Plc unknown;
+        unknown.name = parsed->plc;
+        WriteResponse r = parsed->refuse ? *parsed->refuse : WriteResponse{};
+        if (parsed->write) {
+            r.id = parsed->write->id;
+            r.error = fmt::format("no PLC named '{}' in this bridge's configuration", parsed->plc);
+        }
+        r.ok = false;
+        format_->write_response(unknown, r, sink_);
+        return;
+    }
+    const Plc& plc = it->second->plc();
     if (parsed->refuse) {
         // A repeated id is answered as the first time, even when refused.
         if (!parsed->refuse->id.empty()) {
@@ -231,9 +278,14 @@ void Bridge::command(const std::string& topic, const std::string& payload, bool 
     const auto refuse = [&](std::string error) {
         answer(plc, WriteResponse{w.id, false, std::nullopt, std::nullopt, std::move(error)});
     };
-    if (it == pollers_.end()) return refuse(fmt::format("no PLC named '{}'", w.plc));
     const auto ttl = config_.write.ttl;
-    if (w.ts_ms && epoch_ms() - *w.ts_ms > ttl.count())
+    const auto skew = config_.write.ts_skew;
+    // Compared on this side so that no ts, however far off, overflows.
+    const std::int64_t now_ms = epoch_ms();
+    if (w.ts_ms && *w.ts_ms > now_ms + skew.count())
+        return refuse(fmt::format("ts is more than {} ms ahead of the bridge's clock (ts_skew_s)",
+                                  skew.count()));
+    if (w.ts_ms && *w.ts_ms < now_ms - ttl.count())
         return refuse(fmt::format("command older than the TTL ({} ms)", ttl.count()));
     if (Clock::now() - arrival > ttl)
         return refuse(fmt::format("command waited longer than the TTL ({} ms)", ttl.count()));

@@ -145,7 +145,7 @@ TEST(BridgeRun, TlsAndPasswordBroker) {
                                      d + "/passwd\n"};
     Finsd finsd{{}};
     ASSERT_TRUE(broker.started() && finsd.started());
-    Recorder sub(broker.port(), "t/#", {d + "/ca.crt", "bridge", "s3cret"});
+    Recorder sub(broker.port(), "t/#", {d + "/ca.crt", "bridge", "s3cret", ""});
     ASSERT_TRUE(sub.connected());
     BridgeProcess bridge(dir, mqtt_section(broker.port(), "ca_file = \"" + d +
                                                               "/ca.crt\"\nusername = \"bridge\"\n"
@@ -155,7 +155,7 @@ TEST(BridgeRun, TlsAndPasswordBroker) {
         return j.value("full", false);
     })) << bridge.stop().err;
     // A wrong password is refused by the broker: nothing is published.
-    Recorder wrong(broker.port(), "t/#", {d + "/ca.crt", "bridge", "wrong"});
+    Recorder wrong(broker.port(), "t/#", {d + "/ca.crt", "bridge", "wrong", ""});
     EXPECT_FALSE(wrong.connected());
 }
 
