@@ -13,6 +13,8 @@ namespace fins::bridge::cluster {
 Membership::Membership(std::string self) : self_(std::move(self)) {}
 
 bool Membership::on_status(std::string_view instance, std::string_view payload) {
+    // No status topic names the empty instance (status_topic_instance()): not a member.
+    if (instance.empty()) return false;
     bool online = false;
     if (!payload.empty()) {
         // Anything but a JSON object with "state":"online" counts as not alive: a member is
