@@ -15,8 +15,8 @@
 #include <string_view>
 #include <vector>
 
-#include <boost/asio/io_context.hpp>
 #include <spdlog/spdlog.h>
+#include <boost/asio/io_context.hpp>
 
 #include "bridge/bridge.hpp"
 #include "bridge/json_payload.hpp"
@@ -90,9 +90,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     std::string_view rest(reinterpret_cast<const char*>(data + 1), size - 1);
     std::string topic;
     switch (mode & 3) {
-        case 0: topic = "f/p/write"; break;
-        case 1: topic = "f/nosuch/write"; break;
-        case 2: topic = "f//write"; break;
+        case 0:
+            topic = "f/p/write";
+            break;
+        case 1:
+            topic = "f/nosuch/write";
+            break;
+        case 2:
+            topic = "f//write";
+            break;
         default: {
             const auto nl = rest.find('\n');
             topic = std::string(rest.substr(0, nl));
@@ -125,7 +131,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         check(j.is_object());
         check(j.contains("ok") && j["ok"] == false);
         check(j.contains("id") && (j["id"].is_string() || j["id"].is_number_integer()));
-        check(j.contains("error") && j["error"].is_string() && !j["error"].get<std::string>().empty());
+        check(j.contains("error") && j["error"].is_string() &&
+              !j["error"].get<std::string>().empty());
     }
     // Remembered: only for the configured PLC, at most id_memory ids.
     check(bridge.remembered_plcs() <= 1 && bridge.remembered_ids() <= 4);

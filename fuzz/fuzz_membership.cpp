@@ -70,7 +70,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         } else {
             const auto tab = line.find('\t');
             const auto instance = line.substr(0, tab);
-            const auto payload = tab == std::string_view::npos ? std::string_view{} : line.substr(tab + 1);
+            const auto payload =
+                tab == std::string_view::npos ? std::string_view{} : line.substr(tab + 1);
             const auto changes = m.changes();
             const bool changed = m.on_status(instance, payload);
             check(m.changes() == changes + (changed ? 1 : 0));

@@ -216,8 +216,8 @@ void Bridge::command(const std::string& topic, const std::string& payload, bool 
         // ttl_s), at most max_pending_commands of them.
         if (held_.size() >= max_pending_commands) {
             ++dropped_commands_;
-            spdlog::warn("command on {} dropped: {} commands wait for this instance to join",
-                         topic, held_.size());
+            spdlog::warn("command on {} dropped: {} commands wait for this instance to join", topic,
+                         held_.size());
             return;
         }
         held_.push_back({topic, payload, retained, arrival});

@@ -60,7 +60,8 @@ void JsonPayload::status(const PlcStatus& st, const Sink& out) {
 
 void JsonPayload::write_response(const Plc& plc, const WriteResponse& r, const Sink& out) {
     // r.id is the id's JSON text (parse() below): echoed with its JSON type; none: "".
-    nlohmann::json id = r.id.empty() ? nlohmann::json("") : nlohmann::json::parse(r.id, nullptr, false);
+    nlohmann::json id =
+        r.id.empty() ? nlohmann::json("") : nlohmann::json::parse(r.id, nullptr, false);
     if (id.is_discarded()) id = r.id;
     nlohmann::json j{{"id", std::move(id)}, {"ok", r.ok}};
     j["end_code"] = r.end_code ? nlohmann::json(fmt::format("{:04X}", *r.end_code)) : nullptr;

@@ -28,8 +28,8 @@ bool overlaps(const Tag& a, const Tag& b) {
 std::optional<std::string> PlcPoller::write(const Tag& tag, const Encoded& value, std::string id) {
     if (!running_) return "this instance does not poll the PLC";
     // A UDP PLC being contacted for the first time takes frames already (as its polls do).
-    const bool can_send =
-        state_ == State::online || (state_ == State::connecting && plc_.transport == Transport::udp);
+    const bool can_send = state_ == State::online ||
+                          (state_ == State::connecting && plc_.transport == Transport::udp);
     if (!can_send)
         return last_error_.empty() ? std::string("PLC offline") : "PLC offline: " + last_error_;
     if (writes_.size() >= max_pending_writes)
@@ -122,13 +122,14 @@ void PlcPoller::finish_write(PendingWrite& op, std::error_code error,
     events_.write_done(plc_, r);
     // The writes that waited for this one and now have no earlier write to their words:
     // sent now, or failed as this one did when the PLC is gone.
-    const bool can_send =
-        state_ == State::online || (state_ == State::connecting && plc_.transport == Transport::udp);
+    const bool can_send = state_ == State::online ||
+                          (state_ == State::connecting && plc_.transport == Transport::udp);
     for (std::size_t i = 0; i < writes_.size(); ++i) {
         PendingWrite& w = *writes_[i];
         if (!w.waiting || !overlaps(*w.tag, *op.tag)) continue;
-        const bool behind = std::any_of(writes_.begin(), writes_.begin() + static_cast<std::ptrdiff_t>(i),
-                                        [&w](const auto& e) { return overlaps(*e->tag, *w.tag); });
+        const bool behind =
+            std::any_of(writes_.begin(), writes_.begin() + static_cast<std::ptrdiff_t>(i),
+                        [&w](const auto& e) { return overlaps(*e->tag, *w.tag); });
         if (behind) continue;
         if (can_send) {
             send_write(w);

@@ -52,8 +52,8 @@ inline bool answers_id(const nlohmann::json& j, const std::string& id) {
 }
 
 // The first answer to the write command `id`, if one comes.
-inline std::optional<nlohmann::json> response(Recorder& sub, const std::string& id,
-                                              const std::string& topic = "t/press1/write/response") {
+inline std::optional<nlohmann::json> response(
+    Recorder& sub, const std::string& id, const std::string& topic = "t/press1/write/response") {
     auto r = sub.wait_topic(topic, [&](const nlohmann::json& j) { return answers_id(j, id); });
     if (!r) return std::nullopt;
     return r->json();

@@ -211,14 +211,16 @@ TEST(BridgeRun, BadConfigStopsAtStartWithItsPosition) {
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_EQ(r.err.rfind("fins-bridge: " + file + ":8:", 0), 0u) << r.err;
     // min above max, an empty host, a CA file that is not there: the same, at their key.
-    const auto range = dir.write(
-        "range.toml", "[[plc]]\nname = \"a\"\nhost = \"h\"\n[[plc.group]]\nname = \"g\"\n"
-                      "tags = [{name=\"x\", address=\"D0\", type=\"int16\", min=3, max=1}]\n");
+    const auto range =
+        dir.write("range.toml",
+                  "[[plc]]\nname = \"a\"\nhost = \"h\"\n[[plc.group]]\nname = \"g\"\n"
+                  "tags = [{name=\"x\", address=\"D0\", type=\"int16\", min=3, max=1}]\n");
     r = fins::test::run({bridge_path, "--config", range});
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_EQ(r.err.rfind("fins-bridge: " + range + ":6:", 0), 0u) << r.err;
-    const auto ca = dir.write("ca.toml", "[mqtt]\nca_file = \"/nonexistent/ca.crt\"\n[[plc]]\n"
-                                         "name = \"a\"\nhost = \"\"\n");
+    const auto ca = dir.write("ca.toml",
+                              "[mqtt]\nca_file = \"/nonexistent/ca.crt\"\n[[plc]]\n"
+                              "name = \"a\"\nhost = \"\"\n");
     r = fins::test::run({bridge_path, "--config", ca});
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_EQ(r.err.rfind("fins-bridge: " + ca + ":2:11: ca_file", 0), 0u) << r.err;

@@ -8,8 +8,8 @@
 
 #include <map>
 #include <set>
-#include <utility>
 #include <string>
+#include <utility>
 
 #include "bridge_rig.hpp"
 
@@ -67,8 +67,8 @@ TEST(BridgeSession, WritesPublishedWhileTheBridgeIsStoppedAreAnsweredOnceWhenItS
     ASSERT_TRUE(broker.started() && finsd.started() && sub.connected());
     const auto config = mqtt_section(broker.port()) + plc("press1", finsd.port()) + tags;
     auto bridge = std::make_unique<BridgeProcess>(dir, config);
-    ASSERT_TRUE(sub.wait_topic("t/press1/status",
-                               [](const json& j) { return j["state"] == "online"; }));
+    ASSERT_TRUE(
+        sub.wait_topic("t/press1/status", [](const json& j) { return j["state"] == "online"; }));
     auto from = sub.count();
     bridge->stop();
     ASSERT_TRUE(sub.wait_topic(
@@ -138,8 +138,8 @@ TEST(BridgeSession, WritesAroundARestartOfABrokerWithPersistenceAreEachAnsweredO
     ASSERT_TRUE(broker.started() && finsd.started() && sub.connected());
     const auto config = mqtt_section(broker.port()) + plc("press1", finsd.port()) + tags;
     auto bridge = std::make_unique<BridgeProcess>(dir, config);
-    ASSERT_TRUE(sub.wait_topic("t/press1/status",
-                               [](const json& j) { return j["state"] == "online"; }));
+    ASSERT_TRUE(
+        sub.wait_topic("t/press1/status", [](const json& j) { return j["state"] == "online"; }));
 
     std::vector<std::string> ids;
     int n = 0;

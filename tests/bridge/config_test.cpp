@@ -138,7 +138,8 @@ TEST(BridgeConfig, MinAboveMaxIsAnErrorAtMin) {
 }
 
 TEST(BridgeConfig, EmptyHostsAreErrors) {
-    EXPECT_EQ(parse_error("[mqtt]\nhost = \"\"\n" + one_group("{name=\"a\",address=\"D0\",type=\"int16\"}")),
+    EXPECT_EQ(parse_error("[mqtt]\nhost = \"\"\n" +
+                          one_group("{name=\"a\",address=\"D0\",type=\"int16\"}")),
               "t.toml:2:8: host must not be empty");
     EXPECT_EQ(parse_error("[[plc]]\nname = \"p\"\nhost = \"\"\n[[plc.group]]\nname = \"g\"\n"
                           "tags = [{name=\"a\",address=\"D0\",type=\"int16\"}]\n"),
@@ -152,8 +153,8 @@ TEST(BridgeConfig, ATlsFileThatCannotBeReadIsAnErrorAtItsKey) {
 }
 
 TEST(BridgeConfig, PortAloneUsesTheDefaultHost) {
-    auto c = parse_ok("[mqtt]\nport = 1884\n" +
-                      one_group("{name=\"a\",address=\"D0\",type=\"int16\"}"));
+    auto c =
+        parse_ok("[mqtt]\nport = 1884\n" + one_group("{name=\"a\",address=\"D0\",type=\"int16\"}"));
     ASSERT_EQ(c.mqtt.brokers.size(), 1u);
     EXPECT_EQ(c.mqtt.brokers[0].host, "127.0.0.1");
     EXPECT_EQ(c.mqtt.brokers[0].port, 1884);

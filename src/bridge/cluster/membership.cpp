@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <utility>
 
-#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
+#include <nlohmann/json.hpp>
 
 #include "bridge/cluster/rendezvous.hpp"
 
@@ -42,9 +42,10 @@ bool Membership::on_status(std::string_view instance, std::string_view payload) 
         const std::size_t others = online_.size() - online_.count(self_);
         if (others >= max_members && instance != self_) {
             if (refused_++ % 1024 == 0)
-                spdlog::warn("cluster: status of '{}' ignored: {} members known already (the "
-                             "bound), {} ignored so far",
-                             instance, online_.size(), refused_);
+                spdlog::warn(
+                    "cluster: status of '{}' ignored: {} members known already (the "
+                    "bound), {} ignored so far",
+                    instance, online_.size(), refused_);
             if (was_synced == synced_) return false;
         } else {
             online_.emplace(instance);

@@ -20,8 +20,8 @@
 // the caller then asks owns() for each PLC and starts or stops polling.
 #pragma once
 
-#include <cstdint>
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <set>
 #include <string>

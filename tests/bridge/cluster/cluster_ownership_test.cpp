@@ -135,7 +135,7 @@ TEST(ClusterMembership, JunkAndClearedStatusesAreNotMembers) {
     EXPECT_FALSE(m.on_status("y", R"({"state":"maybe"})"));
     EXPECT_FALSE(m.on_status("z", R"(["online"])"));
     EXPECT_TRUE(m.on_status("w", online));
-    EXPECT_TRUE(m.on_status("w", ""));  // retained status deleted
+    EXPECT_TRUE(m.on_status("w", ""));      // retained status deleted
     EXPECT_FALSE(m.on_status("", online));  // no topic names it (fuzz_membership)
     EXPECT_EQ(m.members(), std::vector<std::string>{"edge-1"});
 }
