@@ -53,7 +53,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     cl::Membership m("self");
     bool first = true;
     std::size_t lines = 0;
-    while (!in.empty() && lines++ < 4096) {
+    while (!in.empty() && lines++ < 600) {
         const auto nl = in.find('\n');
         const auto line = in.substr(0, nl);
         in = nl == std::string_view::npos ? std::string_view{} : in.substr(nl + 1);
@@ -76,7 +76,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             const bool changed = m.on_status(instance, payload);
             check(m.changes() == changes + (changed ? 1 : 0));
         }
-        invariants(m);
+        if (lines % 16 == 0) invariants(m);
     }
+    invariants(m);
     return 0;
 }
