@@ -309,8 +309,14 @@ int main(int argc, char** argv) {
     const long hwm = status_kib(pid, "VmHWM:");
     writing = false;
     writer.join();
+    // The subscriber stops before the model is read: its callback takes model.mutex, and
+    // mosquitto_loop_stop() waits for that callback, so stopping it while holding the mutex
+    // (as this did) waited forever for a callback that waited for the mutex. DISCONNECT ends
+    // the loop thread after the callback in progress; the join is then bounded.
+    mosquitto_disconnect(sub);
+    mosquitto_loop_stop(sub, false);
 
-    std::lock_guard lock(model.mutex);
+    std::lock_guard lock(model.mutex);  // no other thread is left: for the analyser
     double values_per_s = 0;
     std::uint64_t overruns = 0, timeouts = 0, dropped = 0, published = 0;
     if (model.stats.size() > stats0 + 1) {
@@ -352,7 +358,6 @@ int main(int argc, char** argv) {
                100.0 * (finsd1 - finsd0) / elapsed, 100.0 * (broker1 - broker0) / elapsed);
     fmt::print("bridge RSS            {:.1f} MiB (peak {:.1f} MiB)\n",
                static_cast<double>(rss) / 1024.0, static_cast<double>(hwm) / 1024.0);
-    mosquitto_loop_stop(sub, true);
     mosquitto_destroy(sub);
     mosquitto_lib_cleanup();
     bridge.terminate(SIGTERM);

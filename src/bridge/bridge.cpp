@@ -86,9 +86,13 @@ bool Bridge::start(std::string& error) {
         const auto more = format_->subscriptions();
         subscriptions.insert(subscriptions.end(), more.begin(), more.end());
     }
+    // The connection that carries JSON write commands is a persistent session: writes
+    // published while the bridge reconnects or is stopped are queued by the broker and
+    // delivered on the next connect (docs/bridge.md "Writes"). Sparkplug's Edge Node session
+    // must start clean (its specification); its status connection stays as it was.
     mqtt_ = std::make_unique<MqttClient>(config_.mqtt, format_->bridge_status(false),
                                          format_->bridge_status(true), std::move(subscriptions),
-                                         std::move(h));
+                                         std::move(h), !session);
     if (!mqtt_->start(error)) return false;
     if (session) {
         // Sparkplug's Edge Node session: its own client id, its NDEATH as the Will.
@@ -130,6 +134,8 @@ void Bridge::reconcile() {
             format_->released(p->plc(), sink_);
         }
     }
+    // After the pollers: a PLC this instance now owns is started before its writes.
+    release_held();
 }
 
 void Bridge::publish(Message&& m) {
@@ -256,9 +262,38 @@ void Bridge::failed(const std::string& topic, bool retained,
     }
 }
 
+std::size_t Bridge::remembered_ids() const noexcept {
+    std::size_t n = 0;
+    for (const auto& [plc, m] : ids_)
+        n += m.entries.size();
+    return n;
+}
+
+void Bridge::release_held() {
+    if (held_.empty() || !ownership_->joined()) return;
+    // In the order they came, before any command that comes after them.
+    while (!held_.empty() && ownership_->joined() && !stopped_) {
+        Held h = std::move(held_.front());
+        held_.pop_front();
+        handle(h.topic, h.payload, h.retained, h.arrival);
+    }
+}
+
 void Bridge::command(const std::string& topic, const std::string& payload, bool retained,
                      Clock::time_point arrival, std::optional<ParsedCommand>& parsed) {
     if (ownership_->on_message(topic, payload)) return;  // membership
+    if (!ownership_->joined()) {
+        // Who owns the PLC is not known yet: the command waits (its time here counts against
+        // ttl_s), at most max_pending_commands of them.
+        if (held_.size() >= max_pending_commands) {
+            ++dropped_commands_;
+            spdlog::warn("command on {} dropped: {} commands wait for this instance to join", topic,
+                         held_.size());
+            return;
+        }
+        held_.push_back({topic, payload, retained, arrival});
+        return;
+    }
     parsed = format_->parse(topic, payload, retained);
     if (!parsed) return;
     if (command_hook_) command_hook_(*parsed);
@@ -285,9 +320,17 @@ void Bridge::refuse(const Refusal& r, bool retained) {
     // joined (docs/bridge.md "Several instances").
     if (!ownership_->owns(r.plc) && !(retained && ownership_->owns_once_joined(r.plc))) return;
     const auto it = pollers_.find(r.plc);
-    Plc unknown;
-    unknown.name = r.plc;
-    const Plc& plc = it != pollers_.end() ? it->second->plc() : unknown;
+    if (it == pollers_.end()) {
+        // A PLC the configuration does not have (the topic is the sender's): refused, and
+        // nothing is remembered for it (the id memory is per configured PLC, bounded).
+        Plc unknown;
+        unknown.name = r.plc;
+        WriteResponse response = r.response;
+        response.ok = false;
+        format_->write_response(unknown, response, sink_);
+        return;
+    }
+    const Plc& plc = it->second->plc();
     // A repeated id is answered as the first time, even when refused.
     if (!r.response.id.empty()) {
         auto& m = ids_[plc.name];
@@ -302,9 +345,19 @@ void Bridge::refuse(const Refusal& r, bool retained) {
 void Bridge::execute(const WriteCommand& w, Clock::time_point arrival) {
     if (!ownership_->owns(w.plc)) return;  // its owner answers
     auto it = pollers_.find(w.plc);
-    Plc unknown;
-    unknown.name = w.plc;
-    const Plc& plc = it != pollers_.end() ? it->second->plc() : unknown;
+    if (it == pollers_.end()) {
+        // A PLC the configuration does not have (the topic is the sender's): refused, and
+        // nothing is remembered for it (the id memory is per configured PLC, bounded).
+        Plc unknown;
+        unknown.name = w.plc;
+        format_->write_response(
+            unknown,
+            WriteResponse{w.id, false, std::nullopt, std::nullopt,
+                          fmt::format("no PLC named '{}' in this bridge's configuration", w.plc)},
+            sink_);
+        return;
+    }
+    const Plc& plc = it->second->plc();
     {
         auto& m = ids_[plc.name];
         if (auto e = m.entries.find(w.id); e != m.entries.end()) {
@@ -315,9 +368,14 @@ void Bridge::execute(const WriteCommand& w, Clock::time_point arrival) {
     const auto refuse = [&](std::string error) {
         answer(plc, WriteResponse{w.id, false, std::nullopt, std::nullopt, std::move(error)});
     };
-    if (it == pollers_.end()) return refuse(fmt::format("no PLC named '{}'", w.plc));
     const auto ttl = config_.write.ttl;
-    if (w.ts_ms && epoch_ms() - *w.ts_ms > ttl.count())
+    const auto skew = config_.write.ts_skew;
+    // Compared on this side so that no ts, however far off, overflows.
+    const std::int64_t now_ms = epoch_ms();
+    if (w.ts_ms && *w.ts_ms > now_ms + skew.count())
+        return refuse(fmt::format("ts is more than {} ms ahead of the bridge's clock (ts_skew_s)",
+                                  skew.count()));
+    if (w.ts_ms && *w.ts_ms < now_ms - ttl.count())
         return refuse(fmt::format("command older than the TTL ({} ms)", ttl.count()));
     if (Clock::now() - arrival > ttl)
         return refuse(fmt::format("command waited longer than the TTL ({} ms)", ttl.count()));

@@ -11,10 +11,13 @@
 // Writes (docs/bridge.md "Writes"): a command is refused, with an answer and without
 // touching the PLC, when it is retained, not JSON, names an unknown or read-only tag,
 // has a value of the wrong type or out of range, is older than [write] ttl_s (its "ts",
-// or the time it waited here), or the PLC is offline. Its id is remembered (the last
-// [write] id_memory ids per PLC): a repeated id is answered again with the first answer,
-// never executed again; while the first is still running the repeat gets no answer of
-// its own (the first one's answer is on the same topic).
+// or the time it waited here), has a "ts" more than [write] ts_skew_s ahead, names a PLC
+// the configuration does not have, or the PLC is offline. Its id (its JSON text: 5 and "5"
+// differ) is remembered (the last [write] id_memory ids per configured PLC, nothing for
+// other names): a repeated id is answered again with the first answer, never executed
+// again; while the first is still running the repeat gets no answer of its own (the first
+// one's answer is on the same topic). Commands that arrive before the Ownership has joined
+// (a persistent session's queued writes come right after CONNACK) wait for it, bounded.
 //
 // Commands: the format parses a message into one ParsedCommand alternative (payload.hpp) and
 // command() visits it whole: a write to execute, a refusal to answer, a Sparkplug rebirth, a
@@ -70,6 +73,13 @@ class Bridge final : public PollerEvents {
     [[nodiscard]] Ownership& ownership() noexcept { return *ownership_; }
     [[nodiscard]] MqttClient* mqtt() noexcept { return mqtt_.get(); }
     [[nodiscard]] asio::io_context& io() noexcept { return io_; }
+    // What the bridge holds for commands (tests of the bounds, docs/bridge.md "Bounds"):
+    // PLCs with remembered ids, remembered ids in all, commands waiting for the join, and
+    // commands dropped at a bound.
+    [[nodiscard]] std::size_t remembered_plcs() const noexcept { return ids_.size(); }
+    [[nodiscard]] std::size_t remembered_ids() const noexcept;
+    [[nodiscard]] std::size_t held_commands() const noexcept { return held_.size(); }
+    [[nodiscard]] std::uint64_t dropped_commands() const noexcept { return dropped_commands_; }
 
     // Test hook: called with every parsed command before it is handled (a test makes it
     // throw to prove the failure boundary below).
@@ -94,6 +104,13 @@ class Bridge final : public PollerEvents {
         std::deque<std::string> order;  // oldest first
     };
 
+    struct Held {
+        std::string topic;
+        std::string payload;
+        bool retained = false;
+        std::chrono::steady_clock::time_point arrival;
+    };
+
     // One MQTT message, inside the failure boundary: nothing it throws leaves handle().
     void handle(const std::string& topic, const std::string& payload, bool retained,
                 std::chrono::steady_clock::time_point arrival) noexcept;
@@ -105,6 +122,8 @@ class Bridge final : public PollerEvents {
     void rebirth();
     void failed(const std::string& topic, bool retained, const std::optional<ParsedCommand>& parsed,
                 std::string_view what) noexcept;
+    // Commands that came before this instance joined, handled in order once it has.
+    void release_held();
     void answer(const Plc& plc, const WriteResponse& r);
     IdMemory::Entry& remember(const std::string& plc, const std::string& id);
     void publish(Message&& m);
@@ -120,6 +139,7 @@ class Bridge final : public PollerEvents {
     std::map<std::string, std::unique_ptr<PlcPoller>, std::less<>> pollers_;
     std::map<std::string, PlcStatus, std::less<>> statuses_;
     std::map<std::string, IdMemory, std::less<>> ids_;
+    std::deque<Held> held_;  // at most max_pending_commands
     std::atomic<std::size_t> pending_commands_{0};
     std::atomic<std::uint64_t> dropped_commands_{0};
     std::uint64_t failed_commands_ = 0;

@@ -65,7 +65,8 @@ BridgeConfig Loader::load(const toml::table& root, const std::string& instance) 
     }
     if (const auto* n = root.get("write")) {
         const auto& t = table(*n, "[write]");
-        only(t, "[write]", {"ttl_s", "id_memory"});
+        only(t, "[write]", {"ttl_s", "id_memory", "ts_skew_s"});
+        if (auto v = integer(t, "ts_skew_s", 0, 3600)) c.write.ts_skew = std::chrono::seconds(*v);
         if (auto v = integer(t, "ttl_s", 1, 86400)) c.write.ttl = std::chrono::seconds(*v);
         if (auto v = integer(t, "id_memory", 1, 1000000))
             c.write.id_memory = static_cast<std::size_t>(*v);
@@ -91,8 +92,14 @@ void Loader::mqtt(const toml::table& t, Mqtt& m) {
           "key_file", "tls_insecure", "keepalive_s", "topic_prefix", "qos", "queue_limit",
           "backoff_min_ms", "backoff_max_ms"});
     std::uint16_t port = 1883;
-    if (auto v = integer(t, "port", 1, 65535)) port = static_cast<std::uint16_t>(*v);
-    if (auto h = text(t, "host")) m.brokers.push_back({*h, port});
+    const auto given_port = integer(t, "port", 1, 65535);
+    if (given_port) port = static_cast<std::uint16_t>(*given_port);
+    if (auto h = text(t, "host")) {
+        if (h->empty()) fail(*t.get("host"), "host must not be empty");
+        m.brokers.push_back({*h, port});
+    } else if (given_port && t.get("hosts") == nullptr) {
+        m.brokers.push_back({"127.0.0.1", port});  // port alone: the default host
+    }
     if (const auto* n = t.get("hosts")) {
         const auto* list = n->as_array();
         if (list == nullptr || list->empty()) fail(*n, "hosts must be a list of \"host[:port]\"");
@@ -123,6 +130,13 @@ void Loader::mqtt(const toml::table& t, Mqtt& m) {
         fail(t.source(), "cert_file and key_file go together");
     if (!m.cert_file.empty() && m.ca_file.empty())
         fail(t.source(), "a client certificate needs ca_file (TLS)");
+    // Files named are read at start: one that cannot be is this file's error, not a TLS
+    // failure at the first connect.
+    for (const char* key : {"ca_file", "cert_file", "key_file"}) {
+        const auto name = text_or(t, key, "");
+        if (!name.empty() && ::access(name.c_str(), R_OK) != 0)
+            fail(*t.get(key), fmt::format("{} '{}' cannot be read", key, name));
+    }
     m.tls_insecure = boolean(t, "tls_insecure").value_or(false);
     duration(t, "keepalive_s", 5, 65535, m.keepalive);
     m.topic_prefix = text_or(t, "topic_prefix", "finskit");
@@ -143,6 +157,7 @@ Plc Loader::plc(const toml::table& t) {
     Plc p;
     p.name = name(t, "[[plc]]");
     p.host = required_text(t, "host", fmt::format("plc '{}'", p.name));
+    if (p.host.empty()) fail(*t.get("host"), "host must not be empty");
     if (auto v = integer(t, "port", 1, 65535)) p.port = static_cast<std::uint16_t>(*v);
     if (auto tr = text(t, "transport")) {
         if (*tr == "udp")

@@ -98,8 +98,9 @@ struct Mqtt {
 };
 
 struct WriteRules {
-    std::chrono::milliseconds ttl{10000};  // older commands are refused
-    std::size_t id_memory = 1024;          // command ids remembered per PLC
+    std::chrono::milliseconds ttl{10000};     // older commands are refused
+    std::size_t id_memory = 1024;             // command ids remembered per PLC
+    std::chrono::milliseconds ts_skew{5000};  // a "ts" further ahead than this is refused
 };
 
 struct BridgeConfig {

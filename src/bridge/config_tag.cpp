@@ -33,6 +33,9 @@ Tag Loader::tag(const toml::table& t) {
     }
     tag.range.min = number(t, "min");
     tag.range.max = number(t, "max");
+    if (tag.range.min && tag.range.max && *tag.range.min > *tag.range.max)
+        fail(*t.get("min"), fmt::format("min {} is above max {}: no value could be written",
+                                        *tag.range.min, *tag.range.max));
     resolve(at, tag);
     return tag;
 }

@@ -59,18 +59,24 @@ void JsonPayload::status(const PlcStatus& st, const Sink& out) {
 }
 
 void JsonPayload::write_response(const Plc& plc, const WriteResponse& r, const Sink& out) {
-    nlohmann::json j{{"id", r.id}, {"ok", r.ok}};
+    // r.id is the id's JSON text (parse() below): echoed with its JSON type; none: "".
+    nlohmann::json id =
+        r.id.empty() ? nlohmann::json("") : nlohmann::json::parse(r.id, nullptr, false);
+    if (id.is_discarded()) id = r.id;
+    nlohmann::json j{{"id", std::move(id)}, {"ok", r.ok}};
     j["end_code"] = r.end_code ? nlohmann::json(fmt::format("{:04X}", *r.end_code)) : nullptr;
     j["value"] = r.value ? *r.value : nlohmann::json(nullptr);
     j["error"] = r.error.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.error);
-    out({fmt::format("{}/{}/write/response", prefix_, plc.name), j.dump(), 1, false});
+    // Replace: an error text may quote a cut string (never a reason to throw).
+    out({fmt::format("{}/{}/write/response", prefix_, plc.name),
+         j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace), 1, false});
 }
 
 std::optional<ParsedCommand> JsonPayload::parse(std::string_view topic, std::string_view payload,
                                                 bool retained) {
     // {prefix}/{plc}/write
     constexpr std::string_view suffix = "/write";
-    if (topic.size() <= prefix_.size() + 1 + suffix.size() || !topic.starts_with(prefix_) ||
+    if (topic.size() < prefix_.size() + 1 + suffix.size() || !topic.starts_with(prefix_) ||
         topic[prefix_.size()] != '/' || !topic.ends_with(suffix))
         return std::nullopt;
     std::string plc(
@@ -82,17 +88,24 @@ std::optional<ParsedCommand> JsonPayload::parse(std::string_view topic, std::str
     };
     auto j = nlohmann::json::parse(payload, nullptr, false);
     if (j.is_discarded() || !j.is_object()) return refuse("", "the command is not a JSON object");
+    // The id keeps its JSON type: 5 and "5" are two ids. It travels as its JSON text (the
+    // key of the bridge's id memory) and is echoed as the same JSON value.
     std::string id;
     if (auto f = j.find("id"); f != j.end()) {
-        if (f->is_string())
-            id = f->get<std::string>();
-        else if (f->is_number_integer())
+        if (f->is_string()) {
+            const auto& text = f->get_ref<const std::string&>();
+            if (text.size() > max_id_chars)
+                return refuse(nlohmann::json(text.substr(0, max_id_chars))
+                                  .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace),
+                              fmt::format("id longer than {} characters", max_id_chars));
+            if (!text.empty()) id = f->dump();
+        } else if (f->is_number_integer()) {
             id = f->dump();
-        else
+        } else {
             return refuse("", "id must be a string or an integer");
+        }
     }
     if (id.empty()) return refuse("", "the command has no id");
-    if (id.size() > 128) return refuse(id.substr(0, 128), "id longer than 128 characters");
     if (retained)
         return refuse(id, "retained command refused (a command is executed once, when sent)");
     for (auto& [k, v] : j.items())

@@ -7,6 +7,9 @@
 //   {prefix}/{plc}/write/response     out: {"id":..,"ok":..,"end_code":..,"value":..,"error":..}
 // A tag that could not be read is {"error":"<text>","end_code":"1103"} (end_code only when
 // the PLC answered one), never a value.
+// A command's id is a string or an integer, and keeps its JSON type: 5 and "5" are two ids.
+// WriteCommand::id and WriteResponse::id carry its JSON text ("\"w1\"", "5"), the key of
+// the bridge's id memory; the response echoes the same JSON value.
 #pragma once
 
 #include <string>
@@ -14,6 +17,9 @@
 #include "bridge/payload.hpp"
 
 namespace fins::bridge {
+
+// Longest string id (characters); a longer one is refused.
+inline constexpr std::size_t max_id_chars = 128;
 
 class JsonPayload final : public PayloadFormat {
   public:

@@ -21,12 +21,13 @@ void init_library() {
 }  // namespace
 
 MqttClient::MqttClient(const Mqtt& config, Message will, Message online,
-                       std::vector<std::string> subscriptions, Handlers handlers)
+                       std::vector<std::string> subscriptions, Handlers handlers, bool persistent)
     : config_(config),
       will_(std::move(will)),
       online_(std::move(online)),
       subscriptions_(std::move(subscriptions)),
-      handlers_(std::move(handlers)) {}
+      handlers_(std::move(handlers)),
+      persistent_(persistent) {}
 
 MqttClient::~MqttClient() {
     if (thread_.joinable()) stop(will_);
@@ -35,7 +36,9 @@ MqttClient::~MqttClient() {
 
 bool MqttClient::start(std::string& error) {
     init_library();
-    mosq_ = mosquitto_new(config_.client_id.c_str(), true, this);
+    // A persistent session keeps the subscriptions and the QoS 1 messages for them on the
+    // broker while this client is away (clean_session = false).
+    mosq_ = mosquitto_new(config_.client_id.c_str(), !persistent_, this);
     if (mosq_ == nullptr) {
         error = "mosquitto_new failed";
         return false;
@@ -199,7 +202,8 @@ bool MqttClient::publish(const Message& m) {
     const int rc =
         mosquitto_publish(mosq_, nullptr, m.topic.c_str(), static_cast<int>(m.payload.size()),
                           m.payload.data(), m.qos, m.retain);
-    if (rc != MOSQ_ERR_SUCCESS) {
+    // QoS 1 while disconnected: libmosquitto keeps it and sends it after the reconnect.
+    if (rc != MOSQ_ERR_SUCCESS && !(rc == MOSQ_ERR_NO_CONN && m.qos > 0)) {
         queued_.fetch_sub(1);
         ++dropped_;
         return false;

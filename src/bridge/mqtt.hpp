@@ -15,6 +15,10 @@
 // Connection: the brokers are tried in turn; after a failure or a lost connection the
 // next attempt waits uniform(0, min(backoff_max, backoff_min x 2^n)) (full jitter, n
 // reset by an accepted connection). The Will is the bridge's offline status.
+// Session: a persistent client (clean_session = false, `persistent`) keeps its
+// subscriptions on the broker while it is away, and the broker queues the QoS 1 messages
+// published to them meanwhile and delivers them on the next CONNECT with the same client id
+// (MQTT 3.1.1 3.1.2.4): the bridge's write commands (docs/bridge.md "Writes").
 #pragma once
 
 #include <atomic>
@@ -55,7 +59,7 @@ class MqttClient {
         std::function<Message()> will;
     };
     MqttClient(const Mqtt& config, Message will, Message online,
-               std::vector<std::string> subscriptions, Handlers handlers);
+               std::vector<std::string> subscriptions, Handlers handlers, bool persistent = false);
     ~MqttClient();
     MqttClient(const MqttClient&) = delete;
     MqttClient& operator=(const MqttClient&) = delete;
@@ -67,7 +71,8 @@ class MqttClient {
     // joins the thread; at most ~2 s.
     void stop(const Message& last);
 
-    // Thread-safe. False when the message was dropped (see above).
+    // Thread-safe. False when the message was dropped (see above). A QoS 1 message handed
+    // over while disconnected stays in libmosquitto's queue and is sent after the reconnect.
     bool publish(const Message& m);
     [[nodiscard]] bool connected() const noexcept { return connected_; }
     [[nodiscard]] MqttStats stats() const;
@@ -85,6 +90,7 @@ class MqttClient {
     Message online_;
     std::vector<std::string> subscriptions_;
     Handlers handlers_;
+    bool persistent_ = false;
     mosquitto* mosq_ = nullptr;
     std::thread thread_;
     std::mutex mutex_;

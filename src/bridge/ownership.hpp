@@ -32,6 +32,9 @@ class Ownership {
         return false;
     }
     virtual void connection_lost() {}
+    // Whether this instance knows the members and may decide what it owns: commands that
+    // arrive before (a persistent session's queued writes come right after CONNACK) wait.
+    [[nodiscard]] virtual bool joined() const { return true; }
     // Whether this instance owns plc once it has joined (counted as a member even before
     // that): who answers a retained command, which is refused and never executed.
     [[nodiscard]] virtual bool owns_once_joined(std::string_view plc) const { return owns(plc); }

@@ -117,6 +117,7 @@ class PlcPoller {
     void finish_group(std::size_t group);
     void write_answered(Request& r, const ResponseView* response, std::error_code failure);
     void finish_write(PendingWrite& op, std::error_code error, const ResponseView* response);
+    void send_write(PendingWrite& op);
     void go_online();
     void go_offline(std::error_code why);
     std::string other_node_text() const;

@@ -36,6 +36,7 @@ struct PendingWrite {
     const Tag* tag = nullptr;
     std::vector<std::uint8_t> parameters;
     std::uint16_t end_code = 0;
+    bool waiting = false;  // behind an earlier write of the same words (poller_write.cpp)
 };
 
 inline bool is_end_code(std::error_code ec) {

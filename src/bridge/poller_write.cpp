@@ -1,5 +1,7 @@
 // PlcPoller's writes: 01 02 MEMORY AREA WRITE of a checked value, then 01 01 of the same
 // words to read it back; at most max_pending_writes per PLC, none while it is offline.
+// Writes to the same words run one at a time, in the order they came: a write's read back
+// is taken before the next write to those words is sent, so it is that write's value.
 #include <algorithm>
 
 #include <fmt/format.h>
@@ -11,9 +13,24 @@
 
 namespace fins::bridge {
 
+namespace {
+
+// Whether two tags share a word (a write to one changes what the other reads back).
+bool overlaps(const Tag& a, const Tag& b) {
+    if (a.read_start.area_code != b.read_start.area_code) return false;
+    const std::size_t a0 = a.read_start.word;
+    const std::size_t b0 = b.read_start.word;
+    return a0 < b0 + b.words && b0 < a0 + a.words;
+}
+
+}  // namespace
+
 std::optional<std::string> PlcPoller::write(const Tag& tag, const Encoded& value, std::string id) {
     if (!running_) return "this instance does not poll the PLC";
-    if (state_ != State::online)
+    // A UDP PLC being contacted for the first time takes frames already (as its polls do).
+    const bool can_send = state_ == State::online ||
+                          (state_ == State::connecting && plc_.transport == Transport::udp);
+    if (!can_send)
         return last_error_.empty() ? std::string("PLC offline") : "PLC offline: " + last_error_;
     if (writes_.size() >= max_pending_writes)
         return fmt::format("{} writes already wait for this PLC", max_pending_writes);
@@ -38,12 +55,20 @@ std::optional<std::string> PlcPoller::write(const Tag& tag, const Encoded& value
     ByteWriter w(op->parameters);
     MemoryAreaWrite{start, count, data}.encode(w);
     op->parameters.resize(w.written().size());
-    Request r{Request::Kind::write};
-    r.op = op.get();
-    r.command = MemoryAreaWrite::code;
+    op->waiting = std::any_of(writes_.begin(), writes_.end(),
+                              [&tag](const auto& other) { return overlaps(*other->tag, tag); });
+    PendingWrite& queued = *op;
     writes_.push_back(std::move(op));
-    enqueue(r);
+    if (!queued.waiting) send_write(queued);
     return std::nullopt;
+}
+
+void PlcPoller::send_write(PendingWrite& op) {
+    op.waiting = false;
+    Request r{Request::Kind::write};
+    r.op = &op;
+    r.command = MemoryAreaWrite::code;
+    enqueue(r);
 }
 
 void PlcPoller::write_answered(Request& r, const ResponseView* response, std::error_code failure) {
@@ -95,6 +120,24 @@ void PlcPoller::finish_write(PendingWrite& op, std::error_code error,
         writes_.erase(it);
     }
     events_.write_done(plc_, r);
+    // The writes that waited for this one and now have no earlier write to their words:
+    // sent now, or failed as this one did when the PLC is gone.
+    const bool can_send = state_ == State::online ||
+                          (state_ == State::connecting && plc_.transport == Transport::udp);
+    for (std::size_t i = 0; i < writes_.size(); ++i) {
+        PendingWrite& w = *writes_[i];
+        if (!w.waiting || !overlaps(*w.tag, *op.tag)) continue;
+        const bool behind =
+            std::any_of(writes_.begin(), writes_.begin() + static_cast<std::ptrdiff_t>(i),
+                        [&w](const auto& e) { return overlaps(*e->tag, *w.tag); });
+        if (behind) continue;
+        if (can_send) {
+            send_write(w);
+        } else {
+            finish_write(w, error ? error : make_error_code(ClientError::timeout), nullptr);
+            return;  // that call went on with the rest
+        }
+    }
 }
 
 }  // namespace fins::bridge

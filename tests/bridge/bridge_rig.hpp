@@ -46,10 +46,15 @@ struct Rig {
     bool ready() const { return broker.started() && finsd.started() && sub.connected(); }
 };
 
+// Whether a response answers the string id `id` (ids keep their JSON type: 5 is not "5").
+inline bool answers_id(const nlohmann::json& j, const std::string& id) {
+    return j.is_object() && j.contains("id") && j["id"] == id;
+}
+
 // The first answer to the write command `id`, if one comes.
-inline std::optional<nlohmann::json> response(Recorder& sub, const std::string& id) {
-    auto r = sub.wait_topic("t/press1/write/response",
-                            [&](const nlohmann::json& j) { return j.value("id", "") == id; });
+inline std::optional<nlohmann::json> response(
+    Recorder& sub, const std::string& id, const std::string& topic = "t/press1/write/response") {
+    auto r = sub.wait_topic(topic, [&](const nlohmann::json& j) { return answers_id(j, id); });
     if (!r) return std::nullopt;
     return r->json();
 }
@@ -58,7 +63,7 @@ inline std::optional<nlohmann::json> response(Recorder& sub, const std::string& 
 inline std::size_t responses(Recorder& sub, const std::string& id) {
     std::size_t n = 0;
     for (const auto& m : sub.messages())
-        if (m.topic == "t/press1/write/response" && m.json().value("id", "") == id) ++n;
+        if (m.topic == "t/press1/write/response" && answers_id(m.json(), id)) ++n;
     return n;
 }
 

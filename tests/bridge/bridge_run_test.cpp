@@ -145,7 +145,7 @@ TEST(BridgeRun, TlsAndPasswordBroker) {
                                      d + "/passwd\n"};
     Finsd finsd{{}};
     ASSERT_TRUE(broker.started() && finsd.started());
-    Recorder sub(broker.port(), "t/#", {d + "/ca.crt", "bridge", "s3cret"});
+    Recorder sub(broker.port(), "t/#", {d + "/ca.crt", "bridge", "s3cret", ""});
     ASSERT_TRUE(sub.connected());
     BridgeProcess bridge(dir, mqtt_section(broker.port(), "ca_file = \"" + d +
                                                               "/ca.crt\"\nusername = \"bridge\"\n"
@@ -155,7 +155,7 @@ TEST(BridgeRun, TlsAndPasswordBroker) {
         return j.value("full", false);
     })) << bridge.stop().err;
     // A wrong password is refused by the broker: nothing is published.
-    Recorder wrong(broker.port(), "t/#", {d + "/ca.crt", "bridge", "wrong"});
+    Recorder wrong(broker.port(), "t/#", {d + "/ca.crt", "bridge", "wrong", ""});
     EXPECT_FALSE(wrong.connected());
 }
 
@@ -210,6 +210,20 @@ TEST(BridgeRun, BadConfigStopsAtStartWithItsPosition) {
     auto r = fins::test::run({bridge_path, "--config", file});
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_EQ(r.err.rfind("fins-bridge: " + file + ":8:", 0), 0u) << r.err;
+    // min above max, an empty host, a CA file that is not there: the same, at their key.
+    const auto range =
+        dir.write("range.toml",
+                  "[[plc]]\nname = \"a\"\nhost = \"h\"\n[[plc.group]]\nname = \"g\"\n"
+                  "tags = [{name=\"x\", address=\"D0\", type=\"int16\", min=3, max=1}]\n");
+    r = fins::test::run({bridge_path, "--config", range});
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_EQ(r.err.rfind("fins-bridge: " + range + ":6:", 0), 0u) << r.err;
+    const auto ca = dir.write("ca.toml",
+                              "[mqtt]\nca_file = \"/nonexistent/ca.crt\"\n[[plc]]\n"
+                              "name = \"a\"\nhost = \"\"\n");
+    r = fins::test::run({bridge_path, "--config", ca});
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_EQ(r.err.rfind("fins-bridge: " + ca + ":2:11: ca_file", 0), 0u) << r.err;
     auto missing = fins::test::run({bridge_path, "--config", dir.path().string() + "/none.toml"});
     EXPECT_EQ(missing.exit_code, 2);
     auto usage = fins::test::run({bridge_path});

@@ -106,6 +106,94 @@ TEST(BridgeRun, BadCommandsAreAnsweredAndChangeNothing) {
         (std::vector<std::uint16_t>{0, 0}));
 }
 
+TEST(BridgeRun, AWriteForAPlcNotConfiguredIsRefusedWithAnAnswer) {
+    Rig rig;
+    ASSERT_TRUE(rig.ready());
+    ASSERT_TRUE(rig.sub.wait_topic("t/press1/status",
+                                   [](const json& j) { return j["state"] == "online"; }));
+    rig.sub.publish("t/nosuch/write", R"({"id":"n1","tag":"temp","value":1})");
+    auto r = response(rig.sub, "n1", "t/nosuch/write/response");
+    ASSERT_TRUE(r);
+    EXPECT_EQ((*r)["ok"], false);
+    EXPECT_NE((*r)["error"].get<std::string>().find("no PLC named 'nosuch'"), std::string::npos)
+        << r->dump();
+    // A bad command for it is answered too, with what is wrong with it.
+    rig.sub.publish("t/nosuch/write", "[]");
+    EXPECT_TRUE(rig.sub.wait_topic("t/nosuch/write/response", [](const json& j) {
+        return j["id"] == "" && j["ok"] == false;
+    }));
+}
+
+TEST(BridgeRun, ATsAheadOfTheClockBeyondTheSkewIsRefused) {
+    Rig rig;
+    ASSERT_TRUE(rig.ready());
+    ASSERT_TRUE(rig.sub.wait_topic("t/press1/status",
+                                   [](const json& j) { return j["state"] == "online"; }));
+    const auto now = std::chrono::duration_cast<std::chrono::milliseconds>(
+                         std::chrono::system_clock::now().time_since_epoch())
+                         .count();
+    rig.sub.publish("t/press1/write", R"({"id":"f1","tag":"temp","value":4,"ts":)" +
+                                          std::to_string(now + 60000) + "}");
+    rig.sub.publish("t/press1/write", R"({"id":"f2","tag":"temp","value":5,"ts":)" +
+                                          std::to_string(now + 1000) + "}");
+    rig.sub.publish("t/press1/write",
+                    R"({"id":"f3","tag":"temp","value":6,"ts":-9223372036854775808})");
+    rig.sub.publish("t/press1/write",
+                    R"({"id":"f4","tag":"temp","value":6,"ts":9223372036854775807})");
+    auto far = response(rig.sub, "f1");
+    ASSERT_TRUE(far);
+    EXPECT_EQ((*far)["ok"], false);
+    EXPECT_NE((*far)["error"].get<std::string>().find("ahead of the bridge's clock"),
+              std::string::npos)
+        << far->dump();
+    auto near = response(rig.sub, "f2");  // within ts_skew_s (5 s)
+    ASSERT_TRUE(near);
+    EXPECT_EQ((*near)["ok"], true) << near->dump();
+    for (const char* id : {"f3", "f4"}) {
+        auto r = response(rig.sub, id);
+        ASSERT_TRUE(r) << id;
+        EXPECT_EQ((*r)["ok"], false) << r->dump();
+    }
+}
+
+TEST(BridgeRun, NumberAndStringIdsAreTwoIdsEchoedWithTheirType) {
+    Rig rig;
+    ASSERT_TRUE(rig.ready());
+    ASSERT_TRUE(rig.sub.wait_topic("t/press1/status",
+                                   [](const json& j) { return j["state"] == "online"; }));
+    rig.sub.publish("t/press1/write", R"({"id":5,"tag":"temp","value":1.5})");
+    auto number = rig.sub.wait_topic("t/press1/write/response",
+                                     [](const json& j) { return j["id"] == json(5); });
+    ASSERT_TRUE(number);
+    rig.sub.publish("t/press1/write", R"({"id":"5","tag":"temp","value":2.5})");
+    auto text = response(rig.sub, "5");
+    ASSERT_TRUE(text);  // not taken for a repeat of 5
+    EXPECT_EQ(number->json()["value"], 1.5);
+    EXPECT_EQ((*text)["value"], 2.5);
+    auto client = rig.finsd.client();
+    ASSERT_TRUE(client);
+    EXPECT_EQ(client->read_float(fins::test::addr("D200")).value_or(0), 2.5f);
+}
+
+TEST(BridgeRun, EachWritesResponseCarriesItsOwnReadBack) {
+    Rig rig;
+    ASSERT_TRUE(rig.ready());
+    ASSERT_TRUE(rig.sub.wait_topic("t/press1/status",
+                                   [](const json& j) { return j["state"] == "online"; }));
+    // Published together: they reach the PLC window together (4 frames), yet each read back
+    // is taken before the next write to the tag is sent.
+    for (int i = 0; i < 12; ++i)
+        rig.sub.publish("t/press1/write", R"({"id":"k)" + std::to_string(i) +
+                                              R"(","tag":"count","value":)" +
+                                              std::to_string(1000 + i) + "}");
+    for (int i = 0; i < 12; ++i) {
+        auto r = response(rig.sub, "k" + std::to_string(i));
+        ASSERT_TRUE(r) << i;
+        EXPECT_EQ((*r)["ok"], true) << r->dump();
+        EXPECT_EQ((*r)["value"], 1000 + i) << r->dump();
+    }
+}
+
 TEST(BridgeRun, RetainedCommandsAreRefused) {
     ScratchDir dir{"bridge"};
     Mosquitto broker{dir.path()};

@@ -129,5 +129,51 @@ TEST(BridgeConfig, DestAndBrokers) {
         std::string::npos);
 }
 
+TEST(BridgeConfig, MinAboveMaxIsAnErrorAtMin) {
+    EXPECT_EQ(parse_error(one_group(
+                  "{name=\"a\",address=\"D0\",type=\"int16\",writable=true,min=10,max=5}")),
+              "t.toml:6:63: min 10 is above max 5: no value could be written");
+    // min == max is one value: allowed.
+    parse_ok(one_group("{name=\"a\",address=\"D0\",type=\"int16\",writable=true,min=5,max=5}"));
+}
+
+TEST(BridgeConfig, EmptyHostsAreErrors) {
+    EXPECT_EQ(parse_error("[mqtt]\nhost = \"\"\n" +
+                          one_group("{name=\"a\",address=\"D0\",type=\"int16\"}")),
+              "t.toml:2:8: host must not be empty");
+    EXPECT_EQ(parse_error("[[plc]]\nname = \"p\"\nhost = \"\"\n[[plc.group]]\nname = \"g\"\n"
+                          "tags = [{name=\"a\",address=\"D0\",type=\"int16\"}]\n"),
+              "t.toml:3:8: host must not be empty");
+}
+
+TEST(BridgeConfig, ATlsFileThatCannotBeReadIsAnErrorAtItsKey) {
+    EXPECT_EQ(parse_error("[mqtt]\nca_file = \"/nonexistent/ca.crt\"\n" +
+                          one_group("{name=\"a\",address=\"D0\",type=\"int16\"}")),
+              "t.toml:2:11: ca_file '/nonexistent/ca.crt' cannot be read");
+}
+
+TEST(BridgeConfig, PortAloneUsesTheDefaultHost) {
+    auto c =
+        parse_ok("[mqtt]\nport = 1884\n" + one_group("{name=\"a\",address=\"D0\",type=\"int16\"}"));
+    ASSERT_EQ(c.mqtt.brokers.size(), 1u);
+    EXPECT_EQ(c.mqtt.brokers[0].host, "127.0.0.1");
+    EXPECT_EQ(c.mqtt.brokers[0].port, 1884);
+    // With hosts, port is the default port of the entries without one.
+    c = parse_ok("[mqtt]\nport = 1884\nhosts = [\"a\", \"b:1999\"]\n" +
+                 one_group("{name=\"a\",address=\"D0\",type=\"int16\"}"));
+    ASSERT_EQ(c.mqtt.brokers.size(), 2u);
+    EXPECT_EQ(c.mqtt.brokers[0].port, 1884);
+    EXPECT_EQ(c.mqtt.brokers[1].port, 1999);
+}
+
+TEST(BridgeConfig, TsSkew) {
+    EXPECT_EQ(parse_ok(one_group("{name=\"a\",address=\"D0\",type=\"int16\"}")).write.ts_skew,
+              std::chrono::seconds(5));
+    EXPECT_EQ(parse_ok("[write]\nts_skew_s = 30\n" +
+                       one_group("{name=\"a\",address=\"D0\",type=\"int16\"}"))
+                  .write.ts_skew,
+              std::chrono::seconds(30));
+}
+
 }  // namespace
 }  // namespace fins::bridge

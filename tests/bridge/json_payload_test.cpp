@@ -15,12 +15,61 @@ TEST(JsonPayload, ParsesAWriteCommand) {
     const auto* w = std::get_if<WriteCommand>(&*c);
     ASSERT_TRUE(w);
     EXPECT_EQ(w->plc, "press1");
-    EXPECT_EQ(w->id, "a");
+    EXPECT_EQ(w->id, "\"a\"");  // the id's JSON text
     EXPECT_EQ(w->tag, "temp");
     EXPECT_EQ(w->value, 1.5);
     EXPECT_EQ(w->ts_ms, 5);
     EXPECT_FALSE(f.parse("other/press1/write", "{}", false));
     EXPECT_FALSE(f.parse("pre/press1/write/response", "{}", false));
+}
+
+TEST(JsonPayload, IdsKeepTheirJsonType) {
+    JsonPayload f("pre", "edge");
+    auto number = f.parse("pre/p/write", R"({"id":5,"tag":"t","value":1})", false);
+    auto text = f.parse("pre/p/write", R"({"id":"5","tag":"t","value":1})", false);
+    ASSERT_TRUE(number && text);
+    const auto* n = std::get_if<WriteCommand>(&*number);
+    const auto* t = std::get_if<WriteCommand>(&*text);
+    ASSERT_TRUE(n && t);
+    EXPECT_NE(n->id, t->id);  // two ids, two memory keys
+    // Echoed with the type they came with.
+    Plc plc;
+    plc.name = "p";
+    std::vector<Message> out;
+    const Sink sink = [&](Message&& m) { out.push_back(std::move(m)); };
+    f.write_response(plc, {n->id, true, 0, nlohmann::json(1), ""}, sink);
+    f.write_response(plc, {t->id, true, 0, nlohmann::json(1), ""}, sink);
+    f.write_response(plc, {"", false, std::nullopt, std::nullopt, "the command has no id"}, sink);
+    ASSERT_EQ(out.size(), 3u);
+    EXPECT_EQ(out[0].topic, "pre/p/write/response");
+    EXPECT_EQ(nlohmann::json::parse(out[0].payload)["id"], nlohmann::json(5));
+    EXPECT_EQ(nlohmann::json::parse(out[1].payload)["id"], nlohmann::json("5"));
+    EXPECT_EQ(nlohmann::json::parse(out[2].payload)["id"], nlohmann::json(""));
+}
+
+TEST(JsonPayload, AWriteToAnEmptyPlcNameIsParsedToBeRefused) {
+    JsonPayload f("pre", "edge");
+    auto c = f.parse("pre//write", R"({"id":"a","tag":"t","value":1})", false);
+    ASSERT_TRUE(c);
+    const auto* w = std::get_if<WriteCommand>(&*c);
+    ASSERT_TRUE(w);
+    EXPECT_EQ(w->plc, "");
+}
+
+TEST(JsonPayload, ALongIdCutInAUtf8CharacterIsStillAnswered) {
+    JsonPayload f("pre", "edge");
+    std::string id(127, 'a');
+    id += "\u00e9\u00e9";  // two bytes each: byte 128 is inside the first
+    auto c = f.parse("pre/p/write", R"({"id":")" + id + R"(","tag":"t","value":1})", false);
+    ASSERT_TRUE(c);
+    const auto* r = std::get_if<Refusal>(&*c);
+    ASSERT_TRUE(r);
+    Plc plc;
+    plc.name = "p";
+    std::vector<Message> out;
+    f.write_response(plc, r->response, [&](Message&& m) { out.push_back(std::move(m)); });
+    ASSERT_EQ(out.size(), 1u);
+    EXPECT_FALSE(nlohmann::json::parse(out[0].payload, nullptr, false).is_discarded());
 }
 
 TEST(JsonPayload, RefusesBadCommands) {

@@ -27,6 +27,7 @@ struct Received {
     std::string payload;
     bool retain = false;
     std::chrono::steady_clock::time_point at;
+    int mid = 0;  // the broker's message id (QoS 1): a redelivery repeats it
     [[nodiscard]] nlohmann::json json() const {
         return nlohmann::json::parse(payload, nullptr, false);
     }
@@ -38,14 +39,19 @@ class Recorder {
         std::string ca_file;  // TLS with this CA (empty: plain TCP)
         std::string username;
         std::string password;
+        // A persistent session (clean_session = false) under this client id: what is
+        // published to its filters while it reconnects is queued by the broker for it.
+        std::string persistent_id;
     };
     Recorder(std::uint16_t port, std::vector<std::string> filters, const Options& o = {})
         : filters_(std::move(filters)) {
         static std::once_flag once;
         std::call_once(once, [] { mosquitto_lib_init(); });
         static std::atomic<int> n{0};
-        const auto id = "recorder-" + std::to_string(::getpid()) + "-" + std::to_string(n++);
-        m_ = mosquitto_new(id.c_str(), true, this);
+        const auto id = o.persistent_id.empty()
+                            ? "recorder-" + std::to_string(::getpid()) + "-" + std::to_string(n++)
+                            : o.persistent_id;
+        m_ = mosquitto_new(id.c_str(), o.persistent_id.empty(), this);
         // Subscribes on every (re)connection, so a broker restart loses no filter.
         mosquitto_connect_callback_set(m_, [](mosquitto* m, void* self, int rc) {
             auto* r = static_cast<Recorder*>(self);
@@ -70,7 +76,7 @@ class Recorder {
                 Received rec{msg->topic,
                              std::string(static_cast<const char*>(msg->payload),
                                          static_cast<std::size_t>(msg->payloadlen)),
-                             msg->retain, std::chrono::steady_clock::now()};
+                             msg->retain, std::chrono::steady_clock::now(), msg->mid};
                 std::lock_guard lock(r->mu_);
                 r->messages_.push_back(std::move(rec));
                 r->cv_.notify_all();

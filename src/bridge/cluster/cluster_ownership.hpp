@@ -27,6 +27,7 @@ class ClusterOwnership final : public Ownership {
                      std::string payload_kind = "json");
 
     [[nodiscard]] bool owns(std::string_view plc) const override { return membership_.owns(plc); }
+    [[nodiscard]] bool joined() const override { return membership_.synced(); }
     [[nodiscard]] bool owns_once_joined(std::string_view plc) const override {
         return membership_.owns_once_joined(plc);
     }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <utility>
 
+#include <spdlog/spdlog.h>
 #include <nlohmann/json.hpp>
 
 #include "bridge/cluster/rendezvous.hpp"
@@ -12,6 +13,8 @@ namespace fins::bridge::cluster {
 Membership::Membership(std::string self) : self_(std::move(self)) {}
 
 bool Membership::on_status(std::string_view instance, std::string_view payload) {
+    // No status topic names the empty instance (status_topic_instance()): not a member.
+    if (instance.empty()) return false;
     bool online = false;
     if (!payload.empty()) {
         // Anything but a JSON object with "state":"online" counts as not alive: a member is
@@ -30,13 +33,28 @@ bool Membership::on_status(std::string_view instance, std::string_view payload) 
         // until our new "online" comes back we may have been replaced.
         synced_ = online;
     }
+    // Only the instances that say they are online are kept: a name that goes offline is
+    // forgotten, and beyond max_members names the others are refused (any client of the
+    // broker can publish a status, so the table is bounded).
     const auto it = online_.find(instance);
     const bool known = it != online_.end();
-    if (known && it->second == online && was_synced == synced_) return false;
-    if (known)
-        it->second = online;
-    else
-        online_.emplace(std::string(instance), online);
+    if (online && !known) {
+        const std::size_t others = online_.size() - online_.count(self_);
+        if (others >= max_members && instance != self_) {
+            if (refused_++ % 1024 == 0)
+                spdlog::warn(
+                    "cluster: status of '{}' ignored: {} members known already (the "
+                    "bound), {} ignored so far",
+                    instance, online_.size(), refused_);
+            if (was_synced == synced_) return false;
+        } else {
+            online_.emplace(instance);
+        }
+    } else if (!online && known) {
+        online_.erase(it);
+    } else if (was_synced == synced_) {
+        return false;
+    }
     const auto before = live_;
     rebuild();
     const bool changed = before != live_ || was_synced != synced_;
@@ -54,12 +72,11 @@ bool Membership::connection_lost() {
 
 void Membership::rebuild() {
     live_.clear();
-    for (const auto& [name, online] : online_) {
-        if (!online) continue;
+    for (const auto& name : online_) {
         if (name == self_ && !synced_) continue;
         live_.push_back(name);
     }
-    // std::map iterates in order: live_ is sorted already.
+    // std::set iterates in order: live_ is sorted already.
 }
 
 bool Membership::owns(std::string_view plc) const noexcept {

@@ -20,14 +20,19 @@
 // the caller then asks owns() for each PLC and starts or stops polling.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
-#include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace fins::bridge::cluster {
+
+// Instances known at most (self not counted): the statuses of further names are ignored,
+// counted (refused()) and logged.
+inline constexpr std::size_t max_members = 256;
 
 class Membership {
   public:
@@ -59,15 +64,20 @@ class Membership {
 
     // Membership changes seen (joins + deaths), for the bridge's counters.
     std::uint64_t changes() const noexcept { return changes_; }
+    // "online" statuses of new names ignored at the max_members bound.
+    std::uint64_t refused() const noexcept { return refused_; }
+    // Instances known online (self included once it said so).
+    std::size_t known() const noexcept { return online_.size(); }
 
   private:
     void rebuild();
 
     std::string self_;
-    std::map<std::string, bool, std::less<>> online_;  // every instance heard of
+    std::set<std::string, std::less<>> online_;  // the instances whose last status is online
     std::vector<std::string> live_;
     bool synced_ = false;
     std::uint64_t changes_ = 0;
+    std::uint64_t refused_ = 0;
 };
 
 // "{prefix}/$bridge/{instance}/status" -> instance; nullopt for any other topic.

@@ -135,8 +135,40 @@ TEST(ClusterMembership, JunkAndClearedStatusesAreNotMembers) {
     EXPECT_FALSE(m.on_status("y", R"({"state":"maybe"})"));
     EXPECT_FALSE(m.on_status("z", R"(["online"])"));
     EXPECT_TRUE(m.on_status("w", online));
-    EXPECT_TRUE(m.on_status("w", ""));  // retained status deleted
+    EXPECT_TRUE(m.on_status("w", ""));      // retained status deleted
+    EXPECT_FALSE(m.on_status("", online));  // no topic names it (fuzz_membership)
     EXPECT_EQ(m.members(), std::vector<std::string>{"edge-1"});
+}
+
+TEST(ClusterMembership, TheTableIsBoundedAndForgetsTheOffline) {
+    cl::Membership m("edge-1");
+    m.on_status("edge-1", online);
+    for (std::size_t i = 0; i < 10 * cl::max_members; ++i)
+        m.on_status("x" + std::to_string(i), online);
+    // Any client of the broker can publish a status: at most max_members names, self apart.
+    EXPECT_EQ(m.known(), cl::max_members + 1);
+    EXPECT_EQ(m.refused(), 10 * cl::max_members - cl::max_members);
+    EXPECT_EQ(m.members().size(), cl::max_members + 1);
+    // Offline names are forgotten: their room is free again.
+    for (std::size_t i = 0; i < cl::max_members; ++i)
+        m.on_status("x" + std::to_string(i), offline);
+    EXPECT_EQ(m.known(), 1u);
+    EXPECT_EQ(m.members(), std::vector<std::string>{"edge-1"});
+    EXPECT_TRUE(m.on_status("late", online));
+    EXPECT_EQ(m.members(), (std::vector<std::string>{"edge-1", "late"}));
+    // An offline status of a name never seen takes no room.
+    for (int i = 0; i < 1000; ++i)
+        EXPECT_FALSE(m.on_status("gone" + std::to_string(i), offline));
+    EXPECT_EQ(m.known(), 2u);
+}
+
+TEST(ClusterMembership, ItsOwnStatusIsHeardAtTheBound) {
+    cl::Membership m("edge-1");
+    for (std::size_t i = 0; i < cl::max_members + 5; ++i)
+        m.on_status("x" + std::to_string(i), online);
+    EXPECT_TRUE(m.on_status("edge-1", online));
+    EXPECT_TRUE(m.synced());
+    EXPECT_EQ(m.members().size(), cl::max_members + 1);
 }
 
 TEST(ClusterMembership, LosingTheBrokerOrSeeingItsOwnWillGivesEverythingUp) {
