@@ -237,13 +237,13 @@ TEST(SparkplugCommand, AFailureInHandlingAMessageIsARefusalNotAnEnd) {
 TEST(SparkplugCommand, AJsonWriteWhoseHandlingFailsIsAnsweredOkFalse) {
     Harness h(false);
     h.bridge->set_command_hook([](const fb::ParsedCommand& c) {
-        if (const auto* w = std::get_if<fb::WriteCommand>(&c); w && w->id == "bad")
+        if (const auto* w = std::get_if<fb::WriteCommand>(&c); w && w->id == "\"bad\"")  // the id's JSON text
             throw std::runtime_error("boom");
     });
     h.send("plant/p/write", R"({"id":"bad","tag":"temp","value":1})");
     ASSERT_EQ(h.format->answers.size(), 1U);
     EXPECT_EQ(h.format->answers[0].first, "p");
-    EXPECT_EQ(h.format->answers[0].second.id, "bad");
+    EXPECT_EQ(h.format->answers[0].second.id, "\"bad\"");
     EXPECT_FALSE(h.format->answers[0].second.ok);
     EXPECT_EQ(h.format->answers[0].second.error, "internal error: boom");
     // The id is remembered with that answer: a repeat gets the same, and is not executed.
