@@ -83,6 +83,10 @@ struct Metrics {
     KeyedCounter instructions;   // key: kind << 16 | completion code (0000 done)
     KeyedCounter http_requests;  // key: HTTP status
     std::atomic<std::uint64_t> websocket_resyncs{0};
+    // Exceptions the web server's failure boundary caught (src/web/, docs/web.md).
+    std::atomic<std::uint64_t> web_handler_failures{0};
+    // WebSocket connections closed for exceeding their message budget (1008).
+    std::atomic<std::uint64_t> websocket_policy_closes{0};
 };
 
 // The process's metrics (every Server, Router and engine of a plant shares them).
@@ -100,6 +104,8 @@ void note_relay_error(EndCode code) noexcept;
 void note_instruction(std::uint8_t kind, std::uint16_t completion) noexcept;
 void note_http_request(unsigned status) noexcept;
 void note_websocket_resync() noexcept;
+void note_web_handler_failure() noexcept;
+void note_websocket_policy_close() noexcept;
 
 // A gauge (or a counter the caller keeps) for expose(): one sample per label set.
 struct Sample {
