@@ -64,17 +64,23 @@ double thread_cpu_seconds() {
 }
 
 // WebSocket clients on their own thread: each subscribes (or not) and counts messages.
+// --distinct: client i watches its own range D(i*512 mod 28,672) (a Watch each, not one
+// shared); pingers send pings back to back instead of subscribing (a ping flood).
 class Clients {
   public:
-    Clients(std::uint16_t port, unsigned count, unsigned words, bool subscribe) {
+    Clients(std::uint16_t port, unsigned count, unsigned words, bool subscribe,
+            bool distinct = false, bool ping = false) {
         for (unsigned i = 0; i < count; ++i) {
             auto c = std::make_unique<Client>(io_);
             auto& s = beast::get_lowest_layer(c->ws);
             s.connect(asio::ip::tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
             c->ws.handshake("127.0.0.1", "/ws");
-            if (subscribe) {
+            if (ping) {
+                c->ping = true;
+            } else if (subscribe) {
+                const unsigned start = distinct ? (i * 512) % (32768 - 4096) : 0;
                 c->ws.write(asio::buffer(fmt::format(
-                    R"({{"op":"subscribe","id":"s","address":"D0","count":{}}})", words)));
+                    R"({{"op":"subscribe","id":"s","address":"D{}","count":{}}})", start, words)));
             } else {  // an idle page: the status and a grid of words nothing changes
                 c->ws.write(
                     asio::buffer(std::string(R"({"op":"subscribe","id":"st","topic":"status"})")));
@@ -83,8 +89,10 @@ class Clients {
             }
             clients_.push_back(std::move(c));
         }
-        for (auto& c : clients_)
+        for (auto& c : clients_) {
             read(*c);
+            if (c->ping) flood(*c);
+        }
         thread_ = std::thread([this] { io_.run(); });
     }
     ~Clients() {
@@ -103,7 +111,15 @@ class Clients {
         explicit Client(asio::io_context& io) : ws(io) {}
         websocket::stream<beast::tcp_stream> ws;
         beast::flat_buffer buffer;
+        bool ping = false;
     };
+    void flood(Client& c) {
+        c.ws.async_ping({}, [this, &c](beast::error_code ec) {
+            if (ec) return;  // closed (finsd's budget: 1008)
+            ++messages_;
+            flood(c);
+        });
+    }
     void read(Client& c) {
         c.ws.async_read(c.buffer, [this, &c](beast::error_code ec, std::size_t n) {
             if (ec) return;
@@ -150,8 +166,13 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(1u, 4096u));
     app.add_option("--tick-ms", tick_ms, "Milliseconds between changes")->capture_default_str();
     app.add_flag("--json", json, "Print JSON lines");
-    bool fins_side = false;
-    unsigned rounds = 3;
+    bool fins_side = false, distinct = false;
+    unsigned rounds = 3, pingers = 0;
+    app.add_flag("--distinct", distinct,
+                 "Each client watches its own range (D0-D32767 all change every tick)");
+    app.add_option("--pingers", pingers,
+                   "With --fins: this many clients flooding pings instead of the watchers")
+        ->capture_default_str();
     app.add_flag("--fins", fins_side,
                  "FINS/UDP request rate alone and with the clients watching, and the ratio");
     app.add_option("--rounds", rounds, "With --fins: alternate the two cases this many times")
@@ -166,7 +187,7 @@ int main(int argc, char** argv) {
     fins::server::ControlTarget target;
     target.plc = &plc;
     context.targets.push_back(target);
-    context.options.max_connections = clients * 2 + 8;
+    context.options.max_connections = std::max(clients, pingers) * 2 + 8;
     auto web = fins::web::HttpServer::start(io, std::move(context));
     if (!web) {
         std::fprintf(stderr, "fins_web_load: cannot start the server\n");
@@ -181,7 +202,7 @@ int main(int argc, char** argv) {
             if (ec) return;
             ++value;
             auto dm = plc.memory().words(fins::Region::dm);
-            std::fill_n(dm.begin(), words, value);
+            std::fill_n(dm.begin(), distinct ? dm.size() : std::size_t{words}, value);
             arm();
         });
     };
@@ -242,7 +263,8 @@ int main(int argc, char** argv) {
         const double slice = seconds / rounds;
         for (unsigned r = 0; r < rounds; ++r) {
             alone.push_back(fins_udp_rate(fins_server->udp_port(), slice));
-            Clients watching((*web)->port(), clients, words, true);
+            Clients watching((*web)->port(), pingers > 0 ? pingers : clients, words, true, distinct,
+                             pingers > 0);
             std::this_thread::sleep_for(std::chrono::milliseconds(300));  // snapshots out
             const auto m0 = watching.messages();
             const auto w0 = Clock::now();

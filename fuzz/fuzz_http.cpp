@@ -62,9 +62,10 @@ void http_request(State& s, std::string_view bytes) {
         field(http::field::host),
         field(http::field::origin),
         field(http::field::authorization),
-        false};
+        false,
+        field(http::field::content_type)};
     if (auto refused = fins::web::check_request(s.context.options, meta)) {
-        check(refused->status == 403);
+        check(refused->status == 403 || refused->status == 415);
         return;
     }
     int calls = 0;

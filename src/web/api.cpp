@@ -61,11 +61,26 @@ bool allowed_host(const WebOptions& options, std::string_view hostport) {
                        [&](const std::string& h) { return lower(h) == host; });
 }
 
-bool allowed_origin(const WebOptions& options, std::string_view origin) {
-    for (const std::string_view scheme : {"http://", "https://"})
-        if (origin.substr(0, scheme.size()) == scheme)
-            return allowed_host(options, origin.substr(scheme.size()));
-    return false;
+// The page's own origin (scheme, host and port it was reached at: "http://" + Host) or
+// one configured. Not any IP literal or port: a page on http://127.0.0.2:9000 is another
+// site, and so is "null" (sandboxed frames, file: pages).
+bool allowed_origin(const WebOptions& options, std::string_view origin,
+                    std::optional<std::string_view> host) {
+    const std::string o = lower(origin);
+    if (host && !host->empty() && o == "http://" + lower(*host)) return true;
+    return std::any_of(options.allowed_origins.begin(), options.allowed_origins.end(),
+                       [&](const std::string& a) { return lower(a) == o; });
+}
+
+// application/json, any parameters (charset=utf-8), any case, optional spaces.
+bool json_content_type(std::optional<std::string_view> content_type) {
+    if (!content_type) return false;
+    std::string_view t = content_type->substr(0, content_type->find(';'));
+    while (!t.empty() && (t.back() == ' ' || t.back() == '\t'))
+        t.remove_suffix(1);
+    while (!t.empty() && (t.front() == ' ' || t.front() == '\t'))
+        t.remove_prefix(1);
+    return lower(t) == "application/json";
 }
 
 // Compares in time independent of where the first difference is.
@@ -247,8 +262,10 @@ std::optional<HttpAnswer> check_request(const WebOptions& options, const Request
                                              "or an allowed host name)",
                                              *meta.host));
     const bool changes = meta.method == "POST" || meta.websocket_upgrade;
-    if (changes && meta.origin && !allowed_origin(options, *meta.origin))
-        return error_answer(403, fmt::format("Origin {} may not use this server", *meta.origin));
+    if (changes && meta.origin && !allowed_origin(options, *meta.origin, meta.host))
+        return error_answer(403, fmt::format("Origin {} may not use this server (only the "
+                                             "page's own origin or an allowed_origins entry)",
+                                             *meta.origin));
     if (meta.method == "POST" && !options.token.empty()) {
         // The scheme is case-insensitive (RFC 9110 11.1): "bearer", "BEARER" too.
         constexpr std::string_view bearer = "bearer ";
@@ -259,6 +276,8 @@ std::optional<HttpAnswer> check_request(const WebOptions& options, const Request
                                 "this server needs \"Authorization: Bearer <token>\" "
                                 "(the token of --http-token-file)");
     }
+    if (meta.method == "POST" && !json_content_type(meta.content_type))
+        return error_answer(415, "a POST needs \"Content-Type: application/json\"");
     return std::nullopt;
 }
 

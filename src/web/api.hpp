@@ -9,7 +9,7 @@
 //   GET  /api/status             the control channel's status plus network, logs
 //   POST /api/control            any control channel request object     (control on)
 //   GET  /metrics                Prometheus text format
-// Every error is {"error":"..."} with 400, 403, 404, 405, 413 or 431.
+// Every error is {"error":"..."} with 400, 403, 404, 405, 413, 415, 431 or 500.
 #pragma once
 
 #include <chrono>
@@ -41,12 +41,17 @@ struct RequestMeta {
     std::optional<std::string_view> origin;
     std::optional<std::string_view> authorization;
     bool websocket_upgrade = false;
+    std::optional<std::string_view> content_type = std::nullopt;
 };
 
 // The rules every request passes before its route (nullopt: go on):
 //   403 a Host header naming a host other than loopback, the bound address or an allowed
-//       host (DNS rebinding); an Origin other than http://<such a host> on a POST or a
-//       WebSocket upgrade; a POST without "Authorization: Bearer <token>" when a token is set.
+//       host (DNS rebinding); on a POST or a WebSocket upgrade, an Origin other than the
+//       page's own ("http://" + the Host header, port included) or one of
+//       options.allowed_origins ("null" is refused; no Origin at all passes: curl,
+//       scripts); a POST without "Authorization: Bearer <token>" when a token is set.
+//   415 a POST whose Content-Type is not application/json (parameters allowed), so that
+//       a browser must preflight it, and finsd answers no CORS preflight.
 std::optional<HttpAnswer> check_request(const WebOptions& options, const RequestMeta& meta);
 
 // Answers one request; `done` is called exactly once: at once, or later on the io_context

@@ -3,6 +3,7 @@
 #include "web/http_server.hpp"
 
 #include <fmt/core.h>
+#include <spdlog/spdlog.h>
 #include <boost/asio/ip/address.hpp>
 #include <boost/asio/write.hpp>
 
@@ -14,38 +15,55 @@ namespace fins::web {
 
 namespace {
 
+void serve(const std::shared_ptr<ServerShared>& shared, asio::ip::tcp::socket socket) {
+    if (shared->open_connections() >= shared->context.options.max_connections) {
+        // Full: say so and close; the connections being served keep their slots.
+        auto answer = std::make_shared<std::string>();
+        const std::string body =
+            error_answer(503, fmt::format("finsd serves at most {} HTTP connections",
+                                          shared->context.options.max_connections))
+                .body;
+        *answer = fmt::format(
+            "HTTP/1.1 503 Service Unavailable\r\nContent-Type: application/json\r\n"
+            "Content-Security-Policy: {}\r\nX-Frame-Options: DENY\r\n"
+            "X-Content-Type-Options: nosniff\r\nConnection: close\r\n"
+            "Content-Length: {}\r\n\r\n{}",
+            content_security_policy, body.size(), body);
+        server::metrics::note_http_request(503);
+        auto s = std::make_shared<asio::ip::tcp::socket>(std::move(socket));
+        asio::async_write(*s, asio::buffer(*answer), [s, answer](beast::error_code, std::size_t) {
+            beast::error_code ignored;
+            s->close(ignored);
+        });
+    } else {
+        run_http_session(std::move(socket), shared);
+    }
+}
+
 void accept(const std::shared_ptr<ServerShared>& shared) {
     shared->acceptor.async_accept([shared](beast::error_code ec, asio::ip::tcp::socket socket) {
         if (shared->stopped || ec == asio::error::operation_aborted) return;
-        if (!ec) {
-            if (shared->open_connections() >= shared->context.options.max_connections) {
-                // Full: say so and close; the connections being served keep their slots.
-                auto answer = std::make_shared<std::string>();
-                const std::string body =
-                    error_answer(503, fmt::format("finsd serves at most {} HTTP connections",
-                                                  shared->context.options.max_connections))
-                        .body;
-                *answer = fmt::format(
-                    "HTTP/1.1 503 Service Unavailable\r\nContent-Type: application/json\r\n"
-                    "Content-Security-Policy: default-src 'self'\r\nConnection: close\r\n"
-                    "Content-Length: {}\r\n\r\n{}",
-                    body.size(), body);
-                server::metrics::note_http_request(503);
-                auto s = std::make_shared<asio::ip::tcp::socket>(std::move(socket));
-                asio::async_write(*s, asio::buffer(*answer),
-                                  [s, answer](beast::error_code, std::size_t) {
-                                      beast::error_code ignored;
-                                      s->close(ignored);
-                                  });
-            } else {
-                run_http_session(std::move(socket), shared);
-            }
-        }
+        if (!ec)
+            guarded(
+                *shared, "accept", [&] { serve(shared, std::move(socket)); }, [] {});
         accept(shared);
     });
 }
 
 }  // namespace
+
+void note_handler_failure(ServerShared& shared, std::string_view where, std::string_view what) {
+    server::metrics::note_web_handler_failure();
+    const auto n = shared.failures.note();
+    if (n == 0) {
+        spdlog::debug("web: {} failed: {}", where, what);
+        return;
+    }
+    spdlog::error(
+        "web: {} failed: {} (answered 500 or closed, the server goes on{}; "
+        "fins_web_handler_failures_total counts them)",
+        where, what, n > 1 ? fmt::format("; {} failures since the last such line", n) : "");
+}
 
 Result<std::unique_ptr<HttpServer>> HttpServer::start(asio::io_context& io, WebContext context) {
     beast::error_code ec;

@@ -6,8 +6,11 @@
 // http_server.cpp), an HTTP session (http_session.cpp) and a WebSocket session
 // (websocket_session.cpp) as separate small classes. Limits (WebOptions): connections,
 // header bytes and fields (431), body bytes (413), a deadline for each request and for
-// idle keep-alive connections, WebSocket message size, subscriptions and a bounded send
-// queue per WebSocket. Every answer carries Content-Security-Policy: default-src 'self'.
+// idle keep-alive connections, every byte of a request (trailers, chunk framing),
+// WebSocket message size and rate, subscriptions, a bounded send queue per WebSocket and
+// a words budget per tick. Every answer carries Content-Security-Policy: default-src
+// 'self'; frame-ancestors 'none' and X-Frame-Options: DENY. Every handler runs inside the
+// failure boundary (sessions.hpp guarded()): an exception never reaches io_context::run.
 #pragma once
 
 #include <cstdint>

@@ -13,6 +13,7 @@
 #include <boost/beast/http/message.hpp>
 #include <boost/beast/http/string_body.hpp>
 
+#include "server/sessions/log_summary.hpp"
 #include "web/subscriptions.hpp"
 #include "web/web_context.hpp"
 
@@ -27,8 +28,10 @@ class Connection {
     virtual ~Connection() = default;
     virtual void close() = 0;
     // The server's tick (every min_interval while some WebSocket has subscriptions):
-    // sends what is due; true while this connection has subscriptions.
-    virtual bool poll(SteadyTime /*now*/, std::chrono::system_clock::time_point /*wall*/) {
+    // sends what is due within `budget` (words, taken from it); true while this
+    // connection has subscriptions.
+    virtual bool poll(SteadyTime /*now*/, std::chrono::system_clock::time_point /*wall*/,
+                      std::size_t& /*budget*/) {
         return false;
     }
 };
@@ -46,6 +49,8 @@ struct ServerShared {
     std::list<std::weak_ptr<Connection>> connections;
     std::size_t websockets = 0;
     bool stopped = false;
+    // The failure boundary's log line: at most one a second (the rest at debug level).
+    server::LogSummary failures{std::chrono::seconds(1)};
 
     [[nodiscard]] std::size_t open_connections() {
         connections.remove_if([](const auto& w) { return w.expired(); });
@@ -61,11 +66,36 @@ void arm_tick(const std::shared_ptr<ServerShared>& shared);
 void run_websocket_session(beast::tcp_stream stream, http::request<http::string_body> request,
                            std::shared_ptr<ServerShared> shared);
 
-// Content-Security-Policy and the other headers every answer carries.
+// The failure boundary (docs/web.md "Security rules"): a handler threw `what` at `where`.
+// Counts fins_web_handler_failures_total and logs at most one line a second; the caller
+// answers 500 or closes the connection, and the server goes on.
+void note_handler_failure(ServerShared& shared, std::string_view where, std::string_view what);
+
+// Runs `f`; an exception it throws goes to note_handler_failure and `failed()` (which must
+// not throw: it answers 500 or closes). Every session handler runs inside one.
+template <class F, class Failed>
+void guarded(ServerShared& shared, std::string_view where, F&& f, Failed&& failed) noexcept {
+    try {
+        f();
+        return;
+    } catch (const std::exception& e) {
+        note_handler_failure(shared, where, e.what());
+    } catch (...) {
+        note_handler_failure(shared, where, "an exception that is not a std::exception");
+    }
+    failed();
+}
+
+inline constexpr std::string_view content_security_policy =
+    "default-src 'self'; frame-ancestors 'none'";
+
+// Content-Security-Policy and the other headers every answer carries (no page may frame
+// finsd's: clickjacking of its buttons).
 template <class Message>
 void set_common_headers(Message& m) {
     m.set(http::field::server, "finsd");
-    m.set("Content-Security-Policy", "default-src 'self'");
+    m.set("Content-Security-Policy", content_security_policy);
+    m.set("X-Frame-Options", "DENY");
     m.set("X-Content-Type-Options", "nosniff");
     m.set(http::field::cache_control, "no-store");
 }

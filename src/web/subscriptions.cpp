@@ -1,10 +1,16 @@
 // WebSocket subscriptions (contract in subscriptions.hpp).
 #include "web/subscriptions.hpp"
 
-#include <algorithm>
-#include <random>
+#include <sys/random.h>
 
-#include <fmt/core.h>
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <iterator>
+#include <limits>
+#include <system_error>
+
+#include <fmt/format.h>
 
 #include "plc/plc.hpp"
 #include "server/control/control_dispatch.hpp"
@@ -155,8 +161,23 @@ void Subscriptions::subscribe(const Json& j, std::vector<Message>& out) {
 
 void Subscriptions::poll(SteadyTime now, std::chrono::system_clock::time_point wall,
                          std::vector<Message>& out) {
-    for (auto& s : subs_)
+    std::size_t unlimited = std::numeric_limits<std::size_t>::max();
+    poll(now, wall, out, unlimited);
+}
+
+void Subscriptions::poll(SteadyTime now, std::chrono::system_clock::time_point wall,
+                         std::vector<Message>& out, std::size_t& budget) {
+    const std::size_t n = subs_.size();
+    for (std::size_t k = 0; k < n; ++k) {
+        Sub& s = subs_[(next_ + k) % n];
+        const std::size_t cost = s.watch->due(now) ? s.watch->cost() : 0;
+        if (cost > 0 && budget == 0) {
+            next_ = (next_ + k) % n;  // this one first next time
+            return;
+        }
+        budget -= std::min(budget, cost);
         poll_one(s, now, wall, out);
+    }
 }
 
 void Subscriptions::poll_one(Sub& s, SteadyTime now, std::chrono::system_clock::time_point wall,
@@ -261,9 +282,22 @@ std::unique_ptr<Subscriptions> ResumeStore::take(std::string_view session, Stead
     return nullptr;
 }
 
+// 128 bits from the kernel's CSPRNG (getrandom(2)): a session name is a capability (it
+// takes over another page's subscriptions), so it must not be guessable from others.
 std::string new_session_id() {
-    static thread_local std::mt19937_64 generator{std::random_device{}()};
-    return fmt::format("{:016x}{:016x}", generator(), generator());
+    std::array<unsigned char, 16> bits{};
+    std::size_t got = 0;
+    while (got < bits.size()) {
+        const auto n = ::getrandom(bits.data() + got, bits.size() - got, 0);
+        if (n < 0 && errno == EINTR) continue;
+        if (n < 0) throw std::system_error(errno, std::generic_category(), "getrandom");
+        got += static_cast<std::size_t>(n);
+    }
+    std::string hex;
+    hex.reserve(2 * bits.size());
+    for (const auto b : bits)
+        fmt::format_to(std::back_inserter(hex), "{:02x}", b);
+    return hex;
 }
 
 }  // namespace fins::web

@@ -73,6 +73,13 @@ class Subscriptions {
     // The messages due at `now` (`wall` stamps clock pulses and the like).
     void poll(SteadyTime now, std::chrono::system_clock::time_point wall,
               std::vector<Message>& out);
+    // The same within `budget` (Watch::cost() of the watches refreshed, taken from it):
+    // subscriptions are polled round-robin from where the last poll stopped; when the
+    // budget is spent, the rest wait for the next poll (their watch is not read, nothing
+    // is lost: their next message carries what changed meanwhile). A poll with some
+    // budget left always refreshes at least one due watch, however large.
+    void poll(SteadyTime now, std::chrono::system_clock::time_point wall, std::vector<Message>& out,
+              std::size_t& budget);
     // Every subscription's next message is a snapshot (the client fell behind, or what
     // it missed is no longer in the history).
     void resync() noexcept;
@@ -106,6 +113,7 @@ class Subscriptions {
     std::string session_;
     std::uint64_t seq_ = 0;
     std::vector<Sub> subs_;
+    std::size_t next_ = 0;  // where the next budgeted poll starts
     std::deque<std::pair<std::uint64_t, Message>> history_;
     std::size_t history_size_ = 0;
 };

@@ -32,6 +32,10 @@ void Watch::refresh(const WebContext& context, SteadyTime now,
         refresh_topic(context, wall);
 }
 
+std::size_t Watch::cost() const noexcept {
+    return topic_.empty() ? std::max<std::size_t>(1, query_.elements) : topic_cost;
+}
+
 void Watch::set_error(std::string message) {
     if (!have_values_ && error_ == message) return;
     error_ = std::move(message);

@@ -39,6 +39,9 @@ struct WebContext;
 using SteadyTime = std::chrono::steady_clock::time_point;
 using SharedText = std::shared_ptr<const std::string>;
 
+// A topic's object (status, errors, events) against the tick's budget, in words.
+inline constexpr std::size_t topic_cost = 256;
+
 // How often a topic's object is built again to see whether it changed.
 inline constexpr std::chrono::milliseconds topic_interval{500};
 
@@ -51,6 +54,13 @@ class Watch {
     void refresh(const WebContext& context, SteadyTime now,
                  std::chrono::system_clock::time_point wall);
 
+    // True when refresh() at `now` reads (the interval passed, or never read).
+    [[nodiscard]] bool due(SteadyTime now) const noexcept {
+        return !read_once_ || now >= next_refresh_;
+    }
+    // What a refresh costs, in the unit of the tick's budget (WebOptions::
+    // max_ws_words_per_tick): the elements read, or topic_cost for a topic's object.
+    [[nodiscard]] std::size_t cost() const noexcept;
     // Rises with every change of what a client shows (values, object, error state).
     [[nodiscard]] std::uint64_t generation() const noexcept { return generation_; }
     // The next refresh reads whatever the time (something changed it).

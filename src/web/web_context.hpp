@@ -9,6 +9,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -29,6 +30,9 @@ struct WebOptions {
     // Host names besides the loopback ones and the bound address that the Host header
     // (and so a browser's Origin) may name: DNS rebinding protection.
     std::vector<std::string> allowed_hosts;
+    // Origins besides the page's own ("http://" + the Host header) that may POST and open
+    // /ws, compared whole and case-insensitively: "https://scada.lan" (a TLS proxy).
+    std::vector<std::string> allowed_origins;
 
     std::size_t max_body_bytes = 64 * 1024;   // 413 beyond
     std::size_t max_header_bytes = 8 * 1024;  // 431 beyond (request line + fields)
@@ -39,13 +43,21 @@ struct WebOptions {
 
     // WebSocket.
     std::size_t max_ws_message_bytes = 4 * 1024;
+    // Client messages and pings per connection per second (a burst of as many); beyond:
+    // closed with 1008 (policy violation).
+    std::size_t max_ws_messages_per_second = 100;
     // Keep-alive: a client silent for half of it is pinged; one that does not answer
     // (nothing received, not even the pong) by the end of it is closed.
     std::chrono::milliseconds websocket_idle_timeout{std::chrono::seconds(60)};
     std::size_t max_subscriptions = 64;           // per connection
     std::size_t max_queued_messages = 32;         // per connection; beyond: drop to snapshots
     std::chrono::milliseconds min_interval{100};  // per subscription: at most 10 updates/s
-    std::size_t history_messages = 256;           // kept per connection for "resume"
+    // Work of one tick (every min_interval), in words read (Watch::cost()): per connection
+    // and in all. Subscriptions beyond it wait for the next tick, round-robin, so FINS
+    // keeps most of the I/O thread whatever the pages watch (docs/web.md).
+    std::size_t max_ws_words_per_tick_per_connection = 8 * 1024;
+    std::size_t max_ws_words_per_tick = 32 * 1024;
+    std::size_t history_messages = 256;  // kept per connection for "resume"
     std::chrono::milliseconds resume_window{std::chrono::seconds(30)};  // a closed one kept
     std::size_t max_resumable = 16;  // closed connections kept for "resume"
 };
@@ -61,6 +73,10 @@ struct WebContext {
     std::function<std::string()> metrics;
     // What every connection's subscriptions watch, each read once per interval.
     std::shared_ptr<Watches> watches = std::make_shared<Watches>();
+    // Tests only (absent in finsd): called at the failure boundary's points, "http request"
+    // (before a request's route), "websocket message" (before a client message is handled)
+    // and "websocket poll" (a connection's share of the tick), so a test can make each throw.
+    std::function<void(std::string_view point)> fault;
 };
 
 }  // namespace fins::web

@@ -206,39 +206,85 @@ TEST(ApiSecurity, ChecksHostOriginAndToken) {
     web::WebOptions o;
     o.port = 8080;
     auto check = [&](web::RequestMeta m) { return web::check_request(o, m); };
+    const std::optional<std::string_view> json = "application/json";
     EXPECT_FALSE(check({"GET", "/", "127.0.0.1:8080", std::nullopt, std::nullopt}));
     EXPECT_FALSE(check({"GET", "/", "localhost:8080", std::nullopt, std::nullopt}));
     EXPECT_FALSE(check({"GET", "/", "[::1]:8080", std::nullopt, std::nullopt}));
     // DNS rebinding: a name that is not ours.
     EXPECT_EQ(check({"GET", "/", "evil.example:8080", std::nullopt, std::nullopt})->status, 403u);
-    EXPECT_FALSE(check({"POST", "/api/write", "127.0.0.1:8080", "http://127.0.0.1:8080", {}}));
-    EXPECT_EQ(check({"POST", "/api/write", "127.0.0.1:8080", "http://evil.example", {}})->status,
+    EXPECT_FALSE(
+        check({"POST", "/api/write", "127.0.0.1:8080", "http://127.0.0.1:8080", {}, false, json}));
+    EXPECT_FALSE(
+        check({"POST", "/api/write", "127.0.0.1:8080", "HTTP://127.0.0.1:8080", {}, false, json}));
+    EXPECT_EQ(
+        check({"POST", "/api/write", "127.0.0.1:8080", "http://evil.example", {}, false, json})
+            ->status,
+        403u);
+    // Only the page's own origin: not another IP literal, port, scheme or name for it.
+    for (const char* other : {"http://127.0.0.2:9000", "http://127.0.0.1:9000", "http://127.0.0.1",
+                              "https://127.0.0.1:8080", "http://localhost:8080", "null", ""})
+        EXPECT_EQ(check({"POST", "/api/write", "127.0.0.1:8080", other, {}, false, json})->status,
+                  403u)
+            << other;
+    // No Host (HTTP/1.0): no own origin to compare with.
+    EXPECT_EQ(check({"POST", "/api/write", std::nullopt, "http://127.0.0.1:8080", {}, false, json})
+                  ->status,
               403u);
     EXPECT_EQ(check({"GET", "/ws", "127.0.0.1:8080", "http://evil.example", {}, true})->status,
               403u);
+    EXPECT_EQ(check({"GET", "/ws", "127.0.0.1:8080", "null", {}, true})->status, 403u);
+    EXPECT_FALSE(check({"GET", "/ws", "127.0.0.1:8080", "http://127.0.0.1:8080", {}, true}));
     // A GET from another origin changes nothing: the browser's same-origin rule guards it.
     EXPECT_FALSE(check({"GET", "/api/read", "127.0.0.1:8080", "http://evil.example", {}}));
     o.allowed_hosts = {"plc-sim.lan"};
-    EXPECT_FALSE(check({"POST", "/api/write", "plc-sim.lan:8080", "http://plc-sim.lan:8080", {}}));
+    EXPECT_FALSE(check(
+        {"POST", "/api/write", "plc-sim.lan:8080", "http://plc-sim.lan:8080", {}, false, json}));
+    o.allowed_origins = {"https://SCADA.lan"};
+    EXPECT_FALSE(
+        check({"POST", "/api/write", "127.0.0.1:8080", "https://scada.lan", {}, false, json}));
+    EXPECT_FALSE(check({"GET", "/ws", "127.0.0.1:8080", "https://scada.lan", {}, true}));
     o.token = "s3cret";
-    EXPECT_EQ(check({"POST", "/api/write", "127.0.0.1:8080", std::nullopt, std::nullopt})->status,
-              403u);
     EXPECT_EQ(
-        check({"POST", "/api/write", "127.0.0.1:8080", std::nullopt, "Bearer s3creT"})->status,
+        check({"POST", "/api/write", "127.0.0.1:8080", std::nullopt, std::nullopt, false, json})
+            ->status,
         403u);
-    EXPECT_FALSE(check({"POST", "/api/write", "127.0.0.1:8080", std::nullopt, "Bearer s3cret"}));
+    EXPECT_FALSE(check(
+        {"POST", "/api/write", "127.0.0.1:8080", std::nullopt, "Bearer s3cret", false, json}));
     // The scheme is case-insensitive (RFC 9110 11.1); the token is not.
-    EXPECT_FALSE(check({"POST", "/api/write", "127.0.0.1:8080", std::nullopt, "bearer s3cret"}));
-    EXPECT_FALSE(check({"POST", "/api/write", "127.0.0.1:8080", std::nullopt, "BEARER s3cret"}));
+    EXPECT_FALSE(check(
+        {"POST", "/api/write", "127.0.0.1:8080", std::nullopt, "bearer s3cret", false, json}));
+    EXPECT_FALSE(check(
+        {"POST", "/api/write", "127.0.0.1:8080", std::nullopt, "BEARER s3cret", false, json}));
     EXPECT_EQ(
-        check({"POST", "/api/write", "127.0.0.1:8080", std::nullopt, "BEARER S3CRET"})->status,
+        check({"POST", "/api/write", "127.0.0.1:8080", std::nullopt, "BEARER S3CRET", false, json})
+            ->status,
         403u);
     EXPECT_EQ(
-        check({"POST", "/api/write", "127.0.0.1:8080", std::nullopt, "Basic s3cret"})->status,
+        check({"POST", "/api/write", "127.0.0.1:8080", std::nullopt, "Basic s3cret", false, json})
+            ->status,
         403u);
-    EXPECT_EQ(check({"POST", "/api/write", "127.0.0.1:8080", std::nullopt, "Bearer"})->status,
+    EXPECT_EQ(check({"POST", "/api/write", "127.0.0.1:8080", std::nullopt, "Bearer", false, json})
+                  ->status,
               403u);
     EXPECT_FALSE(check({"GET", "/api/read", "127.0.0.1:8080", std::nullopt, std::nullopt}));
+}
+
+TEST(ApiSecurity, APostNeedsAJsonContentType) {
+    web::WebOptions o;
+    auto status = [&](std::optional<std::string_view> type) {
+        auto r = web::check_request(
+            o, {"POST", "/api/control", "127.0.0.1", std::nullopt, std::nullopt, false, type});
+        return r ? r->status : 0u;
+    };
+    EXPECT_EQ(status(std::nullopt), 415u);
+    EXPECT_EQ(status("text/plain"), 415u);
+    EXPECT_EQ(status("multipart/form-data; boundary=x"), 415u);
+    EXPECT_EQ(status("application/json-seq"), 415u);
+    EXPECT_EQ(status("application/json"), 0u);
+    EXPECT_EQ(status("Application/JSON ; charset=UTF-8"), 0u);
+    // A GET needs none.
+    EXPECT_FALSE(web::check_request(
+        o, {"GET", "/api/read", "127.0.0.1", std::nullopt, std::nullopt, false, std::nullopt}));
 }
 
 }  // namespace

@@ -35,6 +35,7 @@ listen = "127.0.0.1:8081"
 control = true
 token_file = "/tmp/token"
 allowed_hosts = ["plc-sim.lan"]
+allowed_origins = ["https://scada.lan", "http://10.0.0.5:8080"]
 max_connections = 10
 )",
                               "test.toml", s);
@@ -43,6 +44,8 @@ max_connections = 10
     EXPECT_TRUE(s.http.control);
     EXPECT_EQ(s.http.token_file, "/tmp/token");
     EXPECT_EQ(s.http.allowed_hosts, std::vector<std::string>{"plc-sim.lan"});
+    EXPECT_EQ(s.http.allowed_origins,
+              (std::vector<std::string>{"https://scada.lan", "http://10.0.0.5:8080"}));
     EXPECT_EQ(s.http.max_connections, 10u);
 }
 
@@ -50,7 +53,8 @@ TEST(ConfigHttp, RefusesBadKeysNamingThem) {
     for (const char* text :
          {"[http]\nlisten = 8080\n", "[http]\nlisten = \"x:1\"\n", "[http]\ncontrol = 1\n",
           "[http]\nmax_connections = 0\n", "[http]\nallowed_hosts = \"a\"\n", "[http]\nport = 1\n",
-          "http = 1\n"}) {
+          "[http]\nallowed_origins = [\"scada.lan\"]\n",
+          "[http]\nallowed_origins = [\"https://scada.lan/page\"]\n", "http = 1\n"}) {
         Settings s;
         auto r = load_config_text(text, "test.toml", s);
         ASSERT_FALSE(r) << text;

@@ -19,13 +19,13 @@ TEST(HttpServer, ServesThePageAndTheApiWithTheSecurityHeaders) {
     auto page = c.request(http::verb::get, "/");
     EXPECT_EQ(page.result_int(), 200u);
     EXPECT_EQ(page[http::field::content_type], "text/html; charset=utf-8");
-    EXPECT_EQ(page["Content-Security-Policy"], "default-src 'self'");
+    EXPECT_EQ(page["Content-Security-Policy"], "default-src 'self'; frame-ancestors 'none'");
     // Keep-alive: the same connection serves the next requests.
     s.on_io([&] { s.plc().memory().words(Region::dm)[100] = 42; });
     auto read = c.request(http::verb::get, "/api/read?address=D100&count=2");
     EXPECT_EQ(read.result_int(), 200u);
     EXPECT_EQ(body_json(read), Json::parse(R"({"address":"D100","as":"uint16","values":[42,0]})"));
-    EXPECT_EQ(read["Content-Security-Policy"], "default-src 'self'");
+    EXPECT_EQ(read["Content-Security-Policy"], "default-src 'self'; frame-ancestors 'none'");
     auto status = c.request(http::verb::get, "/api/status");
     EXPECT_EQ(body_json(status)["mode"], "run");
     EXPECT_EQ(c.request(http::verb::get, "/api/plcs").result_int(), 200u);

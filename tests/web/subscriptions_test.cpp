@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
 #include "plc/plc.hpp"
@@ -254,6 +255,35 @@ TEST_F(Subs, TheStoreIsBoundedInCountAndTime) {
     EXPECT_EQ(store.size(), 2u);
     EXPECT_EQ(store.take("a", now_), nullptr);
     EXPECT_EQ(store.take("c", now_ + context_.options.resume_window), nullptr);  // expired
+}
+
+TEST_F(Subs, ABudgetedPollRefreshesRoundRobinWithinItsBudget) {
+    // Three subscriptions of 1,000 words each; a budget of 1,500 words per poll refreshes
+    // (and sends for) at most two, and the one left waiting goes first at the next poll.
+    web::Subscriptions s(context_, "x");
+    for (const char* id : {"a", "b", "c"})
+        send(s, fmt::format(R"({{"op":"subscribe","id":"{}","address":"D{}","count":1000}})", id,
+                            id[0] == 'a'   ? 0
+                            : id[0] == 'b' ? 1000
+                                           : 2000));
+    const auto ids = [&](std::size_t budget, std::size_t* left = nullptr) {
+        std::vector<web::Message> out;
+        s.poll(now_, wall(), out, budget);
+        if (left != nullptr) *left = budget;
+        std::vector<std::string> names;
+        for (const auto& m : out)
+            names.push_back(Json::parse(m.text())["id"].get<std::string>());
+        return names;
+    };
+    std::size_t left = 0;
+    EXPECT_EQ(ids(1500, &left), (std::vector<std::string>{"a", "b"}));  // b: the one beyond
+    EXPECT_EQ(left, 0u);
+    EXPECT_EQ(ids(1500), (std::vector<std::string>{"c"}));  // not due again before interval
+    now_ += context_.options.min_interval;
+    std::fill_n(dm().begin(), 3000, std::uint16_t{7});
+    EXPECT_EQ(ids(1500), (std::vector<std::string>{"c", "a"}));  // c first: it waited
+    EXPECT_EQ(ids(0), (std::vector<std::string>{}));             // no budget: nothing read
+    EXPECT_EQ(ids(1500), (std::vector<std::string>{"b"}));
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <future>
 #include <memory>
 #include <string>
@@ -30,7 +31,9 @@ namespace http = beast::http;
 
 class WebServer {
   public:
-    explicit WebServer(web::WebOptions options = {}, std::size_t plcs = 1) {
+    // `fault`: WebContext::fault (the failure boundary's test hook).
+    explicit WebServer(web::WebOptions options = {}, std::size_t plcs = 1,
+                       std::function<void(std::string_view)> fault = {}) {
         for (std::size_t i = 0; i < plcs; ++i)
             plcs_.push_back(std::make_unique<plc::Plc>());
         web::WebContext context;
@@ -43,6 +46,7 @@ class WebServer {
         }
         options.port = 0;
         context.options = options;
+        context.fault = std::move(fault);
         context.metrics = [] {
             return server::metrics::expose(server::metrics::process_metrics());
         };
@@ -115,6 +119,22 @@ class HttpClient {
         stream_.expires_after(std::chrono::seconds(10));
         http::read(stream_, buffer_, p);
         return p.release();
+    }
+    // Sends `bytes` as far as the server takes them (it may close midway: a limit), then
+    // reads whatever came back until the server closes: the answer's text, or "".
+    std::string raw_until_closed(const std::string& bytes) {
+        beast::error_code ec;
+        stream_.expires_after(std::chrono::seconds(10));
+        asio::write(stream_, asio::buffer(bytes), ec);
+        std::string in;
+        char chunk[4096];
+        for (int i = 0; i < 1000; ++i) {
+            stream_.expires_after(std::chrono::seconds(10));
+            const auto n = stream_.read_some(asio::buffer(chunk), ec);
+            in.append(chunk, n);
+            if (ec) break;
+        }
+        return in;
     }
     // True when the server closed the connection (read returns end of stream).
     bool closed() {

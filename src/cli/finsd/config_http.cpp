@@ -89,6 +89,24 @@ tl::expected<void, std::string> load_http_table(const toml::node& node, std::str
                 if (s == nullptr || s->get().empty()) return fail("must be an array of host names");
                 http.allowed_hosts.push_back(s->get());
             }
+        } else if (k == "allowed_origins") {
+            // Whole origins, as a browser sends them: scheme://host[:port], no path.
+            const auto* a = value.as_array();
+            const auto bad = [&] {
+                return fail("must be an array of origins like \"https://scada.lan\"");
+            };
+            if (a == nullptr) return bad();
+            http.allowed_origins.clear();
+            for (const auto& o : *a) {
+                const auto* s = o.as_string();
+                if (s == nullptr) return bad();
+                const std::string_view v = s->get();
+                const auto scheme = v.find("://");
+                if (scheme == std::string_view::npos || scheme == 0 || v.size() == scheme + 3 ||
+                    v.find('/', scheme + 3) != std::string_view::npos)
+                    return bad();
+                http.allowed_origins.push_back(s->get());
+            }
         } else if (k == "max_connections") {
             const auto* i = value.as_integer();
             if (i == nullptr || i->get() < 1 || i->get() > 1024) return fail("must be 1-1024");

@@ -8,6 +8,8 @@
 //                                    # not a loopback address and control is on
 //   allowed_hosts = ["plc-sim.lan"]  # host names the Host header may carry (besides
 //                                    # localhost and IP addresses)
+//   allowed_origins = ["https://scada.lan"]  # origins besides the page's own that may
+//                                    # POST and open /ws (docs/web.md "Security rules")
 //   max_connections = 64
 //   websocket_idle_timeout = 60      # seconds: a silent WebSocket client is pinged after
 //                                    # half of it and closed when nothing came by its end
@@ -36,6 +38,7 @@ struct HttpSettings {
     bool control = false;
     std::optional<std::filesystem::path> token_file;
     std::vector<std::string> allowed_hosts;
+    std::vector<std::string> allowed_origins;
     std::size_t max_connections = 64;
     std::chrono::milliseconds websocket_idle_timeout{std::chrono::seconds(60)};
 };

@@ -67,6 +67,7 @@ WebStart start_web(boost::asio::io_context& io, const HttpSettings& http,
     context.options.port = listen->second;
     context.options.control = http.control;
     context.options.allowed_hosts = http.allowed_hosts;
+    context.options.allowed_origins = http.allowed_origins;
     context.options.max_connections = http.max_connections;
     context.options.websocket_idle_timeout = http.websocket_idle_timeout;
     if (http.token_file) {

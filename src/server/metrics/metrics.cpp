@@ -130,6 +130,14 @@ void note_control_failure() noexcept {
     process_metrics().control_failures.fetch_add(1, std::memory_order_relaxed);
 }
 
+void note_web_handler_failure() noexcept {
+    process_metrics().web_handler_failures.fetch_add(1, std::memory_order_relaxed);
+}
+
+void note_websocket_policy_close() noexcept {
+    process_metrics().websocket_policy_closes.fetch_add(1, std::memory_order_relaxed);
+}
+
 std::string expose(const Metrics& m, std::span<const Family> extra) {
     std::string out;
     out.reserve(8192);
@@ -193,6 +201,14 @@ std::string expose(const Metrics& m, std::span<const Family> extra) {
     header(out, "fins_websocket_resyncs_total",
            "WebSocket clients that fell behind: queue dropped, snapshots sent", "counter");
     line("fins_websocket_resyncs_total", "", m.websocket_resyncs.load(std::memory_order_relaxed));
+    header(out, "fins_web_handler_failures_total",
+           "Web handlers that threw: answered 500 or closed, the server went on", "counter");
+    line("fins_web_handler_failures_total", "",
+         m.web_handler_failures.load(std::memory_order_relaxed));
+    header(out, "fins_websocket_policy_closes_total",
+           "WebSocket connections closed (1008) for sending more than their budget", "counter");
+    line("fins_websocket_policy_closes_total", "",
+         m.websocket_policy_closes.load(std::memory_order_relaxed));
 
     header(out, "fins_request_failures_total",
            "FINS requests whose handling failed with an exception (answered 0301 or dropped)",

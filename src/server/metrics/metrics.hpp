@@ -91,6 +91,10 @@ struct Metrics {
     // Requests whose handling threw (sessions/failure_boundary.hpp).
     std::atomic<std::uint64_t> request_failures{0};
     std::atomic<std::uint64_t> control_failures{0};
+    // Exceptions the web server's failure boundary caught (src/web/, docs/web.md).
+    std::atomic<std::uint64_t> web_handler_failures{0};
+    // WebSocket connections closed for exceeding their message budget (1008).
+    std::atomic<std::uint64_t> websocket_policy_closes{0};
 };
 
 // The process's metrics (every Server, Router and engine of a plant shares them).
@@ -110,6 +114,8 @@ void note_http_request(unsigned status) noexcept;
 void note_websocket_resync() noexcept;
 void note_request_failure() noexcept;
 void note_control_failure() noexcept;
+void note_web_handler_failure() noexcept;
+void note_websocket_policy_close() noexcept;
 
 // A gauge (or a counter the caller keeps) for expose(): one sample per label set.
 struct Sample {
