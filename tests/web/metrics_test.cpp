@@ -150,10 +150,12 @@ TEST(Metrics, ControlFailuresOverHttpAreAnsweredCountedAndExported) {
     server::set_control_fault_for_tests(nullptr);
     EXPECT_EQ(r.result_int(), 500u);
     EXPECT_EQ(body_json(r)["error"], "internal error: std::bad_alloc (out of memory)") << r.body();
-    // The server goes on: the same connection, the next request.
-    r = c.request(http::verb::post, "/api/control", R"({"cmd":"mode","mode":"program"})");
+    // The server goes on (a 5xx answer closes its connection: http_session.cpp): the next
+    // request on a new connection.
+    HttpClient c2(s.port());
+    r = c2.request(http::verb::post, "/api/control", R"({"cmd":"mode","mode":"program"})");
     EXPECT_EQ(r.result_int(), 200u) << r.body();
-    r = c.request(http::verb::get, "/metrics");
+    r = c2.request(http::verb::get, "/metrics");
     EXPECT_NE(r.body().find(fmt::format("fins_control_failures_total {}\n", before + 1)),
               std::string::npos)
         << r.body();
