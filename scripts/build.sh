@@ -16,6 +16,11 @@ case "$kind" in
   fuzz) dir=build-fuzz; args=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DFINS_FUZZ=ON -DFINS_TESTS=OFF -DCMAKE_CXX_COMPILER=clang++-14) ;;
   *) echo "usage: $0 [release|asan|fuzz]" >&2; exit 2 ;;
 esac
+# The finskit Python module (release tree) is for Debian's interpreter, whatever python3
+# comes first on PATH (a pyenv one may lack the headers, or be another version).
+if [[ "$kind" == release && -x /usr/bin/python3 ]]; then
+  args+=(-DPython3_EXECUTABLE=/usr/bin/python3)
+fi
 source "$root/scripts/ccache.sh"
 args+=("${fins_ccache_args[@]}")
 dir=${FINS_BUILD_DIR:-$root/$dir}

@@ -1,6 +1,7 @@
 """pytest plugin: the `virtual_plc` fixture, a running finskit.VirtualPlc per test.
 
-Registered automatically when finskit is installed (entry point pytest11), or with
+Registered automatically when finskit is installed or on PYTHONPATH (entry point pytest11,
+through finskit_pytest, which skips it when the extension cannot be imported), or with
 `pytest_plugins = ["finskit.pytest_plugin"]`. Options come from a marker:
 
     @pytest.mark.virtual_plc(profile="cj1m", mode="program")

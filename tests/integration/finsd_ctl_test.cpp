@@ -3,12 +3,15 @@
 // seconds as `fins --timeout`. Every wait is bounded (process.hpp).
 #include <poll.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/un.h>
 #include <unistd.h>
 
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -132,18 +135,100 @@ TEST(FinsdCtl, Newcomer6_FinsdAndCtlShareTheDefaultSocket) {
     d.terminate();
     EXPECT_EQ(d.wait().exit_code, 0);
 
-    // The rule itself: FINSD_SOCKET, else XDG_RUNTIME_DIR (not root), else /run/finsd.
+    // The rule itself: FINSD_SOCKET, else XDG_RUNTIME_DIR, else /run/finsd (root) or
+    // /tmp/finsd-UID.
     const char* saved = std::getenv("FINSD_SOCKET");
     const std::string before = saved != nullptr ? saved : "";
     ::setenv("FINSD_SOCKET", "/tmp/x.sock", 1);
     EXPECT_EQ(cli::default_control_socket(), "/tmp/x.sock");
+    EXPECT_EQ(cli::default_control_sockets(), std::vector<std::filesystem::path>{"/tmp/x.sock"});
     ::unsetenv("FINSD_SOCKET");
     const char* xdg = std::getenv("XDG_RUNTIME_DIR");
-    if (::geteuid() == 0 || xdg == nullptr || *xdg == '\0')
-        EXPECT_EQ(cli::default_control_socket(), "/run/finsd/finsd.sock");
-    else
-        EXPECT_EQ(cli::default_control_socket(), std::filesystem::path(xdg) / "finsd.sock");
+    const std::filesystem::path own = ::geteuid() == 0
+                                          ? std::filesystem::path("/run/finsd/finsd.sock")
+                                          : std::filesystem::path("/tmp/finsd-" +
+                                                                  std::to_string(::geteuid())) /
+                                                "finsd.sock";
+    if (xdg == nullptr || *xdg == '\0') {
+        EXPECT_EQ(cli::default_control_socket(), own);
+        EXPECT_EQ(cli::default_control_sockets(), std::vector<std::filesystem::path>{own});
+    } else {
+        const auto first = std::filesystem::path(xdg) / "finsd.sock";
+        EXPECT_EQ(cli::default_control_socket(), first);
+        EXPECT_EQ(cli::default_control_sockets(), (std::vector<std::filesystem::path>{first, own}));
+    }
     if (!before.empty()) ::setenv("FINSD_SOCKET", before.c_str(), 1);
+}
+
+// Issue 26 point 8: finsd started as the docs show it (no --control, no FINSD_SOCKET)
+// has a control channel, and `finsd ctl status` as the docs show it reaches it: both use
+// $XDG_RUNTIME_DIR/finsd.sock (a scratch one here, so runs do not collide).
+TEST(FinsdCtl, Issue26_8_FinsdAndCtlMeetAtTheDefaultSocketWithoutFlags) {
+    ScratchDir dir("ctlxdg");
+    const std::string xdg = "XDG_RUNTIME_DIR=" + dir.path().string();
+    Child d({"/usr/bin/env", "-u", "FINSD_SOCKET", xdg, finsd_path, "--port", "0"});
+    ASSERT_EQ(d.read_line().rfind("listening ", 0), 0u);
+    EXPECT_TRUE(std::filesystem::is_socket(dir.path() / "finsd.sock"));
+    const auto r = run({"/usr/bin/env", "-u", "FINSD_SOCKET", xdg, finsd_path, "ctl", "status"});
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(has(r.out, "\"ok\":true")) << r.out;
+    d.terminate();
+    const auto end = d.wait();
+    EXPECT_EQ(end.exit_code, 0);
+    EXPECT_TRUE(has(end.err, "control channel on " + (dir.path() / "finsd.sock").string()))
+        << end.err;
+}
+
+// Issue 26 point 8: with no finsd at the default places, `finsd ctl` names the place and
+// says how to start finsd with a control channel (the exact flag).
+TEST(FinsdCtl, Issue26_8_CtlErrorSaysHowToStartFinsdWithAChannel) {
+    ScratchDir dir("ctlnone");
+    const auto r = run({"/usr/bin/env", "-u", "FINSD_SOCKET",
+                        "XDG_RUNTIME_DIR=" + dir.path().string(), finsd_path, "ctl", "status"});
+    EXPECT_NE(r.exit_code, 0);
+    // The first default place that holds a socket, else the first: a stale socket another
+    // run left at /run/finsd or /tmp/finsd-UID may be named instead of the scratch one.
+    EXPECT_TRUE(has(r.err, "finsd ctl: cannot connect to ")) << r.err;
+    EXPECT_TRUE(has(r.err, "`finsd --control PATH`")) << r.err;
+    EXPECT_TRUE(has(r.err, "FINSD_SOCKET=PATH")) << r.err;
+}
+
+// Issue 26 point 8: the directory finsd creates for its default socket (/run/finsd for
+// root, /tmp/finsd-UID otherwise) is created with its mode and refused when it is a link,
+// not a directory, open to others or (root only can arrange it) owned by someone else.
+TEST(FinsdCtl, Issue26_8_SocketDirectoryIsCreatedAndCheckedBeforeUse) {
+    ScratchDir dir("ctldir");
+    const uid_t me = ::geteuid();
+    const auto fresh = dir.path() / "finsd-fresh";
+    EXPECT_EQ(cli::prepare_socket_directory(fresh, 0700, me), "");
+    struct stat st {};
+    ASSERT_EQ(::lstat(fresh.c_str(), &st), 0);
+    EXPECT_EQ(st.st_mode & 07777, 0700u);
+    EXPECT_EQ(cli::prepare_socket_directory(fresh, 0700, me), "");  // again: still fine
+
+    const auto shared = dir.path() / "finsd-shared";
+    ASSERT_EQ(::mkdir(shared.c_str(), 0700), 0);
+    ASSERT_EQ(::chmod(shared.c_str(), 0777), 0);
+    EXPECT_TRUE(has(cli::prepare_socket_directory(shared, 0700, me), "has mode 0777"));
+    ASSERT_EQ(::chmod(shared.c_str(), 0755), 0);
+    EXPECT_TRUE(has(cli::prepare_socket_directory(shared, 0700, me), "has mode 0755"));
+    EXPECT_EQ(cli::prepare_socket_directory(shared, 0755, me), "");  // /run/finsd's mode
+
+    const auto link = dir.path() / "finsd-link";
+    std::filesystem::create_directory_symlink(fresh, link);
+    EXPECT_TRUE(has(cli::prepare_socket_directory(link, 0700, me), "is a symbolic link"));
+    const auto file = dir.write("finsd-file", "x");
+    EXPECT_TRUE(has(cli::prepare_socket_directory(file, 0700, me), "is not a directory"));
+
+    EXPECT_TRUE(has(cli::prepare_socket_directory(fresh, 0700, me + 1),
+                    "is owned by uid " + std::to_string(me)));
+    if (me == 0) {
+        const auto theirs = dir.path() / "finsd-theirs";
+        ASSERT_EQ(::mkdir(theirs.c_str(), 0700), 0);
+        ASSERT_EQ(::chown(theirs.c_str(), 65534, 65534), 0);
+        EXPECT_TRUE(has(cli::prepare_socket_directory(theirs, 0700, 0),
+                        "is owned by uid 65534, not 0"));
+    }
 }
 
 // A stand-in control channel: accepts one client, returns its request line, answers.

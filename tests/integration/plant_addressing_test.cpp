@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include "finsd_run.hpp"
 #include "plant_fixture.hpp"
 
 namespace fins::test {
@@ -52,10 +53,11 @@ class Udp {
     int fd_;
 };
 
-// 01 01 MEMORY AREA READ D0, 1 word, from node 3.77 to 3.5.
-std::vector<std::uint8_t> read_from_node_77() {
-    return {0x80, 0x00, 0x02, 0x03, 0x05, 0x00, 0x03, 77,   0x00,
-            0x42, 0x01, 0x01, 0x82, 0x00, 0x00, 0x00, 0x00, 0x01};
+// 01 01 MEMORY AREA READ D0, 1 word, from node NET.NODE (default 3.77) to DNA.5.
+std::vector<std::uint8_t> read_from_node_77(std::uint8_t node = 77, std::uint8_t network = 3,
+                                            std::uint8_t destination_network = 3) {
+    return {0x80, 0x00,    0x02, destination_network, 0x05, 0x00, network, node, 0x00,
+            0x42, 0x01,    0x01, 0x82,                0x00, 0x00, 0x00,    0x00, 0x01};
 }
 
 // Where the answer arrives: at the sender (127.0.0.1) or at node 77's generated address
@@ -66,7 +68,8 @@ struct Arrivals {
     bool listed = false;
 };
 
-Arrivals answer_for(server::AddressMethod method, bool dynamic, bool listed_77) {
+Arrivals answer_for(server::AddressMethod method, bool dynamic, bool listed_77,
+                    const std::vector<std::uint8_t>& frame = read_from_node_77()) {
     auto config = three_networks();
     auto& unit = config.cpus[2].ports[0];
     unit.method = method;
@@ -77,7 +80,7 @@ Arrivals answer_for(server::AddressMethod method, bool dynamic, bool listed_77) 
     Udp generated("127.0.3.77", port);
     Udp listed("127.0.3.78", port);
     Udp sender("127.0.0.1", 0);
-    sender.send("127.0.3.5", port, read_from_node_77());
+    sender.send("127.0.3.5", port, frame);
     Arrivals a;
     a.sender = sender.receive(500);
     a.generated = generated.receive(a.sender ? 50 : 500);
@@ -125,6 +128,36 @@ TEST(PlantAddressing, W596_2_3_CombinedPrefersTheTable) {
     EXPECT_TRUE(answer_for(server::AddressMethod::combined, true, true).listed);
     const auto a = answer_for(server::AddressMethod::combined, false, false);
     EXPECT_TRUE(a.generated);
+}
+
+// Issue 26 point 14, one rule for SA1 = 0 (the npm omron-fins client's default): node 0
+// is no remote node (fins-frames.md 1.3: SA1 00 is "internal communications inside the
+// local PLC", nodes are 01-FE), so W596 2-3's conversion has no entry for it, and a
+// FINS/UDP unit answers where the request came from (fins-frames.md 2, "Reply
+// destination"), as a single finsd does: under every method, with or without
+// conversion, addressed with DNA 0 or the unit's own network, SNA 0 or the network.
+TEST(PlantAddressing, W596_2_3_SourceNode0IsAnsweredWhereTheRequestCameFrom) {
+    using M = server::AddressMethod;
+    for (const auto method : {M::automatic_dynamic, M::automatic_static, M::table, M::combined})
+        for (const bool dynamic : {true, false})
+            for (const std::uint8_t dna : {std::uint8_t{0}, std::uint8_t{3}})
+                for (const std::uint8_t sna : {std::uint8_t{0}, std::uint8_t{3}}) {
+                    SCOPED_TRACE(::testing::Message()
+                                 << "method " << static_cast<int>(method) << " dynamic "
+                                 << dynamic << " DNA " << int{dna} << " SNA " << int{sna});
+                    const auto a =
+                        answer_for(method, dynamic, false, read_from_node_77(0, sna, dna));
+                    EXPECT_TRUE(a.sender);
+                    EXPECT_FALSE(a.generated);
+                }
+    // The single node (finsd without a plant, node 5 on 127.0.0.1): the same frame on the
+    // local network, the same answer at the sender.
+    Finsd single({"--node", "5"});
+    ASSERT_TRUE(single.started()) << single.result().err;
+    Udp sender("127.0.0.1", 0);
+    sender.send("127.0.0.1", single.port(), read_from_node_77(0, 0, 0));
+    EXPECT_TRUE(sender.receive(2000));
+    EXPECT_EQ(single.stop().exit_code, 0);
 }
 
 }  // namespace

@@ -8,7 +8,7 @@
 // flags:   <!-- readme-test: finsd --profile cs1h-lcb -->  ("{source}": the source tree)
 // In the block:
 //   "$ fins ARGS"       runs build/bin/fins with --port of that finsd added
-//   "$ finsd ctl ARGS"  runs finsd ctl with --socket of that finsd added
+//   "$ finsd ctl ARGS"  runs finsd ctl as shown (both find the default socket)
 //   "  # text"          after a command is a comment (not passed)
 //   other lines         the expected output: stdout, then stderr, line by line; none
 //                       means none. A line "..." stands for any number of lines, and
@@ -16,8 +16,11 @@
 // Blocks without "$ " lines (shell recipes, TOML, C++) are not run.
 // Links: every relative link outside code blocks names an existing file, and its #anchor
 // a heading of that page (GitHub's rule: lower case, punctuation dropped, blanks to '-').
+#include <stdlib.h>
+
 #include <algorithm>
 #include <cctype>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -188,6 +191,37 @@ std::string slug(std::string_view heading) {
     return s;
 }
 
+// XDG_RUNTIME_DIR set to `dir` and FINSD_SOCKET unset while it lives (children inherit
+// them: the finsd of a block and its finsd ctl steps); the values before come back after.
+class RuntimeDirectory {
+  public:
+    explicit RuntimeDirectory(const std::filesystem::path& dir)
+        : xdg_(saved("XDG_RUNTIME_DIR")), socket_(saved("FINSD_SOCKET")) {
+        ::setenv("XDG_RUNTIME_DIR", dir.c_str(), 1);
+        ::unsetenv("FINSD_SOCKET");
+    }
+    ~RuntimeDirectory() {
+        restore("XDG_RUNTIME_DIR", xdg_);
+        restore("FINSD_SOCKET", socket_);
+    }
+    RuntimeDirectory(const RuntimeDirectory&) = delete;
+    RuntimeDirectory& operator=(const RuntimeDirectory&) = delete;
+
+  private:
+    static std::optional<std::string> saved(const char* name) {
+        const char* v = std::getenv(name);
+        return v != nullptr ? std::optional<std::string>(v) : std::nullopt;
+    }
+    static void restore(const char* name, const std::optional<std::string>& value) {
+        if (value)
+            ::setenv(name, value->c_str(), 1);
+        else
+            ::unsetenv(name);
+    }
+    std::optional<std::string> xdg_;
+    std::optional<std::string> socket_;
+};
+
 struct PageText {
     std::set<std::string> anchors;
     std::vector<std::pair<int, std::string>> links;  // line, url
@@ -261,13 +295,14 @@ TEST_P(Doc, EverySampleSessionPrintsWhatThePageShows) {
     for (const auto& block : blocks) {
         SCOPED_TRACE(name + ":" + std::to_string(block.line));
         ScratchDir dir("readme");
-        const std::string socket = (dir.path() / "ctl.sock").string();
+        // finsd and finsd ctl run as the docs show them, without --control/--socket: they
+        // meet at $XDG_RUNTIME_DIR/finsd.sock, a scratch directory of this block's own.
+        const RuntimeDirectory runtime(dir.path());
         auto args = block.finsd_args;
         // "{source}" in a flag is the source tree (an example file: docs/scenarios.md).
         for (auto& arg : args)
             if (const auto at = arg.find("{source}"); at != std::string::npos)
                 arg.replace(at, 8, source_dir.string());
-        args.insert(args.end(), {"--control", socket});
         Finsd finsd(args);
         ASSERT_TRUE(finsd.started()) << finsd.result().err;
         // Files a session writes (program-read --out) land in the scratch directory.
@@ -278,9 +313,8 @@ TEST_P(Doc, EverySampleSessionPrintsWhatThePageShows) {
             if (!words.empty() && words[0] == "fins") {
                 argv = {fins_bin, "--port", std::to_string(finsd.port()), "--timeout", "5"};
             } else if (words.size() > 1 && words[0] == "finsd" && words[1] == "ctl") {
-                argv = {finsd_path, "ctl", "--socket", socket};
+                argv = {finsd_path};
                 argv.insert(argv.end(), words.begin() + 1, words.end());
-                argv.erase(argv.begin() + 4);  // the second "ctl"
             }
             ASSERT_FALSE(argv.empty())
                 << name << ":" << step.line

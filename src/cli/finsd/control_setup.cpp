@@ -1,11 +1,15 @@
 // The control socket's path and start (contract in control_setup.hpp).
 #include "cli/finsd/control_setup.hpp"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <utility>
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 namespace fins::cli {
@@ -18,13 +22,57 @@ std::optional<std::filesystem::path> from_environment(const char* name) {
     return std::filesystem::path(value);
 }
 
+const std::filesystem::path root_directory = "/run/finsd";
+
+std::filesystem::path user_directory() {
+    return fmt::format("/tmp/finsd-{}", ::geteuid());
+}
+
+// Rule 4 or 5: the directory and the mode finsd creates it with.
+std::pair<std::filesystem::path, mode_t> own_directory() {
+    if (::geteuid() == 0) return {root_directory, 0755};
+    return {user_directory(), 0700};
+}
+
 }  // namespace
 
 std::filesystem::path default_control_socket() {
     if (auto p = from_environment("FINSD_SOCKET")) return *p;
-    if (::geteuid() != 0)
-        if (auto dir = from_environment("XDG_RUNTIME_DIR")) return *dir / "finsd.sock";
-    return "/run/finsd/finsd.sock";
+    if (auto dir = from_environment("XDG_RUNTIME_DIR")) return *dir / "finsd.sock";
+    return own_directory().first / "finsd.sock";
+}
+
+std::vector<std::filesystem::path> default_control_sockets() {
+    if (auto p = from_environment("FINSD_SOCKET")) return {*p};
+    std::vector<std::filesystem::path> out;
+    if (auto dir = from_environment("XDG_RUNTIME_DIR")) out.push_back(*dir / "finsd.sock");
+    out.push_back(own_directory().first / "finsd.sock");
+    return out;
+}
+
+std::string prepare_socket_directory(const std::filesystem::path& dir, mode_t mode,
+                                     uid_t owner) {
+    if (::mkdir(dir.c_str(), mode) != 0 && errno != EEXIST)
+        return fmt::format("cannot create {}: {}", dir.string(), std::strerror(errno));
+    struct stat st {};
+    if (::lstat(dir.c_str(), &st) != 0)
+        return fmt::format("{}: {}", dir.string(), std::strerror(errno));
+    if (S_ISLNK(st.st_mode)) return fmt::format("{} is a symbolic link", dir.string());
+    if (!S_ISDIR(st.st_mode)) return fmt::format("{} is not a directory", dir.string());
+    if (st.st_uid != owner)
+        return fmt::format("{} is owned by uid {}, not {}", dir.string(), st.st_uid, owner);
+    const mode_t others = (mode & 077) == 0 ? 077 : 022;
+    if ((st.st_mode & others) != 0)
+        return fmt::format("{} has mode {:04o}; {:04o} is needed", dir.string(),
+                           st.st_mode & 07777, mode);
+    return {};
+}
+
+std::string control_channel_hint() {
+    return "start finsd with a control channel: `finsd --control PATH`, then "
+           "`finsd ctl --socket PATH ...` (or set FINSD_SOCKET=PATH for both); without them "
+           "both use $XDG_RUNTIME_DIR/finsd.sock, else /run/finsd/finsd.sock (root) or "
+           "/tmp/finsd-UID/finsd.sock";
 }
 
 ControlStart start_control(asio::io_context& io, std::vector<server::ControlTarget> targets,
@@ -32,6 +80,17 @@ ControlStart start_control(asio::io_context& io, std::vector<server::ControlTarg
     ControlStart out;
     const bool chosen = configured.has_value() || from_environment("FINSD_SOCKET").has_value();
     out.path = configured ? *configured : default_control_socket();
+    if (!chosen && !from_environment("XDG_RUNTIME_DIR")) {
+        const auto [dir, mode] = own_directory();
+        if (const auto why = prepare_socket_directory(dir, mode, ::geteuid()); !why.empty()) {
+            spdlog::warn(
+                "finsd: no control channel: {} (give one with --control PATH or "
+                "FINSD_SOCKET)",
+                why);
+            out.path.clear();
+            return out;
+        }
+    }
     auto started = server::ControlServer::start(io, std::move(targets), out.path);
     if (started) {
         out.server = std::move(*started);
@@ -44,8 +103,8 @@ ControlStart start_control(asio::io_context& io, std::vector<server::ControlTarg
         out.error = "control channel " + out.path.string() + ": " + why;
         return out;
     }
-    // The default place: a second finsd, or no /run/finsd, is no reason to stop.
-    spdlog::info(
+    // The default place: a second finsd is no reason to stop.
+    spdlog::warn(
         "finsd: no control channel: default socket {}: {} (give one with --control PATH or "
         "FINSD_SOCKET)",
         out.path.string(), why);

@@ -1,7 +1,7 @@
 // `finsd ctl [--socket PATH] [--plc NAME|NET.NODE] VERB ...` (options before or after the
 // verb): sends one request to a running finsd's control channel (server/control/control.hpp)
-// and prints the answer line. Without --socket: $FINSD_SOCKET, else the default path finsd
-// itself uses (control_setup.hpp). --plc picks a CPU Unit of a plant (default the first).
+// and prints the answer line. Without --socket: $FINSD_SOCKET, else the first of the default
+// places finsd itself uses that holds a socket (control_setup.hpp). --plc picks a CPU Unit of a plant (default the first).
 //
 //   status                          the JSON snapshot
 //   battery-error on|off            low battery (error 00F7) / battery replaced
@@ -38,6 +38,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <optional>
 #include <string>
 
@@ -74,8 +75,8 @@ std::optional<std::string> send_request(const std::string& path, const std::stri
     Fd s{::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0)};
     if (s.fd < 0 ||
         ::connect(s.fd, reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0) {
-        std::fprintf(stderr, "finsd ctl: cannot connect to %s: %s\n", path.c_str(),
-                     std::strerror(errno));
+        std::fprintf(stderr, "finsd ctl: cannot connect to %s: %s\n%s\n", path.c_str(),
+                     std::strerror(errno), control_channel_hint().c_str());
         return std::nullopt;
     }
     const std::string line = request + "\n";
@@ -120,7 +121,8 @@ int run_ctl(int argc, char** argv) {
     std::string socket;
     app.add_option("--socket", socket,
                    "The control socket (finsd --control PATH; default $FINSD_SOCKET, "
-                   "$XDG_RUNTIME_DIR/finsd.sock or /run/finsd/finsd.sock)");
+                   "$XDG_RUNTIME_DIR/finsd.sock, /run/finsd/finsd.sock (root) or "
+                   "/tmp/finsd-UID/finsd.sock)");
     std::string plc;
     app.add_option("--plc", plc,
                    "The CPU Unit of a plant: its [[plc]] name or FINS address NET.NODE "
@@ -224,7 +226,18 @@ int run_ctl(int argc, char** argv) {
     }
     const bool raw_line = verbs.send->parsed() && !verbs.raw.empty();
     if (!plc.empty() && !raw_line) request["plc"] = plc;
-    if (socket.empty()) socket = default_control_socket().string();
+    if (socket.empty()) {
+        // The first default place that holds a socket, else the first (control_setup.hpp).
+        const auto places = default_control_sockets();
+        socket = places.front().string();
+        for (const auto& place : places) {
+            std::error_code ec;
+            if (std::filesystem::is_socket(place, ec)) {
+                socket = place.string();
+                break;
+            }
+        }
+    }
     const std::string line = raw_line ? verbs.raw : request.dump();
     if (line.find('\n') != std::string::npos) {
         std::fprintf(stderr, "finsd ctl: a request is one line\n");

@@ -97,8 +97,9 @@ int configure(int argc, char** argv, Settings& settings) {
     app.set_version_flag("--version", std::string("finsd ") + FINSKIT_VERSION);
     app.footer(
         "finsd ctl [--socket PATH] VERB ...: change a running finsd through its control channel\n"
-        "(--control PATH, else $FINSD_SOCKET, else $XDG_RUNTIME_DIR/finsd.sock or, for root,\n"
-        "/run/finsd/finsd.sock); `finsd ctl --help` lists the verbs.\n"
+        "(--control PATH, else $FINSD_SOCKET, else $XDG_RUNTIME_DIR/finsd.sock, else\n"
+        "/run/finsd/finsd.sock for root or /tmp/finsd-UID/finsd.sock, the directory created);\n"
+        "`finsd ctl --help` lists the verbs.\n"
         "Logs go to stderr; stdout carries only \"listening <port>\" once serving.\n"
         "Exit codes: 0 clean shutdown, 2 usage or configuration error, 3 start-up failure,\n"
         "4 the state file shrank (was truncated) while finsd ran.");
@@ -120,8 +121,8 @@ int configure(int argc, char** argv, Settings& settings) {
         "Keep retained memory in DIR/finsd.state (DIR and its parents are created if missing)");
     auto* o_control = app.add_option(
         "--control", control,
-        "Control channel socket path (default $FINSD_SOCKET, $XDG_RUNTIME_DIR/finsd.sock or "
-        "/run/finsd/finsd.sock)");
+        "Control channel socket path (default $FINSD_SOCKET, $XDG_RUNTIME_DIR/finsd.sock, "
+        "/run/finsd/finsd.sock (root) or /tmp/finsd-UID/finsd.sock)");
     auto* o_bind =
         app.add_option("--bind", bind, "Address to listen on (IPv4 or IPv6; default 127.0.0.1)");
     auto* o_port =

@@ -102,6 +102,11 @@ bool Router::note_source(std::size_t port, const Header& header,
     const auto& source = header.source;
     if (source.network != local_network && source.network != arrival.address.network)
         return true;  // relayed: the answer goes back the way the frame came
+    // SA1 00 is no remote node (fins-frames.md 1.3: 00 is "internal communications inside
+    // the local PLC", nodes are 01-FE): the conversion (W596 2-3) has no entry for it, so
+    // the answer goes where the request came from (fins-frames.md 2, "Reply destination"),
+    // as a single node answers; nothing is learned (issue 26 point 14).
+    if (source.node == 0) return true;
     sockaddr_in peer{};
     std::memcpy(&peer, context.peer, sizeof peer);
     Ipv4Endpoint from{{}, ntohs(peer.sin_port)};

@@ -78,7 +78,8 @@ class Router {
     // port's network, the node-address table learns it (as the method allows) and the
     // answer is sent where the table says (context.peer is rewritten). False when the
     // table knows no address for the source node: the command runs, nothing is answered
-    // (a real unit cannot send to 0.0.0.0).
+    // (a real unit cannot send to 0.0.0.0). A source node 00 (SA1 = 0) has no entry: it
+    // is answered at context.peer under every method.
     bool note_source(std::size_t port, const Header& header,
                      const RequestContext& context) noexcept;
     void set_wire(WireSend send) { wire_ = std::move(send); }
