@@ -225,7 +225,10 @@ int run_ctl(int argc, char** argv) {
     const bool raw_line = verbs.send->parsed() && !verbs.raw.empty();
     if (!plc.empty() && !raw_line) request["plc"] = plc;
     if (socket.empty()) socket = default_control_socket().string();
-    const std::string line = raw_line ? verbs.raw : request.dump();
+    // An argument that is not UTF-8 is replaced (U+FFFD), not thrown on.
+    const std::string line =
+        raw_line ? verbs.raw
+                 : request.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
     if (line.find('\n') != std::string::npos) {
         std::fprintf(stderr, "finsd ctl: a request is one line\n");
         return exit_usage;
