@@ -407,7 +407,7 @@ std::optional<std::string> json_to_words(Format f, const nlohmann::json& value,
             return fmt::format("{} is out of range for {} ({} to {})", dump(value), name, r->first,
                                r->second);
     } else if (!std::isfinite(d)) {
-        // A JSON text's 1e309 parses as infinity: out of range, as for the command line.
+        // Not from JSON text (it has no infinity), but from a Sparkplug double metric.
         return fmt::format("the number is out of range for {}", name);
     } else if (f == Format::float32 && std::abs(d) > std::numeric_limits<float>::max()) {
         return fmt::format("{} is out of range for float", dump(value));

@@ -1,7 +1,6 @@
 // Typed reads and writes of I/O memory (contract in memory_values.hpp).
 #include "web/memory_values.hpp"
 
-#include <cmath>
 #include <variant>
 #include <vector>
 
@@ -175,11 +174,6 @@ ApiResult<std::size_t> write_values(plc::IoMemory& memory, std::string_view addr
                 return tl::unexpected(bad(fmt::format(
                     "{} is not a value",
                     v.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace))));
-            // JSON text 1e309 parses as infinity, which no format holds.
-            if (v.is_number_float() && !std::isfinite(v.get<double>()))
-                return tl::unexpected(bad(fmt::format("value {} is out of range for {}",
-                                                      texts.size() + 1,
-                                                      typed::format_name(q->format))));
             texts.push_back(as_text(v));
         }
     } else {

