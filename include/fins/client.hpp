@@ -190,8 +190,9 @@ class Client {
     Result<std::uint32_t> read_bcd32(const Address& a);  // 0-99999999, two words
     Result<void> write_bcd16(const Address& a, std::uint16_t v);
     Result<void> write_bcd32(const Address& a, std::uint32_t v);
-    // `word_count` words, two ASCII characters per word, first in the high byte; stops at
-    // the first 00 byte.
+    // `word_count` words, two characters per word, first in the high byte; stops at the
+    // first 00 byte. Each byte is the character of the same code point (Latin-1), in
+    // UTF-8; a write refuses a character above U+00FF (fins/values.hpp).
     Result<std::string> read_string(const Address& a, std::size_t word_count);
     // Writes ceil(size/2) words, or exactly `word_count` (padded with 00) when non-zero.
     Result<void> write_string(const Address& a, std::string_view s, std::size_t word_count = 0);

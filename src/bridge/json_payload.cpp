@@ -67,7 +67,8 @@ void JsonPayload::write_response(const Plc& plc, const WriteResponse& r, const S
     j["end_code"] = r.end_code ? nlohmann::json(fmt::format("{:04X}", *r.end_code)) : nullptr;
     j["value"] = r.value ? *r.value : nlohmann::json(nullptr);
     j["error"] = r.error.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.error);
-    // Replace: an error text may quote a cut string (never a reason to throw).
+    // The id is the peer's, cut to 128 bytes (perhaps inside a UTF-8 character): replace
+    // rather than throw.
     out({fmt::format("{}/{}/write/response", prefix_, plc.name),
          j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace), 1, false});
 }

@@ -26,8 +26,10 @@ void decode_words(const Tag& tag, Bytes data, std::size_t offset, TagSample& s) 
         std::uint16_t words[max_read_words];
         for (std::size_t i = 0; i < tag.words; ++i)
             words[i] = word_at(data, offset + i);
+        // An odd length leaves the last word's low byte outside the tag. Cut it from the
+        // word, not from the text: a character above U+007F is two bytes of UTF-8.
+        if (tag.length % 2 != 0 && tag.words > 0) words[tag.words - 1] &= 0xFF00;
         s.value.text = words_to_string({words, tag.words});
-        if (s.value.text.size() > tag.length) s.value.text.resize(tag.length);
         return;
     }
     // Words past the tag's own stay 0 from the first decode: TagValue compares all four.

@@ -34,7 +34,9 @@ double numeric(TagType t, const TagValue& v) {
 
 void append_json(std::string& out, TagType t, const TagValue& v) {
     if (t == TagType::string)
-        out += nlohmann::json(v.text).dump();
+        // Read text is valid UTF-8 (words_to_string); replace is the last line of defence.
+        out += nlohmann::json(v.text).dump(-1, ' ', false,
+                                           nlohmann::json::error_handler_t::replace);
     else
         typed::append_json(out, t, v.words);
 }
@@ -50,10 +52,13 @@ std::optional<std::string> encode_value(TagType t, std::size_t string_length, co
     if (t == TagType::string) {
         if (!value.is_string()) return "string needs a JSON string";
         const auto& s = value.get_ref<const std::string&>();
-        if (s.size() > string_length)
-            return fmt::format("string of {} characters is longer than the tag's {}", s.size(),
-                               string_length);
-        if (!string_to_words(s)) return "string must be ASCII (01-7F)";
+        // One byte a character, U+0001-U+00FF (Latin-1, fins/values.hpp).
+        if (auto why = string_problem(s)) return fmt::format("string refused: {}", *why);
+        const auto bytes = utf8_to_latin1(s);
+        if (!bytes) return std::string("string refused: not Latin-1 text");
+        if (bytes->size() > string_length)
+            return fmt::format("string of {} characters is longer than the tag's {}",
+                               bytes->size(), string_length);
         out.text = s;
         return std::nullopt;
     }

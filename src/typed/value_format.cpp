@@ -36,6 +36,8 @@ constexpr auto format_order = [] {
     return out;
 }();
 
+// Decimal or 0x hex, with one optional sign: "--5", "+-5" and "0x-5" are refused
+// (std::from_chars takes a '-' of its own, which would make "--5" read as 5).
 template <class T>
 std::optional<T> parse_integer(std::string_view s) {
     int base = 10;
@@ -48,7 +50,7 @@ std::optional<T> parse_integer(std::string_view s) {
         base = 16;
         s.remove_prefix(2);
     }
-    if (s.empty()) return std::nullopt;
+    if (s.empty() || s[0] == '-' || s[0] == '+') return std::nullopt;
     long long v = 0;
     auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v, base);
     if (ec != std::errc{} || end != s.data() + s.size()) return std::nullopt;
@@ -59,10 +61,26 @@ std::optional<T> parse_integer(std::string_view s) {
     return static_cast<T>(v);
 }
 
-std::optional<double> parse_real(std::string_view s) {
+// A decimal number ("1.5", "-2e3", "inf", "nan"), or why not. A finite number too large
+// for the format, or nonzero but too small to be anything but 0, is refused rather than
+// stored as infinity or 0 (std::from_chars already refuses one out of double's range).
+std::variant<double, std::string> parse_real(std::string_view s, Format f) {
+    const auto name = format_name(f);
+    const auto bad = [&] { return fmt::format("'{}' is not a valid {} value", s, name); };
+    if (s.empty() || s[0] == '+') return bad();
     double v = 0;
     auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (ec != std::errc{} || end != s.data() + s.size() || s.empty()) return std::nullopt;
+    if (end != s.data() + s.size()) return bad();
+    if (ec == std::errc::result_out_of_range)
+        return fmt::format("'{}' is out of range for {}", s, name);
+    if (ec != std::errc{}) return bad();
+    if (f == Format::float32 && std::isfinite(v)) {
+        if (std::abs(v) > std::numeric_limits<float>::max())
+            return fmt::format("'{}' is out of range for float (at most {:g} either side of 0)", s,
+                               std::numeric_limits<float>::max());
+        if (v != 0 && static_cast<float>(v) == 0)
+            return fmt::format("'{}' is too small for float (it would be 0)", s);
+    }
     return v;
 }
 
@@ -75,6 +93,11 @@ Printed real(double v) {
     // JSON has no NaN/Infinity: print those as strings so the document stays valid.
     if (!std::isfinite(v)) return {fmt::format("{}", v), nlohmann::json(fmt::format("{}", v))};
     return {fmt::format("{}", v), nlohmann::json(v)};
+}
+
+// A JSON value in an error message: never throws, whatever bytes a string holds.
+std::string dump(const nlohmann::json& j) {
+    return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 template <class Array>
@@ -119,8 +142,10 @@ std::optional<bool> parse_bit(std::string_view s) {
 Result<std::vector<Printed>> print_words(Format f, const std::vector<std::uint16_t>& words) {
     std::vector<Printed> out;
     if (f == Format::string) {
-        const auto s = words_to_string(words);
-        out.push_back({nlohmann::json(s).dump(), nlohmann::json(s)});
+        // words_to_string gives valid UTF-8 (one character a byte, Latin-1), so the dump
+        // cannot throw; replace stays as the last line of defence.
+        nlohmann::json j = words_to_string(words);
+        out.push_back({j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace), j});
         return out;
     }
     const std::size_t step = words_per_value(f);
@@ -177,8 +202,10 @@ std::variant<std::vector<std::uint16_t>, ParseError> parse_words(
         std::string joined;
         for (std::size_t i = 0; i < values.size(); ++i)
             joined += (i ? " " : "") + values[i];
+        if (auto why = string_problem(joined))
+            return ParseError{fmt::format("cannot write that text as a string: {}", *why)};
         auto w = string_to_words(joined);
-        if (!w) return ParseError{fmt::format("cannot write {:?} as a string", joined)};
+        if (!w) return ParseError{"cannot write that text as a string"};
         return *w;
     }
     for (const auto& v : values) {
@@ -211,16 +238,15 @@ std::variant<std::vector<std::uint16_t>, ParseError> parse_words(
                 append(out, uint32_to_words(*x));
                 break;
             }
-            case Format::float32: {
-                auto x = parse_real(v);
-                if (!x) return bad();
-                append(out, float_to_words(static_cast<float>(*x)));
-                break;
-            }
+            case Format::float32:
             case Format::float64: {
-                auto x = parse_real(v);
-                if (!x) return bad();
-                append(out, double_to_words(*x));
+                auto x = parse_real(v, f);
+                if (auto* why = std::get_if<std::string>(&x)) return ParseError{std::move(*why)};
+                const double d = std::get<double>(x);
+                if (f == Format::float32)
+                    append(out, float_to_words(static_cast<float>(d)));
+                else
+                    append(out, double_to_words(d));
                 break;
             }
             case Format::bcd: {
@@ -376,12 +402,17 @@ std::optional<std::string> json_to_words(Format f, const nlohmann::json& value,
     const double d = value.get<double>();
     if (auto r = integer_range(f)) {
         if (!value.is_number_integer())
-            return fmt::format("{} needs an integer, not {}", name, value.dump());
+            return fmt::format("{} needs an integer, not {}", name, dump(value));
         if (d < r->first || d > r->second)
-            return fmt::format("{} is out of range for {} ({} to {})", value.dump(), name, r->first,
+            return fmt::format("{} is out of range for {} ({} to {})", dump(value), name, r->first,
                                r->second);
+    } else if (!std::isfinite(d)) {
+        // Not from JSON text (it has no infinity), but from a Sparkplug double metric.
+        return fmt::format("the number is out of range for {}", name);
     } else if (f == Format::float32 && std::abs(d) > std::numeric_limits<float>::max()) {
-        return fmt::format("{} is out of range for float", value.dump());
+        return fmt::format("{} is out of range for float", dump(value));
+    } else if (f == Format::float32 && d != 0 && static_cast<float>(d) == 0) {
+        return fmt::format("{} is too small for float (it would be 0)", dump(value));
     }
     switch (f) {
         case Format::int16:

@@ -171,7 +171,9 @@ ApiResult<std::size_t> write_values(plc::IoMemory& memory, std::string_view addr
     } else if (values.is_array() && !values.empty() && values.size() <= max_values_per_read) {
         for (const auto& v : values) {
             if (!v.is_number() && !v.is_string() && !v.is_boolean())
-                return tl::unexpected(bad(fmt::format("{} is not a value", v.dump())));
+                return tl::unexpected(bad(fmt::format(
+                    "{} is not a value",
+                    v.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace))));
             texts.push_back(as_text(v));
         }
     } else {

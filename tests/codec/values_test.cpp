@@ -90,7 +90,13 @@ TEST(Values, Strings) {
     EXPECT_EQ(string_to_words("AB", 3).value(), (W{0x4142, 0x0000, 0x0000}));
     EXPECT_EQ(string_to_words("ABCDE", 2).error(), ClientError::invalid_argument);
     EXPECT_EQ(string_to_words(std::string_view("A\0B", 3)).error(), ClientError::invalid_argument);
-    EXPECT_EQ(string_to_words("caf\xC3\xA9").error(), ClientError::invalid_argument);
+    // UTF-8 in, one byte a character (Latin-1): é is U+00E9, byte E9.
+    EXPECT_EQ(string_to_words("caf\xC3\xA9").value(), (W{0x6361, 0x66E9}));
+    EXPECT_EQ(string_to_words("\xC4\x80").error(), ClientError::invalid_argument);  // U+0100
+    EXPECT_EQ(string_to_words("\xE9").error(), ClientError::invalid_argument);  // not UTF-8
+    EXPECT_EQ(string_to_words("\xC3\xA9\xC3\xA9\xC3\xA9", 1).error(),
+              ClientError::invalid_argument);  // 3 characters, 6 bytes of UTF-8: 2 words
+    EXPECT_EQ(string_to_words("\xC3\xA9\xC3\xA9\xC3\xA9", 2).value(), (W{0xE9E9, 0xE900}));
     // Reading stops at the first 00 byte, wherever it is.
     EXPECT_EQ(words_to_string(W{0x4142, 0x4300}), "ABC");
     EXPECT_EQ(words_to_string(W{0x4142, 0x4344}), "ABCD");
@@ -98,6 +104,58 @@ TEST(Values, Strings) {
     EXPECT_EQ(words_to_string(W{0x0041}), "");
     EXPECT_EQ(words_to_string(W{}), "");
     EXPECT_EQ(words_to_string(string_to_words("HELLO PLC", 8).value()), "HELLO PLC");
+}
+
+// Issue 25: bytes 80-FF are text too. Each byte reads as the character of the same code
+// point, in UTF-8, so the text is always valid UTF-8 and writing it back restores it.
+TEST(Values, StringBytesAreLatin1) {
+    EXPECT_EQ(words_to_string(W{0x41E1, 0x4243}), "A\xC3\xA1" "BC");  // Aá BC
+    EXPECT_EQ(words_to_string(W{0xB043}), "\xC2\xB0" "C");             // °C
+    EXPECT_EQ(words_to_string(W{0xFF80}), "\xC3\xBF\xC2\x80");
+    // Every byte 01-FF, in both halves of a word: one character, and back to the same byte.
+    for (unsigned b = 1; b <= 0xFF; ++b) {
+        const auto word = static_cast<std::uint16_t>(b << 8 | b);
+        const std::string text = words_to_string(W{word});
+        EXPECT_EQ(text, latin1_to_utf8(std::string(2, static_cast<char>(b)))) << b;
+        EXPECT_EQ(text.size(), b < 0x80 ? 2u : 4u) << b;
+        EXPECT_EQ(string_to_words(text).value(), W{word}) << b;
+        EXPECT_EQ(string_problem(text), std::nullopt) << b;
+    }
+    // Every word without a 00 byte: words -> text -> the same word.
+    for (unsigned w = 0; w <= 0xFFFF; ++w) {
+        if ((w & 0xFF) == 0 || (w >> 8) == 0) continue;
+        const W words{static_cast<std::uint16_t>(w)};
+        ASSERT_EQ(string_to_words(words_to_string(words)).value(), words) << w;
+    }
+}
+
+TEST(Values, Latin1Conversions) {
+    std::string all;
+    for (unsigned b = 0; b <= 0xFF; ++b)
+        all.push_back(static_cast<char>(b));
+    const std::string utf8 = latin1_to_utf8(all);
+    EXPECT_EQ(utf8.size(), 128u + 2 * 128u);
+    EXPECT_EQ(utf8_to_latin1(utf8), all);  // all 256 byte values, 00 included
+    EXPECT_EQ(utf8_to_latin1("\xC4\x80"), std::nullopt);          // U+0100
+    EXPECT_EQ(utf8_to_latin1("\xE2\x82\xAC"), std::nullopt);      // U+20AC euro sign
+    EXPECT_EQ(utf8_to_latin1("\xF0\x9F\x98\x80"), std::nullopt);  // U+1F600
+    for (const std::string_view bad :
+         {"\xB0", "\xC3", "\xC3(", "\xC1\xBF" /* overlong 7F */, "\xC0\x80" /* overlong 00 */,
+          "\xED\xA0\x80" /* surrogate */, "\xF4\x90\x80\x80" /* above U+10FFFF */, "\xFF",
+          "\xE0\x80\xAF" /* overlong / */})
+        EXPECT_EQ(utf8_to_latin1(bad), std::nullopt) << bad.size();
+}
+
+TEST(Values, StringProblemsSayWhy) {
+    EXPECT_EQ(string_problem("A\xC4\x80"),
+              "character 2 is U+0100, above U+00FF: a PLC byte holds one character "
+              "U+0000-U+00FF (Latin-1)");
+    EXPECT_EQ(string_problem("AB\xE9"), "byte 3 (0xE9) is not UTF-8: text must be UTF-8");
+    EXPECT_EQ(string_problem(std::string_view("A\0", 2)),
+              "character 2 is U+0000, which would end the string in PLC memory (00 ends a "
+              "string)");
+    EXPECT_EQ(string_problem("\xC2\xB0" "C"), std::nullopt);
+    EXPECT_EQ(string_problem(""), std::nullopt);
 }
 
 TEST(Values, BytesAndWords) {

@@ -134,6 +134,48 @@ TEST_F(Cli, ExitCodesSeparateUsageTransportAndEndCode) {
     EXPECT_NE(transport.err.find("127.0.0.1:1: "), std::string::npos) << transport.err;
 }
 
+// Issue 25: `fins read D0 2 --as string` over 41 E1 42 43 aborted (the JSON dump of the
+// text threw). Each byte is the character of the same code point, printed as UTF-8.
+TEST_F(Cli, StringBytesAbove7FPrintAsLatin1) {
+    ASSERT_EQ(fins({"write", "D0", "0x41E1", "0x4243"}).exit_code, 0);
+    auto r = fins({"read", "D0", "2", "--as", "string"});
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(r.out, "D0  \"A\xC3\xA1" "BC\"\n");
+    auto j = fins({"read", "D0", "2", "--as", "string", "--json"});
+    ASSERT_EQ(j.exit_code, 0) << j.err;
+    EXPECT_EQ(nlohmann::json::parse(j.out)["values"][0], "A\xC3\xA1" "BC");
+    // The text writes back the same words; a character above U+00FF is refused.
+    ASSERT_EQ(fins({"write", "D10", "\xC2\xB0" "C", "--as", "string"}).exit_code, 0);
+    EXPECT_EQ(fins({"read", "D10", "--as", "hex"}).out, "D10  0xB043\n");
+    auto high = fins({"write", "D10", "\xE2\x82\xAC", "--as", "string"});  // euro sign
+    EXPECT_EQ(high.exit_code, 2);
+    EXPECT_NE(high.err.find("U+20AC, above U+00FF"), std::string::npos) << high.err;
+    auto bad = fins({"write", "D10", "\xB0", "--as", "string", "--json"});
+    EXPECT_EQ(bad.exit_code, 2);
+    EXPECT_NE(nlohmann::json::parse(bad.out)["error"]["message"].get<std::string>().find(
+                  "not UTF-8"),
+              std::string::npos)
+        << bad.out;
+    EXPECT_EQ(fins({"read", "D10", "--as", "hex"}).out, "D10  0xB043\n");
+}
+
+// A float the format cannot hold was written as +inf; "--5" was read as 5.
+TEST_F(Cli, NumbersTheFormatCannotHoldAreRefused) {
+    auto big = fins({"write", "D0", "3.5e38", "--as", "float"});
+    EXPECT_EQ(big.exit_code, 2);
+    EXPECT_NE(big.err.find("'3.5e38' is out of range for float"), std::string::npos) << big.err;
+    auto huge = fins({"write", "D0", "1e309", "--as", "double"});
+    EXPECT_EQ(huge.exit_code, 2);
+    EXPECT_NE(huge.err.find("out of range for double"), std::string::npos) << huge.err;
+    auto twice = fins({"write", "D0", "--", "--5"});
+    EXPECT_EQ(twice.exit_code, 2);
+    EXPECT_NE(twice.err.find("'--5' is not a valid uint16 value"), std::string::npos)
+        << twice.err;
+    EXPECT_EQ(fins({"write", "D0", "--5", "--as", "int16"}).exit_code, 2);
+    EXPECT_EQ(fins({"read", "D0", "4", "--as", "hex"}).out,
+              "D0  0x0000\nD1  0x0000\nD2  0x0000\nD3  0x0000\n");
+}
+
 TEST(Finsd, RefusesBadOptionsAndBusyPorts) {
     EXPECT_EQ(run({finsd_bin, "--node", "0"}).exit_code, 2);
     EXPECT_EQ(run({finsd_bin, "--bind", "not-an-ip", "--port", "0"}).exit_code, 3);

@@ -39,6 +39,13 @@ const char* kind_name(ErrorKind k) {
     return "transport";
 }
 
+// One JSON document on a line. Values read from memory are valid UTF-8 (Latin-1 text,
+// fins/values.hpp), but a message may quote an argument: replace its invalid bytes
+// rather than throw.
+std::string dump(const nlohmann::json& j) {
+    return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
 }  // namespace
 
 std::string plural(std::size_t n, std::string_view one, std::string_view many) {
@@ -61,7 +68,7 @@ int Output::usage(const std::string& message) {
     if (json_)
         std::printf(
             "%s\n",
-            nlohmann::json{{"error", {{"kind", "usage"}, {"message", message}}}}.dump().c_str());
+            dump(nlohmann::json{{"error", {{"kind", "usage"}, {"message", message}}}}).c_str());
     std::fprintf(stderr, "fins: %s\n", message.c_str());
     return exit_usage;
 }
@@ -126,7 +133,7 @@ int Output::failure(std::error_code ec, const std::string& context) {
         if (relay_ && kind == ErrorKind::end_code)
             e["relay_error"] = {{"network", relay_->network}, {"node", relay_->node}};
         if (!hint.empty()) e["hint"] = hint;
-        std::printf("%s\n", nlohmann::json{{"error", e}}.dump().c_str());
+        std::printf("%s\n", dump(nlohmann::json{{"error", e}}).c_str());
     }
     if (kind == ErrorKind::end_code)
         std::fprintf(stderr, "fins: %s: the PLC answered %s\n", context.c_str(), meaning.c_str());
@@ -157,7 +164,7 @@ void Output::print(const nlohmann::json& doc, const std::string& text) {
             d["fatal_cpu_error"] = fatal_;
             d["non_fatal_cpu_error"] = non_fatal_;
         }
-        std::printf("%s\n", d.dump().c_str());
+        std::printf("%s\n", dump(d).c_str());
     } else {
         std::fputs(text.c_str(), stdout);
     }

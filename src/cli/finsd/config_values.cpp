@@ -47,8 +47,10 @@ const std::string& type_names() {
 std::optional<std::string> add_value(Format f, const toml::node& n, WordList& out) {
     if (f == Format::string) {
         const auto* text = n.as_string();
-        auto w = text ? string_to_words(text->get()) : Result<std::vector<std::uint16_t>>{};
-        if (!text || !w) return "must be a string (two characters a word)";
+        if (text == nullptr) return "must be a string (two characters a word)";
+        if (auto why = string_problem(text->get())) return *why;
+        auto w = string_to_words(text->get());
+        if (!w) return "must be a string (two characters a word)";
         out.insert(out.end(), w->begin(), w->end());
         return std::nullopt;
     }

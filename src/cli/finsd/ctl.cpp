@@ -238,7 +238,10 @@ int run_ctl(int argc, char** argv) {
             }
         }
     }
-    const std::string line = raw_line ? verbs.raw : request.dump();
+    // An argument that is not UTF-8 is replaced (U+FFFD), not thrown on.
+    const std::string line =
+        raw_line ? verbs.raw
+                 : request.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
     if (line.find('\n') != std::string::npos) {
         std::fprintf(stderr, "finsd ctl: a request is one line\n");
         return exit_usage;

@@ -1,7 +1,9 @@
 // Typed views of PLC words. The grid always holds raw 16-bit words (what the WebSocket
 // sends as "uint16"); a view decides how many words one value takes and how it prints.
 // Omron CS/CJ store a 32/64-bit value with its lowest word at the lowest address
-// (W340 "Data formats"); ASCII keeps the first character in the high byte.
+// (W340 "Data formats"); ASCII keeps the first character in the high byte, and a byte is
+// the character of the same code point (Latin-1: B0 is "°"), as the server's `ascii` reads
+// it (fins/values.hpp), so every byte shows as one character and an edit writes it back.
 
 const buffer = new DataView(new ArrayBuffer(8));
 
@@ -15,8 +17,9 @@ function bcdText(w) {
   return /^[0-9]+$/.test(digits) ? String(Number(digits)) : null;
 }
 
+// 00 ends a string on the server; in a cell it shows as nothing.
 function asciiChar(b) {
-  return b >= 0x20 && b < 0x7f ? String.fromCharCode(b) : '·';
+  return b === 0 ? '' : String.fromCharCode(b);
 }
 
 function trimFloat(x, digits) {
@@ -89,7 +92,14 @@ export function parseEdit(viewId, address, text) {
       return {address, values: [parseInt(t.replace(/^0x/i, ''), 16)], as: 'uint16'};
     }
     case 'ascii': {
-      if (!/^[\x20-\x7e]{1,2}$/.test(t.length === 1 ? t + ' ' : t)) return {error: 'ASCII: 1-2 printable characters'};
+      // One byte a character: U+0001-U+00FF, as the server refuses what a byte cannot hold.
+      const chars = [...t];
+      if (chars.length > 2) return {error: 'ASCII: 1-2 characters'};
+      const high = chars.find((c) => c.codePointAt(0) > 0xff);
+      if (high !== undefined) {
+        const code = high.codePointAt(0).toString(16).toUpperCase().padStart(4, '0');
+        return {error: `ASCII: U+${code} is above U+00FF (a byte holds one Latin-1 character)`};
+      }
       const s = t.padEnd(2, ' ');
       return {address, values: [(s.charCodeAt(0) << 8) | s.charCodeAt(1)], as: 'uint16'};
     }
