@@ -49,11 +49,13 @@ TEST(BridgeText, AWriteResponseWithACutIdIsValidJson) {
     const std::string id = std::string(127, 'a') + "\xC3\xA9";  // 129 bytes
     auto c = f.parse("pre/press1/write", json{{"id", id}, {"tag", "t"}, {"value", 1}}.dump(),
                      false);
-    ASSERT_TRUE(c && c->refuse);
+    ASSERT_TRUE(c);
+    const auto* r = std::get_if<Refusal>(&*c);
+    ASSERT_TRUE(r);
     Plc plc;
     plc.name = "press1";
     std::vector<Message> out;
-    EXPECT_NO_THROW(f.write_response(plc, *c->refuse, [&](Message&& m) { out.push_back(m); }));
+    EXPECT_NO_THROW(f.write_response(plc, r->response, [&](Message&& m) { out.push_back(m); }));
     ASSERT_EQ(out.size(), 1u);
     const auto j = json::parse(out[0].payload, nullptr, false);
     ASSERT_TRUE(j.is_object()) << out[0].payload;
