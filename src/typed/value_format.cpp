@@ -148,7 +148,9 @@ Result<std::vector<Printed>> print_words(Format f, const std::vector<std::uint16
         out.push_back({j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace), j});
         return out;
     }
-    const std::size_t step = words_per_value(f);
+    // Bits take one word a value here (the bit as word 0, as in append_json): with the
+    // table's 0 words per value the loop would never advance.
+    const std::size_t step = f == Format::bits ? 1 : words_per_value(f);
     for (std::size_t i = 0; i + step <= words.size(); i += step) {
         const Words w{words.data() + i, step};
         switch (f) {
@@ -187,8 +189,10 @@ Result<std::vector<Printed>> print_words(Format f, const std::vector<std::uint16
                 out.push_back(number(*v));
                 break;
             }
-            case Format::string:
             case Format::bits:
+                out.push_back({w[0] != 0 ? "1" : "0", nlohmann::json(w[0] != 0)});
+                break;
+            case Format::string:
                 break;
         }
     }

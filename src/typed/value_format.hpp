@@ -51,7 +51,8 @@ struct Printed {
     nlohmann::json json;
 };
 
-// Words -> values. `words.size()` is a multiple of words_per_value(f); for string the
+// Words -> values. `words.size()` is a multiple of words_per_value(f) (bits: one word a
+// value, the bit as word 0, nonzero = 1); for string the
 // whole run is one value.
 Result<std::vector<Printed>> print_words(Format f, const std::vector<std::uint16_t>& words);
 // Command-line values -> words, with a readable error for the first bad one.

@@ -2,6 +2,7 @@
 // UTF-8 whatever the bytes (issue 25), and numbers a format cannot hold are refused.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -63,6 +64,36 @@ TEST(ValueFormat, EveryWordReadsAsTextThatWritesItBack) {
         }
         const auto back = words_of(Format::string, {text});
         ASSERT_EQ(back, ((w & 0xFF) == 0 ? W{static_cast<std::uint16_t>(w)} : words)) << w;
+    }
+}
+
+// Issue 25: memory holding any of the 65,536 word values prints in every format as text and
+// JSON that dumps without throwing and parses back (a read-only finsd ended on one word).
+TEST(ValueFormat, EveryWordOfEveryFormatPrintsValidJson) {
+    // Bits print one value a word (print_words looped for ever on them: fuzz_formats).
+    const auto bits = typed::print_words(Format::bits, W{0, 1, 0x8000});
+    ASSERT_TRUE(bits);
+    ASSERT_EQ(bits->size(), 3u);
+    EXPECT_EQ((*bits)[0].text, "0");
+    EXPECT_EQ((*bits)[2].json, true);
+    for (const Format f : typed::all_formats()) {
+        const std::size_t n = std::max<std::size_t>(typed::words_per_value(f), 1);
+        for (unsigned w = 0; w <= 0xFFFF; ++w) {
+            W words(n, static_cast<std::uint16_t>(w));
+            auto p = typed::print_words(f, words);
+            if (!p) {
+                ASSERT_TRUE(f == Format::bcd || f == Format::bcd32) << w;  // not BCD: refused
+                continue;
+            }
+            for (const auto& v : *p) {
+                std::string dumped;
+                ASSERT_NO_THROW(dumped = v.json.dump()) << typed::format_name(f) << " " << w;
+                ASSERT_FALSE(nlohmann::json::parse(dumped, nullptr, false).is_discarded()) << w;
+                ASSERT_FALSE(nlohmann::json::parse(nlohmann::json(v.text).dump(), nullptr, false)
+                                 .is_discarded())
+                    << w;
+            }
+        }
     }
 }
 
