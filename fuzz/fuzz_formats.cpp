@@ -124,7 +124,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const auto json = Json::parse(input, nullptr, false);
     for (const Format f : fins::typed::all_formats()) {
         const std::size_t n = std::max<std::size_t>(fins::typed::words_per_value(f), 1);
-        Words whole(words.begin(), words.begin() + static_cast<std::ptrdiff_t>(words.size() / n * n));
+        Words whole(words.begin(),
+                    words.begin() + static_cast<std::ptrdiff_t>(words.size() / n * n));
         if (f == Format::string || !whole.empty()) print_and_reparse(f, whole);
 
         // The input as a typed value: words that print back to values of the format, or a

@@ -248,9 +248,8 @@ void Bridge::failed(const std::string& topic, bool retained,
                                   retained);
                        },
                        [&](const Refusal& r) {
-                           refuse(Refusal{r.plc, WriteResponse{r.response.id, false,
-                                                               std::nullopt, std::nullopt,
-                                                               reason}},
+                           refuse(Refusal{r.plc, WriteResponse{r.response.id, false, std::nullopt,
+                                                               std::nullopt, reason}},
                                   retained);
                        },
                        [&](const NodeRebirth&) { format_->rejected(topic, reason); },

@@ -83,9 +83,8 @@ std::optional<ParsedCommand> JsonPayload::parse(std::string_view topic, std::str
     std::string plc(
         topic.substr(prefix_.size() + 1, topic.size() - prefix_.size() - 1 - suffix.size()));
     const auto refuse = [&](std::string id, std::string error) -> std::optional<ParsedCommand> {
-        return Refusal{plc,
-                       WriteResponse{std::move(id), false, std::nullopt, std::nullopt,
-                                     std::move(error)}};
+        return Refusal{
+            plc, WriteResponse{std::move(id), false, std::nullopt, std::nullopt, std::move(error)}};
     };
     auto j = nlohmann::json::parse(payload, nullptr, false);
     if (j.is_discarded() || !j.is_object()) return refuse("", "the command is not a JSON object");

@@ -94,8 +94,8 @@ struct WriteResponse {
 //   Rejected      a command addressed to this instance that is not executed and has no
 //                 response topic (Sparkplug): PayloadFormat::rejected() logs and counts it.
 struct Refusal {
-    std::string plc;          // the PLC it concerns (for the answer topic)
-    WriteResponse response;   // ok false, the reason in error
+    std::string plc;         // the PLC it concerns (for the answer topic)
+    WriteResponse response;  // ok false, the reason in error
 };
 struct NodeRebirth {};
 struct Rejected {

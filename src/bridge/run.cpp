@@ -31,10 +31,9 @@ int run(const BridgeConfig& given, const std::string& log_level) {
         cluster::keepalive_for_failover(static_cast<int>(config.failover.count())));
     if (config.mqtt.keepalive > needed) config.mqtt.keepalive = needed;
     asio::io_context io(1);
-    Bridge bridge(
-        io, config, make_format(config),
-        std::make_unique<cluster::ClusterOwnership>(config.instance, config.mqtt.topic_prefix,
-                                                    config.payload));
+    Bridge bridge(io, config, make_format(config),
+                  std::make_unique<cluster::ClusterOwnership>(
+                      config.instance, config.mqtt.topic_prefix, config.payload));
     std::string error;
     if (!bridge.start(error)) {
         spdlog::error("{}", error);

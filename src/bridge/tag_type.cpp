@@ -35,8 +35,8 @@ double numeric(TagType t, const TagValue& v) {
 void append_json(std::string& out, TagType t, const TagValue& v) {
     if (t == TagType::string)
         // Read text is valid UTF-8 (words_to_string); replace is the last line of defence.
-        out += nlohmann::json(v.text).dump(-1, ' ', false,
-                                           nlohmann::json::error_handler_t::replace);
+        out +=
+            nlohmann::json(v.text).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
     else
         typed::append_json(out, t, v.words);
 }
@@ -57,8 +57,8 @@ std::optional<std::string> encode_value(TagType t, std::size_t string_length, co
         const auto bytes = utf8_to_latin1(s);
         if (!bytes) return std::string("string refused: not Latin-1 text");
         if (bytes->size() > string_length)
-            return fmt::format("string of {} characters is longer than the tag's {}",
-                               bytes->size(), string_length);
+            return fmt::format("string of {} characters is longer than the tag's {}", bytes->size(),
+                               string_length);
         out.text = s;
         return std::nullopt;
     }

@@ -239,8 +239,8 @@ std::optional<ParsedCommand> SparkplugPayload::parse(std::string_view topic,
         return std::nullopt;
     if (retained) {
         // NCMD and DCMD are never retained (chapter 6): a retained one is stale, not executed.
-        return Rejected{fmt::format("retained {} (a command is executed once, when sent)",
-                                    parts->verb)};
+        return Rejected{
+            fmt::format("retained {} (a command is executed once, when sent)", parts->verb)};
     }
     std::vector<Command> cmds;
     node_.on_command(topic, payload, cmds);
@@ -271,8 +271,7 @@ std::optional<ParsedCommand> SparkplugPayload::parse(std::string_view topic,
                            }
                            const auto dev = devices_.find(w.device);
                            if (dev == devices_.end() || w.index >= dev->second.tags.size()) {
-                               reject(fmt::format("no metric {} on device {}", w.metric,
-                                                  w.device));
+                               reject(fmt::format("no metric {} on device {}", w.metric, w.device));
                                return;
                            }
                            const auto [g, t] = dev->second.tags[w.index];
@@ -287,7 +286,8 @@ std::optional<ParsedCommand> SparkplugPayload::parse(std::string_view topic,
                    },
                    c);
     }
-    if (!result) return Rejected{first_error.value_or(fmt::format("{} sets no metric", parts->verb))};
+    if (!result)
+        return Rejected{first_error.value_or(fmt::format("{} sets no metric", parts->verb))};
     if (first_error) rejected(topic, *first_error);
     return result;
 }

@@ -141,9 +141,10 @@ int refused(Output& out, nlohmann::json error, const std::string& context,
     error["message"] = message;
     error["context"] = context;
     if (!hint.empty()) error["hint"] = hint;
-    if (out.json()) std::printf("%s\n", nlohmann::json{{"error", error}}
-                                         .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)
-                                         .c_str());
+    if (out.json())
+        std::printf("%s\n", nlohmann::json{{"error", error}}
+                                .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)
+                                .c_str());
     std::fprintf(stderr, "fins: %s: %s%s\n", context.c_str(), said, message.c_str());
     if (!hint.empty()) std::fprintf(stderr, "fins: %s\n", hint.c_str());
     return exit_end_code;

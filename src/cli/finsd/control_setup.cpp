@@ -50,8 +50,7 @@ std::vector<std::filesystem::path> default_control_sockets() {
     return out;
 }
 
-std::string prepare_socket_directory(const std::filesystem::path& dir, mode_t mode,
-                                     uid_t owner) {
+std::string prepare_socket_directory(const std::filesystem::path& dir, mode_t mode, uid_t owner) {
     if (::mkdir(dir.c_str(), mode) != 0 && errno != EEXIST)
         return fmt::format("cannot create {}: {}", dir.string(), std::strerror(errno));
     struct stat st {};
@@ -63,8 +62,8 @@ std::string prepare_socket_directory(const std::filesystem::path& dir, mode_t mo
         return fmt::format("{} is owned by uid {}, not {}", dir.string(), st.st_uid, owner);
     const mode_t others = (mode & 077) == 0 ? 077 : 022;
     if ((st.st_mode & others) != 0)
-        return fmt::format("{} has mode {:04o}; {:04o} is needed", dir.string(),
-                           st.st_mode & 07777, mode);
+        return fmt::format("{} has mode {:04o}; {:04o} is needed", dir.string(), st.st_mode & 07777,
+                           mode);
     return {};
 }
 
