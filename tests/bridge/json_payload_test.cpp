@@ -56,22 +56,6 @@ TEST(JsonPayload, AWriteToAnEmptyPlcNameIsParsedToBeRefused) {
     EXPECT_EQ(w->plc, "");
 }
 
-TEST(JsonPayload, ALongIdCutInAUtf8CharacterIsStillAnswered) {
-    JsonPayload f("pre", "edge");
-    std::string id(127, 'a');
-    id += "\u00e9\u00e9";  // two bytes each: byte 128 is inside the first
-    auto c = f.parse("pre/p/write", R"({"id":")" + id + R"(","tag":"t","value":1})", false);
-    ASSERT_TRUE(c);
-    const auto* r = std::get_if<Refusal>(&*c);
-    ASSERT_TRUE(r);
-    Plc plc;
-    plc.name = "p";
-    std::vector<Message> out;
-    f.write_response(plc, r->response, [&](Message&& m) { out.push_back(std::move(m)); });
-    ASSERT_EQ(out.size(), 1u);
-    EXPECT_FALSE(nlohmann::json::parse(out[0].payload, nullptr, false).is_discarded());
-}
-
 TEST(JsonPayload, RefusesBadCommands) {
     JsonPayload f("pre", "edge");
     const auto refusal = [&](const std::string& text, bool retained = false) {
