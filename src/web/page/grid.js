@@ -34,6 +34,8 @@ export class Grid {
     this.subCounter = 0;
     this.editing = null;
     this.frame = 0;
+    this.tagTypes = false;       // "Tag types": a scenario tag's cells show its own type
+    this.tagSource = null;       // {tagsAt(prefix, word) -> tags, value(tag) -> {text}}
     this.scroller.addEventListener('scroll', () => this.schedule());
     new ResizeObserver(() => this.schedule()).observe(this.scroller);
     this.rowsBox.addEventListener('mousedown', (e) => this.onMouseDown(e));
@@ -223,6 +225,26 @@ export class Grid {
     }
   }
 
+  // The scenario tags whose words include one of the cell at `word`.
+  tagged(word) {
+    if (!this.tagSource) return [];
+    const per = view(this.viewId).words;
+    if (per === 1) return this.tagSource.tagsAt(this.area.prefix, word);
+    const out = new Set();
+    for (let i = 0; i < per; i++) for (const t of this.tagSource.tagsAt(this.area.prefix, word + i)) out.add(t);
+    return [...out];
+  }
+
+  // The scenario's tags or their values changed.
+  tagsChanged(valuesOnly) {
+    if (!valuesOnly || this.tagTypes) this.schedule();
+  }
+
+  setTagTypes(on) {
+    this.tagTypes = on;
+    this.schedule();
+  }
+
   paintCell(cell, word) {
     if (word >= this.area.words) {
       cell.className = 'cell void';
@@ -257,8 +279,25 @@ export class Grid {
       }
       cell.title = `${this.address(word)} = ${text === '' ? '?' : '0x' + (w.toString(16).toUpperCase().padStart(4, '0'))}`;
     } else {
-      if (cell.textContent !== text) cell.textContent = text;
-      cell.title = this.address(word);
+      const tagged = this.tagged(word);
+      let shown = text;
+      if (tagged.length) {
+        cell.classList.add('tagged');
+        const first = tagged.find((t) => t.word === word && t.type !== 'bool');
+        if (this.tagTypes) {
+          if (first) {
+            shown = this.tagSource.value(first).text;
+            cell.classList.add('tag-start');
+          } else if (tagged.some((t) => t.type !== 'bool' && t.word < word)) {
+            shown = '';
+            cell.classList.add('tag-cont');
+          }
+        }
+      }
+      if (cell.textContent !== shown) cell.textContent = shown;
+      cell.title = tagged.length
+        ? `${this.address(word)}\n` + tagged.map((t) => `tag ${t.address} (${t.type}) = ${this.tagSource.value(t).text}`).join('\n')
+        : this.address(word);
     }
   }
 
