@@ -4,6 +4,7 @@ page's panels never overlap at 1280, 900 and 420 px wide. Each test starts its o
 with a small scenario written here; screenshots go to the build's artifacts."""
 import json
 import math
+import urllib.error
 import urllib.request
 from pathlib import Path
 
@@ -50,10 +51,10 @@ value = 7
 """
 
 
-def start(finsd_factory, tmp_path, *args):
+def start(finsd_factory, tmp_path, *args, token=None):
     path = Path(tmp_path) / "scenario.toml"
     path.write_text(SCENARIO)
-    return finsd_factory("--scenario", str(path), *args)
+    return finsd_factory("--scenario", str(path), *args, token=token)
 
 
 def get(finsd, route):
@@ -250,3 +251,26 @@ def test_the_page_at_every_size(finsd_factory, tmp_path, page):
     finally:
         set_size(page, 1440, 900)
     assert severe_console_errors(page) == []
+
+
+def test_the_scenario_buttons_send_the_token(finsd_factory, tmp_path, page):
+    from selenium.webdriver.common.keys import Keys
+    finsd = start(finsd_factory, tmp_path, "--http-control", token="scenario-token")
+    open_page(page, finsd.url)
+    wait_for(lambda: page.find_element(By.ID, "scenario-pause").is_displayed(), 10, "the Pause button")
+    page.execute_script("sessionStorage.removeItem('finsd-token')")
+    page.find_element(By.ID, "scenario-pause").click()
+    wait_for(lambda: page.execute_script("return document.getElementById('token-dialog').open"), 5,
+             "the token dialog")
+    page.find_element(By.ID, "token-input").send_keys("scenario-token", Keys.ENTER)
+    wait_for(lambda: status(finsd)["paused"] is True, 10, "the scenario paused with the token")
+    # Without the token nothing reaches the scenario (a POST of another client).
+    req = urllib.request.Request(finsd.url + "api/control", method="POST",
+                                 data=b'{"cmd":"scenario","action":"resume"}',
+                                 headers={"Content-Type": "application/json"})
+    try:
+        urllib.request.urlopen(req, timeout=10)
+        raise AssertionError("a POST without the token was taken")
+    except urllib.error.HTTPError as e:
+        assert e.code == 403
+    assert status(finsd)["paused"] is True

@@ -104,6 +104,7 @@ export class ScenarioPanel {
       this.key = key;
       this.build(def);
     } catch (e) {
+      this.key = key;  // asked again only when the scenario changes (reload, another file)
       if (!(e instanceof ApiError && e.status === 404)) this.app.toast(`scenario: ${e.message}`);
     } finally {
       this.loading = false;
