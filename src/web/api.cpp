@@ -236,8 +236,9 @@ HttpAnswer scenario_route(const WebContext& context, const Query& q) {
     const auto* t = target_of(context, plc_param(q), error);
     if (t == nullptr) return error;
     if (t->scenario == nullptr)
-        return error_answer(404, "this CPU Unit runs no scenario (finsd --scenario FILE, or a "
-                                 "[scenario] table)");
+        return error_answer(404,
+                            "this CPU Unit runs no scenario (finsd --scenario FILE, or a "
+                            "[scenario] table)");
     return json_answer(200, scenario_object(*t));
 }
 

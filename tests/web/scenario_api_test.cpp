@@ -33,8 +33,8 @@ TEST(ScenarioApi, ListsTagsWithTypesAndEventsWithState) {
     EXPECT_EQ(j["tags"][1]["address"], "CIO2.00");
     EXPECT_EQ(j["tags"][1]["type"], "bool");
     EXPECT_EQ(j["tags"][1]["words"], 0);
-    EXPECT_EQ(j["tags"][2], (Json{{"address", "D21"}, {"type", "uint16"}, {"words", 1},
-                                  {"kind", "counter"}}));
+    EXPECT_EQ(j["tags"][2],
+              (Json{{"address", "D21"}, {"type", "uint16"}, {"words", 1}, {"kind", "counter"}}));
     EXPECT_EQ(j["tags"][3]["address"], "D22");
     EXPECT_EQ(j["tags"][3]["type"], "uint32");
     EXPECT_EQ(j["tags"][3]["words"], 2);
@@ -50,10 +50,10 @@ TEST(ScenarioApi, ListsTagsWithTypesAndEventsWithState) {
     EXPECT_EQ(j["status"]["time"], "virtual");
 
     // The actions are POST /api/control's; GET /api/scenario shows their effect.
-    EXPECT_EQ(http.request(http::verb::post, "/api/control",
-                           R"({"cmd":"scenario","action":"pause"})")
-                  .result_int(),
-              200u);
+    EXPECT_EQ(
+        http.request(http::verb::post, "/api/control", R"({"cmd":"scenario","action":"pause"})")
+            .result_int(),
+        200u);
     EXPECT_EQ(body_json(http.request(http::verb::get, "/api/scenario"))["status"]["paused"], true);
     EXPECT_EQ(http.request(http::verb::post, "/api/control",
                            R"({"cmd":"scenario","action":"trigger","event":"jam"})")
