@@ -18,6 +18,7 @@
 #include "server/control/control_dispatch.hpp"
 #include "server/control/control_requests.hpp"
 #include "server/control/control_scenario.hpp"
+#include "web/api_scenario.hpp"
 #include "web/assets.hpp"
 #include "web/cpu_facts.hpp"
 #include "web/memory_values.hpp"
@@ -229,6 +230,18 @@ HttpAnswer write_route(WebContext& context, std::string_view body) {
     return json_answer(200, Json{{"ok", true}, {"written", *written}});
 }
 
+// The running scenario's tags, types and events (api_scenario.hpp).
+HttpAnswer scenario_route(const WebContext& context, const Query& q) {
+    HttpAnswer error;
+    const auto* t = target_of(context, plc_param(q), error);
+    if (t == nullptr) return error;
+    if (t->scenario == nullptr)
+        return error_answer(404,
+                            "this CPU Unit runs no scenario (finsd --scenario FILE, or a "
+                            "[scenario] table)");
+    return json_answer(200, scenario_object(*t));
+}
+
 void control_route(WebContext& context, std::string_view body,
                    const std::function<void(HttpAnswer)>& done) {
     if (!context.options.control)
@@ -366,6 +379,10 @@ void handle_request(WebContext& context, std::string_view method, std::string_vi
         const auto* t = target_of(context, plc_param(*q), error);
         if (t == nullptr) return done(error);
         return done(json_answer(200, status_object(context, *t, std::chrono::system_clock::now())));
+    }
+    if (path == "/api/scenario") {
+        if (!get) return only("GET");
+        return done(scenario_route(context, *q));
     }
     if (path == "/api/plcs") {
         if (!get) return only("GET");

@@ -7,6 +7,7 @@
 //   GET  /api/read               ?address=D100&count=3&as=uint16[&plc=NAME|NET.NODE]
 //   POST /api/write              {"address","values","as"[,"plc"]}       (control on)
 //   GET  /api/status             the control channel's status plus network, logs
+//   GET  /api/scenario           a running scenario's tags, types, events (api_scenario.hpp)
 //   POST /api/control            any control channel request object     (control on)
 //   GET  /metrics                Prometheus text format
 // Every error is {"error":"..."} with 400, 403, 404, 405, 413, 415, 431 or 500.

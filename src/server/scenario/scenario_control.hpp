@@ -39,6 +39,10 @@ class ScenarioControl {
     // Loads the scenario again from its file; on any error the running one stays and
     // the error says why.
     virtual tl::expected<void, std::string> reload() = 0;
+    // The running scenario as its file states it (tags with their types, events): read by
+    // finsd's page (GET /api/scenario); null when the implementation keeps none. Valid
+    // until the next reload().
+    [[nodiscard]] virtual const scenario::ScenarioDef* definition() const { return nullptr; }
 };
 
 }  // namespace fins::server

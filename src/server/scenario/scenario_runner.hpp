@@ -84,6 +84,9 @@ class ScenarioRunner final : public ScenarioControl,
     std::uint64_t advance(double seconds) override;
     bool trigger(std::string_view event) override;
     tl::expected<void, std::string> reload() override;
+    [[nodiscard]] const scenario::ScenarioDef* definition() const override {
+        return &scenario_->definition();
+    }
 
     // FaultHook
     [[nodiscard]] bool offline() const noexcept override;

@@ -5,6 +5,7 @@ import {Grid} from './grid.js';
 import {Trend} from './trend.js';
 import {VIEWS, view} from './values.js';
 import * as panels from './panels.js';
+import {ScenarioPanel} from './scenario.js';
 
 const $ = (id) => document.getElementById(id);
 
@@ -46,6 +47,7 @@ function markControls() {
     else if (c.title === READ_ONLY) c.removeAttribute('title');
   }
   $('grid').setAttribute('aria-readonly', String(off));
+  scenario.markControls();
 }
 
 function setControl(on) {
@@ -162,10 +164,16 @@ app.live = new Live(onMessage, (s) => {
 
 const grid = new Grid($('grid'), app);
 const trend = new Trend($('trend-canvas'), $('trend-tags'), app);
-window.finsd = {state, grid, trend, live: app.live};  // for the console and the tests
+const scenario = new ScenarioPanel(app, (text) => locate(text), (valuesOnly) => {
+  $('tag-types').hidden = !scenario.tags.length;
+  grid.tagsChanged(valuesOnly);
+});
+grid.tagSource = scenario;
+window.finsd = {state, grid, trend, scenario, live: app.live};  // for the console and the tests
 
 function onMessage(msg) {
   if (grid.onMessage(msg)) return;
+  if (scenario.onMessage(msg)) return;
   if (trend.onMessage(msg)) return;
   if (msg.type === 'error') {
     if (msg.id !== 'st') toast(msg.error);
@@ -294,7 +302,7 @@ function selectPlc(p, address) {
   const changed = plcKey(p) !== plcKey(state.plc);
   state.plc = p;
   $('unit-title').textContent = p ? (p.name || p.model || 'CPU Unit') : '—';
-  $('unit-address').textContent = p ? `FINS ${p.net}.${p.node}.${p.unit ?? 0}${p.model && p.name ? ' · ' + p.model : ''}` : '';
+  $('unit-address').textContent = p ? `node ${p.net}.${p.node}.${p.unit ?? 0}${p.model && p.name ? ' · ' + p.model : ''}` : '';
   document.title = p && p.name ? `${p.name} · finsd` : 'finsd';
   panels.renderPlant(state.plcs, p, (q) => selectPlc(q));
   panels.renderRouting(p);
@@ -335,7 +343,7 @@ function showStatus(s) {
   markControls();
   panels.renderConnections(s);
   panels.renderLogs(s);
-  panels.renderScenario(s);
+  scenario.update(plcKey(state.plc), s.scenario);
   const mode = String(s.mode ?? '').toLowerCase();
   const badge = $('mode-badge');
   badge.textContent = mode ? mode.toUpperCase() : '—';
@@ -396,11 +404,17 @@ function wire() {
     tab.addEventListener('click', () => {
       for (const t of $('lower-tabs').querySelectorAll('[role=tab]')) t.setAttribute('aria-selected', String(t === tab));
       for (const body of document.querySelectorAll('.tab-body')) body.hidden = body.dataset.body !== tab.dataset.tab;
+      $('lower').dataset.tab = tab.dataset.tab;  // an empty trend folds (app.css)
       if (tab.dataset.tab === 'trend') trend.draw();
     });
   }
   document.addEventListener('visibilitychange', () => app.live.pause(document.hidden));
   $('help-button').addEventListener('click', () => $('help').showModal());
+  $('tag-types').addEventListener('click', () => {
+    const on = $('tag-types').getAttribute('aria-pressed') !== 'true';
+    $('tag-types').setAttribute('aria-pressed', String(on));
+    grid.setTagTypes(on);
+  });
   $('token-cancel').addEventListener('click', () => $('token-dialog').close('cancel'));
   $('token-form').addEventListener('submit', (e) => {
     // method=dialog closes the dialog with the button's value ("ok" or "cancel")

@@ -9,9 +9,12 @@ const MAX_SUBSCRIBED_WORDS = 1000;
 const FLASH_MS = 700;
 
 // Rows start at round decimal addresses, as engineers count words; a double takes 4.
-function wordsPerRow(viewId) {
-  if (viewId === 'bits') return 5;
-  return view(viewId).words === 4 ? 8 : 10;
+// A narrow grid (a phone) has half as many one-word cells a row, so values stay legible.
+const NARROW_PX = 600;
+function wordsPerRow(viewId, narrow = false) {
+  if (viewId === 'bits') return narrow ? 2 : 5;
+  if (view(viewId).words === 4) return 8;
+  return narrow && view(viewId).words === 1 ? 5 : 10;
 }
 
 export class Grid {
@@ -34,8 +37,11 @@ export class Grid {
     this.subCounter = 0;
     this.editing = null;
     this.frame = 0;
+    this.tagTypes = false;       // "Tag types": a scenario tag's cells show its own type
+    this.tagSource = null;       // {tagsAt(prefix, word) -> tags, value(tag) -> {text}}
     this.scroller.addEventListener('scroll', () => this.schedule());
-    new ResizeObserver(() => this.schedule()).observe(this.scroller);
+    this.narrow = false;
+    new ResizeObserver(() => this.resized()).observe(this.scroller);
     this.rowsBox.addEventListener('mousedown', (e) => this.onMouseDown(e));
     this.rowsBox.addEventListener('dblclick', (e) => this.onDoubleClick(e));
     root.addEventListener('keydown', (e) => this.onKey(e));
@@ -77,8 +83,27 @@ export class Grid {
     this.resubscribe(true);
   }
 
+  wpr() {
+    return wordsPerRow(this.viewId, this.narrow);
+  }
+
+  // The grid's width crossed NARROW_PX: fewer cells a row, the selection kept in view.
+  resized() {
+    const narrow = this.scroller.clientWidth > 0 && this.scroller.clientWidth < NARROW_PX;
+    if (narrow !== this.narrow) {
+      this.narrow = narrow;
+      if (this.rows) {
+        this.layout();
+        this.scrollTo(this.selected, true);
+        this.resubscribe(true);
+        return;
+      }
+    }
+    this.schedule();
+  }
+
   layout() {
-    const wpr = wordsPerRow(this.viewId);
+    const wpr = this.wpr();
     const per = view(this.viewId).words;
     this.rows = Math.ceil(this.area.words / wpr);
     this.spacer.style.height = `${this.rows * ROW_HEIGHT}px`;
@@ -93,7 +118,7 @@ export class Grid {
   }
 
   scrollTo(word, center = false) {
-    const row = Math.floor(word / wordsPerRow(this.viewId));
+    const row = Math.floor(word / this.wpr());
     const top = row * ROW_HEIGHT;
     const h = this.scroller.clientHeight;
     if (center) {
@@ -124,7 +149,7 @@ export class Grid {
   // Subscribes the rows on screen plus a margin when they leave the subscribed range.
   resubscribe(force) {
     if (!this.rows) return;  // not laid out yet: show() subscribes
-    const wpr = wordsPerRow(this.viewId);
+    const wpr = this.wpr();
     const [r0, r1] = this.visibleRows();
     const need0 = r0 * wpr;
     const need1 = Math.min(this.area.words, r1 * wpr);
@@ -189,7 +214,7 @@ export class Grid {
 
   render() {
     if (!this.rowEls) return;
-    const wpr = wordsPerRow(this.viewId);
+    const wpr = this.wpr();
     const per = view(this.viewId).words;
     const [r0, r1] = this.visibleRows();
     const n = r1 - r0;
@@ -221,6 +246,26 @@ export class Grid {
         this.paintCell(cell, word);
       }
     }
+  }
+
+  // The scenario tags whose words include one of the cell at `word`.
+  tagged(word) {
+    if (!this.tagSource) return [];
+    const per = view(this.viewId).words;
+    if (per === 1) return this.tagSource.tagsAt(this.area.prefix, word);
+    const out = new Set();
+    for (let i = 0; i < per; i++) for (const t of this.tagSource.tagsAt(this.area.prefix, word + i)) out.add(t);
+    return [...out];
+  }
+
+  // The scenario's tags or their values changed.
+  tagsChanged(valuesOnly) {
+    if (!valuesOnly || this.tagTypes) this.schedule();
+  }
+
+  setTagTypes(on) {
+    this.tagTypes = on;
+    this.schedule();
   }
 
   paintCell(cell, word) {
@@ -257,8 +302,25 @@ export class Grid {
       }
       cell.title = `${this.address(word)} = ${text === '' ? '?' : '0x' + (w.toString(16).toUpperCase().padStart(4, '0'))}`;
     } else {
-      if (cell.textContent !== text) cell.textContent = text;
-      cell.title = this.address(word);
+      const tagged = this.tagged(word);
+      let shown = text;
+      if (tagged.length) {
+        cell.classList.add('tagged');
+        const first = tagged.find((t) => t.word === word && t.type !== 'bool');
+        if (this.tagTypes) {
+          if (first) {
+            shown = this.tagSource.value(first).text;
+            cell.classList.add('tag-start');
+          } else if (tagged.some((t) => t.type !== 'bool' && t.word < word)) {
+            shown = '';
+            cell.classList.add('tag-cont');
+          }
+        }
+      }
+      if (cell.textContent !== shown) cell.textContent = shown;
+      cell.title = tagged.length
+        ? `${this.address(word)}\n` + tagged.map((t) => `tag ${t.address} (${t.type}) = ${this.tagSource.value(t).text}`).join('\n')
+        : this.address(word);
     }
   }
 
@@ -297,7 +359,7 @@ export class Grid {
 
   onKey(e) {
     if (this.editing || e.ctrlKey || e.metaKey || e.altKey) return;
-    const wpr = wordsPerRow(this.viewId);
+    const wpr = this.wpr();
     const per = view(this.viewId).words;
     const page = Math.max(1, Math.floor(this.scroller.clientHeight / ROW_HEIGHT) - 1) * wpr;
     const moves = {

@@ -207,29 +207,7 @@ export function renderLogs(s) {
   $('error-count').textContent = ne ? String(ne) : '';
 }
 
-// ---- scenario -------------------------------------------------------------------------
-
-export function renderScenario(s) {
-  const panel = $('scenario-panel');
-  const sc = s.scenario;
-  panel.hidden = !sc;
-  if (!sc) return;
-  const body = $('scenario-body');
-  body.textContent = '';
-  const dl = el('dl', 'facts');
-  for (const [k, v] of Object.entries(sc)) {
-    if (Array.isArray(v) || (v && typeof v === 'object')) continue;
-    dl.append(el('dt', '', k.replaceAll('_', ' ')), el('dd', '', cellText(v)));
-  }
-  body.append(dl);
-  for (const [k, v] of Object.entries(sc)) {
-    if (!Array.isArray(v)) continue;
-    body.append(el('h3', '', k.replaceAll('_', ' ')));
-    const t = el('table', 'table');
-    fillTable(t, v.map((x) => (x && typeof x === 'object' ? x : {value: x})), null, 'none');
-    body.append(t);
-  }
-}
+// The Scenario panel is scenario.js.
 
 // ---- the plant ------------------------------------------------------------------------
 

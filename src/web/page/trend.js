@@ -96,6 +96,8 @@ export class Trend {
       li.append(sw, name, as, value, x);
       this.list.append(li);
     }
+    // No series: the trend folds to its hint line and the grid gets the room.
+    document.getElementById('lower')?.classList.toggle('trend-empty', !this.tags.length);
     if (!this.tags.length) {
       const li = document.createElement('li');
       li.className = 'hint';
@@ -136,14 +138,18 @@ export class Trend {
     }
     if (lo === Infinity) { lo = 0; hi = 1; }
     if (lo === hi) { lo -= 1; hi += 1; }
-    const step = niceStep((hi - lo) / 4);
+    // As many value lines as fit 18 px apart (at most 5), labels as wide as the widest.
+    const top = 8;
+    const bottom = 18;
+    const right = 8;
+    const lines = Math.max(1, Math.min(4, Math.floor((h - top - bottom) / 18)));
+    const step = niceStep((hi - lo) / lines);
     lo = Math.floor(lo / step) * step;
     hi = Math.ceil(hi / step) * step;
     if (hi === lo) hi = lo + step;
-    const left = 56;
-    const right = 8;
-    const top = 8;
-    const bottom = 18;
+    const labels = [];
+    for (let v = lo; v <= hi + step / 2; v += step) labels.push([v, Number(v.toPrecision(6)).toString()]);
+    const left = Math.min(Math.max(40, ...labels.map(([, t]) => g.measureText(t).width + 12)), w / 3);
     const pw = w - left - right;
     const ph = h - top - bottom;
     const x = (tt) => left + ((tt - t0) / WINDOW_MS) * pw;
@@ -153,19 +159,32 @@ export class Trend {
     g.lineWidth = 1;
     g.textAlign = 'right';
     g.textBaseline = 'middle';
-    for (let v = lo; v <= hi + step / 2; v += step) {
+    let lastLabel = -Infinity;  // a label closer than 14 px to the one below is skipped
+    for (const [v, label] of labels) {
       const yy = Math.round(y(v)) + 0.5;
       g.beginPath();
       g.moveTo(left, yy);
       g.lineTo(w - right, yy);
       g.stroke();
-      g.fillText(Number(v.toPrecision(6)).toString(), left - 6, yy);
+      if (Math.abs(lastLabel - yy) < 14) continue;
+      g.fillText(label, left - 6, yy);
+      lastLabel = yy;
     }
+    // Time labels: the smallest of 10, 20, 30, 60 or 120 s whose labels keep a gap.
+    const widest = g.measureText('-120s').width + 10;
+    const every = [10, 20, 30, 60, 120].find((s) => (s / (WINDOW_MS / 1000)) * pw >= widest) ?? 120;
     g.textAlign = 'center';
     g.textBaseline = 'top';
-    for (let s = 0; s <= WINDOW_MS / 1000; s += 20) {
+    // From "now" leftwards; a label that would touch the one drawn before is skipped.
+    let edge = Infinity;
+    for (let s = 0; s <= WINDOW_MS / 1000; s += every) {
       const xx = Math.round(x(now - s * 1000)) + 0.5;
-      g.fillText(s === 0 ? 'now' : `-${s}s`, Math.min(xx, w - right - 12), h - bottom + 4);
+      const label = s === 0 ? 'now' : `-${s}s`;
+      const half = g.measureText(label).width / 2;
+      const cx = Math.max(left + half, Math.min(xx, w - right - half));
+      if (cx + half + 6 > edge) continue;
+      g.fillText(label, cx, h - bottom + 4);
+      edge = cx - half;
     }
     g.lineWidth = 1.5;
     for (const t of this.tags) {
