@@ -5,11 +5,13 @@
 #include <array>
 #include <chrono>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/udp.hpp>
+#include <boost/asio/post.hpp>
 #include <nlohmann/json.hpp>
 
 #include "fins/byte_io.hpp"
@@ -222,6 +224,31 @@ TEST_F(Listing, AnswersFinsToAUnitWhileALargePlantIsListed) {
     ASSERT_EQ(j["plcs"].size(), 2000u);
     EXPECT_EQ(j["total"], 2000);
     EXPECT_EQ(j["plcs"][1999]["name"], "unit2000");
+}
+
+// A slice that throws (here the describe hook, at the 30th unit, in a slice posted to the
+// io_context) ends that request with a 500 JSON error; io_context::run goes on.
+TEST_F(Listing, ASliceThatThrowsAnswers500AndTheIoContextGoesOn) {
+    make(50);
+    boost::asio::io_context io{1};
+    context_.executor = io.get_executor();
+    context_.options.listing_slice = std::chrono::microseconds(0);
+    context_.describe = [](const server::ControlTarget& t, Json&) {
+        if (t.name == "unit30") throw std::runtime_error("describe failed");
+    };
+    std::vector<web::HttpAnswer> answers;
+    web::handle_request(context_, "GET", "/api/plcs", {},
+                        [&](web::HttpAnswer a) { answers.push_back(std::move(a)); });
+    bool after = false;
+    boost::asio::post(io, [&] { after = true; });
+    for (int i = 0; i < 1000 && (answers.empty() || !after); ++i)
+        ASSERT_NO_THROW(io.run_one_for(std::chrono::milliseconds(100)));
+    ASSERT_EQ(answers.size(), 1u);
+    EXPECT_EQ(answers[0].status, 500u);
+    EXPECT_TRUE(Json::parse(answers[0].body)["error"].is_string());
+    EXPECT_TRUE(after);
+    io.restart();
+    EXPECT_EQ(io.poll(), 0u);  // nothing left: the listing stopped there
 }
 
 // Through the HTTP server (which lists in slices on its io_context): whole and paged.
