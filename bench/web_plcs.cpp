@@ -64,8 +64,8 @@ double ms_since(Clock::time_point t, Clock::time_point now = Clock::now()) {
 }
 
 struct Case {
-    std::vector<double> rtt_ms;  // FINS round trips
-    double probe_max_ms = 0;     // the probe timer's worst lateness
+    std::vector<double> rtt_ms;   // FINS round trips
+    double probe_max_ms = 0;      // the probe timer's worst lateness
     double probe_cpu_max_ms = 0;  // the I/O thread's most CPU time between two probes
     std::size_t fetches = 0;
     double fetch_ms = 0;  // mean
@@ -86,7 +86,8 @@ std::vector<double> fins_round_trips(std::uint16_t port, double seconds, bool& o
                                         std::chrono::duration<double>(seconds));
     while (Clock::now() < end) {
         const auto t = Clock::now();
-        if (::send(fd, frame.data(), frame.size(), 0) <= 0 || ::recv(fd, in.data(), in.size(), 0) <= 0) {
+        if (::send(fd, frame.data(), frame.size(), 0) <= 0 ||
+            ::recv(fd, in.data(), in.size(), 0) <= 0) {
             ok = false;  // SO_RCVTIMEO is 1 s: a datagram lost or held that long
             break;
         }
@@ -153,7 +154,8 @@ int main(int argc, char** argv) {
         fins::server::ControlTarget t;
         t.plc = plcs.back().get();
         t.name = fmt::format("plc{}", i + 1);
-        t.addresses = {{static_cast<std::uint8_t>(1 + i / 250), static_cast<std::uint8_t>(1 + i % 250)}};
+        t.addresses = {
+            {static_cast<std::uint8_t>(1 + i / 250), static_cast<std::uint8_t>(1 + i % 250)}};
         context.targets.push_back(t);
     }
     context.options.listing_slice =
@@ -224,7 +226,8 @@ int main(int argc, char** argv) {
         c.probe_max_ms = on_io([&] { return probe_max; });
         c.probe_cpu_max_ms = on_io([&] { return probe_cpu_max; });
         all_ok = all_ok && c.ok && !c.rtt_ms.empty();
-        const double max = c.rtt_ms.empty() ? 0 : *std::max_element(c.rtt_ms.begin(), c.rtt_ms.end());
+        const double max =
+            c.rtt_ms.empty() ? 0 : *std::max_element(c.rtt_ms.begin(), c.rtt_ms.end());
         const char* name = listing ? "listing" : "idle";
         if (json)
             std::printf(

@@ -129,8 +129,8 @@ std::optional<HttpAnswer> parse_listing_range(const std::string* offset, const s
     if (offset != nullptr) {
         const auto n = count_param(*offset);
         if (!n)
-            return error_answer(400, fmt::format("offset={}: not a number of units (0 or more)",
-                                                 *offset));
+            return error_answer(
+                400, fmt::format("offset={}: not a number of units (0 or more)", *offset));
         out.offset = *n;
     }
     if (limit != nullptr) {

@@ -36,8 +36,8 @@ class Listing : public ::testing::Test {
             server::ControlTarget t;
             t.plc = plcs_.back().get();
             t.name = "unit" + std::to_string(i + 1);
-            t.addresses = {{static_cast<std::uint8_t>(1 + i / 250),
-                            static_cast<std::uint8_t>(1 + i % 250)}};
+            t.addresses = {
+                {static_cast<std::uint8_t>(1 + i / 250), static_cast<std::uint8_t>(1 + i % 250)}};
             context_.targets.push_back(t);
         }
     }
@@ -129,10 +129,10 @@ TEST_F(Listing, AnEmptyPageStillCarriesTheTotal) {
 TEST_F(Listing, RefusesBadPagingParametersWith400AndAJsonError) {
     make(3);
     for (const char* target :
-         {"/api/plcs?offset=-1", "/api/plcs?offset=x", "/api/plcs?offset=", "/api/plcs?limit=",
-          "/api/plcs?limit=-5", "/api/plcs?limit=2.5", "/api/plcs?limit=1e3",
-          "/api/plcs?limit=%2B3", "/api/plcs?offset=0x10", "/api/plcs?limit=99999999999999999999",
-          "/api/plcs?offset"}) {
+         {"/api/plcs?offset=-1", "/api/plcs?offset=x",
+          "/api/plcs?offset=", "/api/plcs?limit=", "/api/plcs?limit=-5", "/api/plcs?limit=2.5",
+          "/api/plcs?limit=1e3", "/api/plcs?limit=%2B3", "/api/plcs?offset=0x10",
+          "/api/plcs?limit=99999999999999999999", "/api/plcs?offset"}) {
         const auto j = get(target, 400);
         ASSERT_TRUE(j.is_object()) << target;
         ASSERT_TRUE(j["error"].is_string()) << target;
@@ -149,8 +149,8 @@ TEST_F(Listing, ShowsAUnitsModeChangeAndOnlyThatUnitsEntryChanges) {
     const auto before = get("/api/plcs");
     for (const auto& p : before["plcs"])
         EXPECT_EQ(p["mode"], "run");
-    const auto changed = call("POST", "/api/control",
-                              R"({"cmd":"mode","mode":"program","plc":"unit3"})");
+    const auto changed =
+        call("POST", "/api/control", R"({"cmd":"mode","mode":"program","plc":"unit3"})");
     ASSERT_EQ(changed.status, 200u) << changed.body;
     const auto after = get("/api/plcs");
     ASSERT_EQ(after["plcs"].size(), 5u);
@@ -188,7 +188,8 @@ TEST_F(Listing, AnswersFinsToAUnitWhileALargePlantIsListed) {
     std::array<std::uint8_t, max_frame_size> frame{};
     const auto n = encode_request(h, MemoryAreaRead::code, pw.written(), frame);
     ASSERT_TRUE(n);
-    asio::ip::udp::socket client(io, asio::ip::udp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
+    asio::ip::udp::socket client(io,
+                                 asio::ip::udp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
     const asio::ip::udp::endpoint to(asio::ip::make_address("127.0.0.1"), (*server)->udp_port());
     client.send_to(asio::buffer(frame.data(), *n), to);
 
@@ -196,11 +197,12 @@ TEST_F(Listing, AnswersFinsToAUnitWhileALargePlantIsListed) {
     std::array<std::uint8_t, max_frame_size> in{};
     asio::ip::udp::endpoint from;
     std::vector<std::uint8_t> answer;
-    client.async_receive_from(asio::buffer(in), from, [&](boost::system::error_code ec, std::size_t got) {
-        ASSERT_FALSE(ec) << ec.message();
-        order.push_back("fins");
-        answer.assign(in.begin(), in.begin() + static_cast<std::ptrdiff_t>(got));
-    });
+    client.async_receive_from(
+        asio::buffer(in), from, [&](boost::system::error_code ec, std::size_t got) {
+            ASSERT_FALSE(ec) << ec.message();
+            order.push_back("fins");
+            answer.assign(in.begin(), in.begin() + static_cast<std::ptrdiff_t>(got));
+        });
     web::HttpAnswer listing;
     web::handle_request(context_, "GET", "/api/plcs", {}, [&](web::HttpAnswer a) {
         order.push_back("plcs");
