@@ -14,7 +14,6 @@
 #include <boost/url/url_view.hpp>
 
 #include "plc/plc.hpp"
-#include "plc/routing_tables.hpp"
 #include "server/control/control_dispatch.hpp"
 #include "server/control/control_requests.hpp"
 #include "server/control/control_scenario.hpp"
@@ -22,6 +21,7 @@
 #include "web/assets.hpp"
 #include "web/cpu_facts.hpp"
 #include "web/memory_values.hpp"
+#include "web/plc_listing.hpp"
 
 namespace fins::web {
 
@@ -140,44 +140,6 @@ std::optional<std::string_view> plc_param(const Query& q) {
     return std::nullopt;
 }
 
-Json plc_entry(const WebContext& context, const server::ControlTarget& t) {
-    Json addresses = Json::array();
-    for (const auto& [net, node] : t.addresses)
-        addresses.push_back(fmt::format("{}.{}", net, node));
-    Json entry{{"name", t.name},
-               {"model", t.plc->profile().model},
-               {"profile", t.plc->profile().name},
-               {"addresses", addresses},
-               {"net", t.addresses.empty() ? 0 : t.addresses.front().first},
-               {"node", t.addresses.empty() ? 0 : t.addresses.front().second},
-               {"unit", 0},
-               {"em_banks", t.plc->profile().em_banks},
-               {"areas", memory_areas(t.plc->profile())}};
-    // The CPU Unit's routing tables (parameter area 8013, W342 5-3-8): what the router uses.
-    const auto decoded =
-        plc::decode_routing_tables(t.plc->parameters().words(plc::routing_table_area));
-    Json routes = Json::array();
-    if (decoded.state == plc::RoutingTablesState::valid) {
-        const auto& tables = decoded.tables;
-        for (std::size_t i = 0; i < tables.local_count; ++i)
-            routes.push_back({{"network", tables.local[i].network},
-                              {"local", true},
-                              {"unit", tables.local[i].unit}});
-        for (std::size_t i = 0; i < tables.relay_count; ++i)
-            routes.push_back({{"network", tables.relay[i].network},
-                              {"local", false},
-                              {"relay_network", tables.relay[i].relay_network},
-                              {"relay_node", tables.relay[i].relay_node}});
-    }
-    entry["routing_tables"] = decoded.state == plc::RoutingTablesState::valid  ? "valid"
-                              : decoded.state == plc::RoutingTablesState::none ? "none"
-                                                                               : "broken";
-    entry["routes"] = std::move(routes);
-    entry["relays"] = Json::object();
-    if (context.describe) context.describe(t, entry);
-    return entry;
-}
-
 HttpAnswer read_route(WebContext& context, const Query& q) {
     HttpAnswer error;
     const auto* t = target_of(context, plc_param(q), error);
@@ -294,7 +256,10 @@ std::optional<HttpAnswer> check_request(const WebOptions& options, const Request
     return std::nullopt;
 }
 
-Json errors_object(const server::ControlTarget& target) {
+namespace {
+
+// The error log's records, oldest first.
+Json error_log(const server::ControlTarget& target) {
     const auto& errors = target.plc->errors();
     Json log = Json::array();
     for (std::size_t i = 0; i < errors.log_size(); ++i) {
@@ -305,11 +270,11 @@ Json errors_object(const server::ControlTarget& target) {
                                             r.time.month, r.time.day, r.time.hour, r.time.minute,
                                             r.time.second)}});
     }
-    const Json status = server::handle_control_request(*target.plc, Json{{"cmd", "status"}});
-    return Json{{"errors", status["status"]["errors"]}, {"error_log", log}};
+    return log;
 }
 
-Json events_object(const server::ControlTarget& target) {
+// The write access log's records.
+Json access_log(const server::ControlTarget& target) {
     auto& log = target.plc->write_access_log();
     Json records = Json::array();
     for (std::size_t i = 0; i < log.size(); ++i) {
@@ -321,7 +286,18 @@ Json events_object(const server::ControlTarget& target) {
               fmt::format("20{:02}-{:02}-{:02} {:02}:{:02}:{:02}", r.time.year, r.time.month,
                           r.time.day, r.time.hour, r.time.minute, r.time.second)}});
     }
-    return Json{{"access_log", records}};
+    return records;
+}
+
+}  // namespace
+
+Json errors_object(const server::ControlTarget& target) {
+    const Json status = server::handle_control_request(*target.plc, Json{{"cmd", "status"}});
+    return Json{{"errors", status["status"]["errors"]}, {"error_log", error_log(target)}};
+}
+
+Json events_object(const server::ControlTarget& target) {
+    return Json{{"access_log", access_log(target)}};
 }
 
 Json status_object(const WebContext& context, const server::ControlTarget& target,
@@ -339,8 +315,9 @@ Json status_object(const WebContext& context, const server::ControlTarget& targe
                              {"dip_write", target.plc->dip_write_protection()}};
     status["faults"] = {{"battery_error", target.plc->errors().battery_low()},
                         {"errors", status["errors"]}};
-    status["error_log"] = errors_object(target)["error_log"];
-    status["access_log"] = events_object(target)["access_log"];
+    // The control status is built once (above); the logs are read on their own.
+    status["error_log"] = error_log(target);
+    status["access_log"] = access_log(target);
     status["connections"] = Json::array();
     status["udp_peers"] = Json::array();
     add_cpu_facts(*target.plc, status, now);
@@ -386,13 +363,10 @@ void handle_request(WebContext& context, std::string_view method, std::string_vi
     }
     if (path == "/api/plcs") {
         if (!get) return only("GET");
-        Json plcs = Json::array();
-        for (const auto& t : context.targets)
-            plcs.push_back(plc_entry(context, t));
-        // token_required: POSTs need --http-token-file's token (the page asks for it).
-        return done(json_answer(200, Json{{"plcs", plcs},
-                                          {"control", context.options.control},
-                                          {"token_required", !context.options.token.empty()}}));
+        ListingRange range;
+        if (auto bad = parse_listing_range(q->find("offset"), q->find("limit"), range))
+            return done(std::move(*bad));
+        return list_plcs(context, range, done);
     }
     if (path == "/metrics" && context.metrics) {
         if (!get) return only("GET");

@@ -3,7 +3,7 @@
 // only reads, calls and writes. Routes and bodies: docs/web.md, docs/api/openapi.yaml.
 //
 //   GET  /  /<file>              the embedded page, /openapi.yaml, /chart.js
-//   GET  /api/plcs               the CPU Units served
+//   GET  /api/plcs               the CPU Units served [?offset=0&limit=N]
 //   GET  /api/read               ?address=D100&count=3&as=uint16[&plc=NAME|NET.NODE]
 //   POST /api/write              {"address","values","as"[,"plc"]}       (control on)
 //   GET  /api/status             the control channel's status plus network, logs

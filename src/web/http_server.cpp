@@ -69,6 +69,7 @@ Result<std::unique_ptr<HttpServer>> HttpServer::start(asio::io_context& io, WebC
     beast::error_code ec;
     const auto address = asio::ip::make_address(context.options.bind_address, ec);
     if (ec) return Unexpected(std::make_error_code(std::errc::invalid_argument));
+    if (!context.executor) context.executor = io.get_executor();
     auto shared = std::make_shared<ServerShared>(io, std::move(context));
     const asio::ip::tcp::endpoint endpoint(address, shared->context.options.port);
     auto& acceptor = shared->acceptor;

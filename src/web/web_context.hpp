@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include <boost/asio/any_io_executor.hpp>
 #include <nlohmann/json.hpp>
 
 #include "server/control/control.hpp"
@@ -40,6 +41,9 @@ struct WebOptions {
     std::size_t max_connections = 64;         // HTTP + WebSocket; the oldest idle one goes
     std::chrono::milliseconds idle_timeout{std::chrono::seconds(30)};     // HTTP keep-alive
     std::chrono::milliseconds request_timeout{std::chrono::seconds(10)};  // a begun request
+    // GET /api/plcs builds its entries at most this long at a time (at least one entry),
+    // then lets the io_context serve FINS before the next slice (docs/web.md).
+    std::chrono::microseconds listing_slice{1000};
 
     // WebSocket.
     std::size_t max_ws_message_bytes = 4 * 1024;
@@ -65,6 +69,9 @@ struct WebOptions {
 struct WebContext {
     std::vector<server::ControlTarget> targets;  // the first is the default CPU Unit
     WebOptions options;
+    // The io_context's executor (HttpServer::start sets it when empty): GET /api/plcs
+    // posts its slices to it. Empty (the unit tests' plain calls): built in one go.
+    boost::asio::any_io_executor executor;
     // Adds what the server around a CPU Unit knows (its network, routes, relays, FINS/TCP
     // connections, UDP peers) to its /api/plcs entry and its /api/status object. Optional.
     std::function<void(const server::ControlTarget&, nlohmann::json& plc)> describe;
