@@ -363,7 +363,12 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
                                  "fault = \"end_code\" needs the address of the area");
                 auto code = to_memory_address(*address, Access::word);
                 if (!code) return error(e.address.pos, code.error().message());
-                es.area_code = code->area_code;
+                const auto* segment = find_segment(code->area_code, code->word);
+                if (segment == nullptr)
+                    return error(e.address.pos,
+                                 fmt::format("{} is not in an I/O memory area", e.address.text));
+                es.region = segment->region;
+                es.em_bank = segment->em_bank;
                 if (e.end_code == 0) return error(e.pos, "end_code must not be 0000");
                 break;
             }
@@ -418,6 +423,11 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
 }
 
 Scenario::Impl::~Impl() {
+    // A battery event holding the battery low ends with its scenario (a reload).
+    if (plc != nullptr && std::any_of(events.begin(), events.end(), [](const EventState& e) {
+            return e.holding && e.def->fault == FaultKind::battery;
+        }))
+        plc->errors().set_battery_cause(plc::ErrorState::battery_cause_scenario, false, host_now);
     if (plc != nullptr && !def.loop_items.empty()) plc->loop_control().clear_sources(this);
 }
 
