@@ -66,8 +66,8 @@ bool ErrorState::raise_fals(std::uint16_t number, std::string_view message, Time
 }
 
 void ErrorState::set_battery_cause(std::uint8_t cause, bool low, TimePoint now) {
-    state_.battery_low = static_cast<std::uint8_t>(low ? state_.battery_low | cause
-                                                       : state_.battery_low & ~cause);
+    state_.battery_low =
+        static_cast<std::uint8_t>(low ? state_.battery_low | cause : state_.battery_low & ~cause);
     if (low)
         raise(battery_error_code, now);
     else if (!battery_low())

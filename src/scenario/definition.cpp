@@ -164,8 +164,8 @@ SourcePos Text::position(std::uint32_t line, std::uint32_t column) const {
                 // A line-ending backslash: it and the white space after it give nothing.
                 ++i;
                 ++raw_column;
-                while (i < end && (raw[i] == ' ' || raw[i] == '\t' || raw[i] == '\r' ||
-                                   raw[i] == '\n')) {
+                while (i < end &&
+                       (raw[i] == ' ' || raw[i] == '\t' || raw[i] == '\r' || raw[i] == '\n')) {
                     if (raw[i] == '\n')
                         next_line();
                     else

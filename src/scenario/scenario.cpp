@@ -139,8 +139,7 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
     for (std::size_t i = 0; i < def.tags.size(); ++i) {
         const TagDef& t = def.tags[i];
         auto address = parse_address(t.address.text);
-        if (!address)
-            return error(t.address.pos, address_error(t.address.text, address.error()));
+        if (!address) return error(t.address.pos, address_error(t.address.text, address.error()));
         auto r = c.locate(*address, t.type, t.address.text, plc::Intent::write,
                           static_cast<std::int32_t>(i));
         if (!r) return error(t.address.pos, r.error());
@@ -227,8 +226,7 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
     }
     for (const auto& in : def.inputs) {
         auto address = parse_address(in.address.text);
-        if (!address)
-            return error(in.address.pos, address_error(in.address.text, address.error()));
+        if (!address) return error(in.address.pos, address_error(in.address.text, address.error()));
         for (const auto& known : c.addresses)
             if (known == *address)
                 return error(in.address.pos,

@@ -143,8 +143,7 @@ void Scenario::Impl::end_event(EventState& event) noexcept {
         case FaultKind::battery:
             if (!held) break;
             if (other_holder(event) == nullptr)
-                errors.set_battery_cause(plc::ErrorState::battery_cause_scenario, false,
-                                         host_now);
+                errors.set_battery_cause(plc::ErrorState::battery_cause_scenario, false, host_now);
             break;
         case FaultKind::mode: {
             if (!held) break;
@@ -189,8 +188,8 @@ void Scenario::Impl::combine_faults() noexcept {
                 transport.offline = true;
                 break;
             case FaultKind::latency:
-                transport.latency_ms = std::max(
-                    transport.latency_ms, static_cast<std::uint32_t>(std::llround(e.value)));
+                transport.latency_ms = std::max(transport.latency_ms,
+                                                static_cast<std::uint32_t>(std::llround(e.value)));
                 break;
             case FaultKind::drop:
                 transport.drop_fraction = std::max(transport.drop_fraction, e.value);
@@ -207,8 +206,8 @@ void Scenario::Impl::combine_faults() noexcept {
     for (std::uint64_t from = 1; from <= newest_area;) {
         const EventState* next = nullptr;
         for (const auto& event : events)
-            if (event.holding && event.def->fault == FaultKind::end_code &&
-                event.started >= from && (next == nullptr || event.started < next->started))
+            if (event.holding && event.def->fault == FaultKind::end_code && event.started >= from &&
+                (next == nullptr || event.started < next->started))
                 next = &event;
         if (next == nullptr) break;
         auto it = std::find_if(transport.areas.begin(), transport.areas.end(),

@@ -38,7 +38,8 @@ std::unique_ptr<Scenario> with_events(plc::Plc& plc, std::vector<EventDef> event
 // A tick ends the events whose end is the time after it: run_to(29.9) shows an event
 // ending at 30 ended.
 void run_to(Scenario& s, double t) {
-    for (int bound = 0; bound < 100000 && s.time() < t + 0.05; ++bound) s.tick(now);
+    for (int bound = 0; bound < 100000 && s.time() < t + 0.05; ++bound)
+        s.tick(now);
 }
 
 MemoryAddress address(std::uint8_t code, std::uint16_t word, std::uint8_t bit = 0) {
@@ -47,7 +48,8 @@ MemoryAddress address(std::uint8_t code, std::uint16_t word, std::uint8_t bit = 
 
 TEST(ScenarioFaults, AnOfflineEventInsideAnotherDoesNotBringTheUnitBack) {
     plc::Plc plc;
-    auto s = with_events(plc, {event(FaultKind::offline, 10, 20), event(FaultKind::offline, 12, 2)});
+    auto s =
+        with_events(plc, {event(FaultKind::offline, 10, 20), event(FaultKind::offline, 12, 2)});
     ASSERT_TRUE(s);
     run_to(*s, 9.9);
     EXPECT_FALSE(s->transport().offline);
@@ -75,9 +77,9 @@ TEST(ScenarioFaults, AnOfflineEventOfDurationZeroStaysPastATimedOne) {
 
 TEST(ScenarioFaults, LatencyIsTheLargestOfTheActiveEvents) {
     plc::Plc plc;
-    auto s = with_events(plc, {event(FaultKind::latency, 10, 20, 100),
-                               event(FaultKind::latency, 12, 2, 500),
-                               event(FaultKind::latency, 20, 2, 50)});
+    auto s = with_events(
+        plc, {event(FaultKind::latency, 10, 20, 100), event(FaultKind::latency, 12, 2, 500),
+              event(FaultKind::latency, 20, 2, 50)});
     ASSERT_TRUE(s);
     run_to(*s, 11);
     EXPECT_EQ(s->transport().latency_ms, 100u);
@@ -96,8 +98,8 @@ TEST(ScenarioFaults, LatencyIsTheLargestOfTheActiveEvents) {
 TEST(ScenarioFaults, DropIsTheLargestFractionOfTheActiveEvents) {
     plc::Plc plc;
     // Not nested: the first ends while the second holds.
-    auto s = with_events(plc, {event(FaultKind::drop, 10, 10, 0.5),
-                               event(FaultKind::drop, 15, 10, 0.25)});
+    auto s = with_events(
+        plc, {event(FaultKind::drop, 10, 10, 0.5), event(FaultKind::drop, 15, 10, 0.25)});
     ASSERT_TRUE(s);
     run_to(*s, 11);
     EXPECT_DOUBLE_EQ(s->transport().drop_fraction, 0.5);
@@ -132,9 +134,9 @@ TEST(ScenarioFaults, EndCodesOfSeveralAreasHoldAtOnce) {
     run_to(*s, 13);
     EXPECT_EQ(f.end_code_for(dm_word), 0x1101);
     EXPECT_EQ(f.end_code_for(w_word), 0x2101);
-    EXPECT_EQ(f.end_code_for(w_bit), 0x2101);  // a bit code names the same area
+    EXPECT_EQ(f.end_code_for(w_bit), 0x2101);        // a bit code names the same area
     EXPECT_EQ(f.end_code_for(address(0xB0, 3)), 0);  // CIO is not W
-    run_to(*s, 15);  // W ended; D still faulted
+    run_to(*s, 15);                                  // W ended; D still faulted
     EXPECT_EQ(f.end_code_for(dm_word), 0x1101);
     EXPECT_EQ(f.end_code_for(w_word), 0);
     run_to(*s, 21);

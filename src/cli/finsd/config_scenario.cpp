@@ -132,8 +132,7 @@ std::string ScenarioLoader::raw(const toml::source_region& r) const {
     if (begin >= text_.size()) return {};
     const char quote = text_[begin];
     if (quote != '"' && quote != '\'') return {};
-    const std::string delimiter(text_.compare(begin, 3, std::string(3, quote)) == 0 ? 3 : 1,
-                                quote);
+    const std::string delimiter(text_.compare(begin, 3, std::string(3, quote)) == 0 ? 3 : 1, quote);
     // Up to the closing delimiter (a basic string's \" does not close it).
     for (std::size_t i = begin + delimiter.size(); i < text_.size(); ++i) {
         if (quote == '"' && text_[i] == '\\') {

@@ -130,8 +130,7 @@ tl::expected<void, std::string> ScenarioLoader::tag(const toml::table& t, const 
                 if (!(*n >= 0 && *n <= 1))
                     return fail(v, p, fmt::format("{} is not a fraction 0-1", *n));
                 d.duty = *n;
-            }
-            else if (k == "step")
+            } else if (k == "step")
                 d.step = *n;
             else if (k == "rate")
                 d.rate = *n;

@@ -187,8 +187,7 @@ std::size_t Dispatcher::run_with_faults(Reply& reply, const CommandInfo& info,
                                         const handlers::HandlerEntry& entry, Bytes parameters,
                                         const RequestContext& context) {
     if (reply.command.main == 0x01)
-        if (const auto code = memory_area_fault(*faults_, reply.command.sub, parameters);
-            code != 0)
+        if (const auto code = memory_area_fault(*faults_, reply.command.sub, parameters); code != 0)
             return reply.answer(static_cast<EndCode>(code));
     const std::size_t n = run(reply, info, entry, parameters, context);
     if (n == 0 || faults_->latency().count() <= 0 || context.reply_path == nullptr) return n;

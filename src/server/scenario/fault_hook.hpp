@@ -30,7 +30,8 @@ class FaultHook {
     // True when this request gets no answer (offline, or drawn by the drop fraction).
     virtual bool silent() noexcept = 0;
     // The end code a memory area command naming `address` answers (0: none).
-    [[nodiscard]] virtual std::uint16_t area_end_code(const MemoryAddress& address) const noexcept = 0;
+    [[nodiscard]] virtual std::uint16_t area_end_code(
+        const MemoryAddress& address) const noexcept = 0;
     // How long answers wait (0: none).
     [[nodiscard]] virtual std::chrono::milliseconds latency() const noexcept = 0;
     // Sends `response` through `completion` once latency() has passed.

@@ -44,12 +44,12 @@ struct Faulted : ::testing::Test {
 };
 
 TEST_F(Faulted, WordAndBitReadsAndWritesAnswerTheAreasEndCode) {
-    EXPECT_EQ(end_code_bytes("0101 82000A00 0001"), "11 01");        // D word read
-    EXPECT_EQ(end_code_bytes("0102 82000A00 0001 1234"), "11 01");   // D word write
-    EXPECT_EQ(end_code_bytes("0101 B1000300 0001"), "21 01");        // W word read
-    EXPECT_EQ(end_code_bytes("0101 31000304 0001"), "21 01");        // W bit read
-    EXPECT_EQ(end_code_bytes("0102 31000304 0001 01"), "21 01");     // W bit write
-    EXPECT_EQ(end_code_bytes("0102 02000A03 0001 01"), "11 01");     // D bit write (CV)
+    EXPECT_EQ(end_code_bytes("0101 82000A00 0001"), "11 01");       // D word read
+    EXPECT_EQ(end_code_bytes("0102 82000A00 0001 1234"), "11 01");  // D word write
+    EXPECT_EQ(end_code_bytes("0101 B1000300 0001"), "21 01");       // W word read
+    EXPECT_EQ(end_code_bytes("0101 31000304 0001"), "21 01");       // W bit read
+    EXPECT_EQ(end_code_bytes("0102 31000304 0001 01"), "21 01");    // W bit write
+    EXPECT_EQ(end_code_bytes("0102 02000A03 0001 01"), "11 01");    // D bit write (CV)
     EXPECT_EQ(h.memory().words(Region::work)[3], 0);                // nothing written
     EXPECT_EQ(h.memory().words(Region::dm)[10], 0);
     // Another area is served as usual.
