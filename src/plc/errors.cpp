@@ -65,11 +65,12 @@ bool ErrorState::raise_fals(std::uint16_t number, std::string_view message, Time
     return raise(static_cast<std::uint16_t>(fals_code_base + number), now, message);
 }
 
-void ErrorState::set_battery_low(bool low, TimePoint now) {
-    state_.battery_low = low ? 1 : 0;
+void ErrorState::set_battery_cause(std::uint8_t cause, bool low, TimePoint now) {
+    state_.battery_low =
+        static_cast<std::uint8_t>(low ? state_.battery_low | cause : state_.battery_low & ~cause);
     if (low)
         raise(battery_error_code, now);
-    else
+    else if (!battery_low())
         clear(battery_error_code, now);
 }
 

@@ -78,8 +78,16 @@ class ErrorState {
     bool raise_fals(std::uint16_t number, std::string_view message, TimePoint now);
 
     // The battery: low raises 00F7 and keeps the cause; replaced removes the cause and
-    // the error.
-    void set_battery_low(bool low, TimePoint now);
+    // the error. Two causes are kept apart, the operator's (finsd ctl battery-error, the
+    // [inject] table: set_battery_low) and a scenario's battery events: the battery is
+    // low while either is, so a scenario event that ends does not replace a battery the
+    // operator said is low, nor the operator's "off" one an event holds low.
+    static constexpr std::uint8_t battery_cause_operator = 0x01;
+    static constexpr std::uint8_t battery_cause_scenario = 0x02;
+    void set_battery_low(bool low, TimePoint now) {
+        set_battery_cause(battery_cause_operator, low, now);
+    }
+    void set_battery_cause(std::uint8_t cause, bool low, TimePoint now);
     [[nodiscard]] bool battery_low() const noexcept { return state_.battery_low != 0; }
 
     // Removes `code` if present (true). The battery error recurs while the cause remains.

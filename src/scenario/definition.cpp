@@ -2,7 +2,13 @@
 #include "scenario/definition.hpp"
 
 #include <array>
+#include <cctype>
 #include <utility>
+
+#include <fmt/core.h>
+
+#include "fins/address.hpp"
+#include "fins/error.hpp"
 
 namespace fins::scenario {
 
@@ -109,6 +115,109 @@ std::string_view fault_kind_name(FaultKind kind) {
 }
 bool is_value_fault(FaultKind kind) {
     return kind <= FaultKind::noise;
+}
+
+namespace {
+
+// Bytes of the UTF-8 character whose first byte is `lead` (1 for a stray byte).
+std::size_t utf8_length(unsigned char lead) {
+    if (lead >= 0xF0 && lead < 0xF8) return 4;
+    if (lead >= 0xE0) return lead < 0xF0 ? 3 : 1;
+    if (lead >= 0xC0) return 2;
+    return 1;
+}
+
+}  // namespace
+
+SourcePos Text::position(std::uint32_t line, std::uint32_t column) const {
+    if (pos.line == 0) return {line, column, pos.source};
+    if (raw.empty()) {
+        if (line == 1) return {pos.line, pos.column + column, pos.source};
+        return {pos.line + line - 1, column, pos.source};
+    }
+    // Walk the value as written and as decoded side by side: (raw_line, raw_column) is
+    // where raw[i] is in the file, (line_now, column_now) the decoded character it gives.
+    const bool literal = raw.front() == '\'';
+    const bool multi = raw.rfind("\"\"\"", 0) == 0 || raw.rfind("'''", 0) == 0;
+    const std::size_t quote = multi ? 3 : 1;
+    const std::size_t end = raw.size() >= 2 * quote ? raw.size() - quote : raw.size();
+    std::size_t i = std::min(quote, raw.size());
+    std::uint32_t raw_line = pos.line, raw_column = pos.column + static_cast<std::uint32_t>(i);
+    const auto next_line = [&] {
+        ++raw_line;
+        raw_column = 1;
+    };
+    // A line break right after the opening """ is not part of the value.
+    if (multi && i < end && raw[i] == '\r' && i + 1 < end && raw[i + 1] == '\n') {
+        i += 2;
+        next_line();
+    } else if (multi && i < end && raw[i] == '\n') {
+        ++i;
+        next_line();
+    }
+    std::uint32_t line_now = 1, column_now = 1;
+    while (i < end) {
+        const auto c = static_cast<unsigned char>(raw[i]);
+        if (!literal && c == '\\' && i + 1 < end) {
+            const char n = raw[i + 1];
+            if (multi && (n == ' ' || n == '\t' || n == '\r' || n == '\n')) {
+                // A line-ending backslash: it and the white space after it give nothing.
+                ++i;
+                ++raw_column;
+                while (i < end &&
+                       (raw[i] == ' ' || raw[i] == '\t' || raw[i] == '\r' || raw[i] == '\n')) {
+                    if (raw[i] == '\n')
+                        next_line();
+                    else
+                        ++raw_column;
+                    ++i;
+                }
+                continue;
+            }
+        }
+        if (line_now == line && column_now == column) return {raw_line, raw_column, pos.source};
+        if (!literal && c == '\\' && i + 1 < end) {
+            const char n = raw[i + 1];
+            const std::size_t length = n == 'u' ? 6 : n == 'U' ? 10 : 2;
+            i += length;
+            raw_column += static_cast<std::uint32_t>(length);
+            if (n == 'n') {
+                ++line_now;
+                column_now = 1;
+            } else {
+                ++column_now;
+            }
+            continue;
+        }
+        if (c == '\n' || (c == '\r' && i + 1 < end && raw[i + 1] == '\n')) {
+            i += c == '\r' ? 2 : 1;
+            next_line();
+            ++line_now;
+            column_now = 1;
+            continue;
+        }
+        i += utf8_length(c);
+        ++raw_column;
+        ++column_now;
+    }
+    return {raw_line, raw_column, pos.source};  // past the end: the closing quote
+}
+
+std::string address_error(std::string_view text, const std::error_code& error) {
+    if (error == AddressError::word_out_of_range) {
+        // The area's prefix: what comes before the word's digits (after E<bank>_).
+        const auto underscore = text.find('_');
+        std::size_t digits = underscore == std::string_view::npos ? 0 : underscore + 1;
+        while (digits < text.size() && std::isdigit(static_cast<unsigned char>(text[digits])) == 0)
+            ++digits;
+        const std::string prefix(text.substr(0, digits));
+        if (auto area = parse_address(prefix + "0"))
+            return fmt::format("{} is out of range: {}0-{}{}", text, prefix, prefix,
+                               max_word(area->area));
+    }
+    if (error == AddressError::bit_out_of_range)
+        return fmt::format("{} is out of range: bits 00-15", text);
+    return fmt::format("\"{}\" is not an address: {}", text, error.message());
 }
 
 }  // namespace fins::scenario

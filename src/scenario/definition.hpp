@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
+#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -41,11 +43,25 @@ std::string_view value_type_name(ValueType type);
 unsigned value_words(ValueType type);
 
 // A string value of the file: an expression or an address, with where it starts (the
-// position of its opening quote).
+// position of its opening quote) and, when the loader has it, the value as written in
+// the file (`raw`: from its opening quote to its closing one, escapes undone by TOML).
 struct Text {
     std::string text;
     SourcePos pos;
+    std::string raw;
+
+    // Where character `column` of line `line` of `text` (1-based, counted in characters,
+    // not bytes) is in the file: through `raw` across a multi-line string's lines, its
+    // skipped first line break, escape sequences (\n, \t, \", \u00E9 ...) and
+    // line-ending backslashes; without `raw`, counted from the opening quote as if the
+    // value held no escapes.
+    [[nodiscard]] SourcePos position(std::uint32_t line, std::uint32_t column) const;
 };
+
+// The message for an address `text` that fins::parse_address refused with `error`: a
+// word, bit or bank beyond its area names the area's range ("D40000 is out of range:
+// D0-D32767").
+std::string address_error(std::string_view text, const std::error_code& error);
 
 enum class SignalKind : std::uint8_t {
     constant,     // value

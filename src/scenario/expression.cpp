@@ -8,6 +8,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "fins/error.hpp"
+#include "scenario/definition.hpp"
 #include "scenario/expression_eval.hpp"
 
 namespace fins::scenario {
@@ -65,7 +67,7 @@ class ExpressionParser {
         if (at_end()) return fail(pos_, "empty expression");
         if (!parse_or()) return std::nullopt;
         skip_space();
-        if (!at_end()) return fail(pos_, "unexpected '" + std::string(1, text_[pos_]) + "'");
+        if (!at_end()) return fail(pos_, unexpected(pos_));
         return std::move(out_);
     }
 
@@ -80,14 +82,23 @@ class ExpressionParser {
             if (text_[i] == '\n') {
                 ++line;
                 column = 1;
-            } else {
-                ++column;
+            } else if ((static_cast<unsigned char>(text_[i]) & 0xC0) != 0x80) {
+                ++column;  // characters, not bytes: a UTF-8 continuation byte is not one
             }
         }
         error_ = {line, column, std::move(message)};
         return std::nullopt;
     }
     [[nodiscard]] bool at_end() const { return pos_ >= text_.size(); }
+    // "unexpected character 'é'": the whole UTF-8 character at `at`, not its first byte.
+    [[nodiscard]] std::string unexpected(std::size_t at) const {
+        std::size_t end = at + 1;
+        if (static_cast<unsigned char>(text_[at]) >= 0xC0)
+            while (end < text_.size() && end < at + 4 &&
+                   (static_cast<unsigned char>(text_[end]) & 0xC0) == 0x80)
+                ++end;
+        return "unexpected character '" + std::string(text_.substr(at, end - at)) + "'";
+    }
     void skip_space() {
         while (!at_end() && std::isspace(static_cast<unsigned char>(text_[pos_])) != 0)
             ++pos_;
@@ -238,9 +249,12 @@ class ExpressionParser {
             return true;
         }
         if (std::isdigit(static_cast<unsigned char>(c)) != 0 || c == '.') return parse_number();
-        if (!is_name_start(c)) return error(start, "unexpected '" + std::string(1, c) + "'");
+        if (!is_name_start(c)) return error(start, unexpected(start));
         while (!at_end() && is_name_char(text_[pos_]))
             ++pos_;
+        // A name does not go on with a non-ASCII character (D1é): that character is wrong.
+        if (!at_end() && static_cast<unsigned char>(text_[pos_]) >= 0x80)
+            return error(pos_, unexpected(pos_));
         const std::string_view name = text_.substr(start, pos_ - start);
         skip_space();
         if (!at_end() && text_[pos_] == '(') return parse_call(name, start);
@@ -250,8 +264,12 @@ class ExpressionParser {
         if (name == "true") return emit(Op::number, 0, 0, 1.0);
         if (name == "false") return emit(Op::number, 0, 0, 0.0);
         auto address = parse_address(name);
-        if (!address)
+        if (!address) {
+            const auto e = address.error();
+            if (e == AddressError::word_out_of_range || e == AddressError::bit_out_of_range)
+                return error(start, address_error(name, e));
             return error(start, "'" + std::string(name) + "' is neither an address nor a name");
+        }
         std::string message;
         auto reference = resolve_(*address, message);
         if (!reference) return error(start, std::string(name) + ": " + message);

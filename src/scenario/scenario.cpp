@@ -18,14 +18,6 @@ tl::unexpected<CompileError> error(SourcePos pos, std::string message) {
     return tl::unexpected(CompileError{pos, std::move(message)});
 }
 
-// The position of column `column` of line `line` of a string value starting at `pos`
-// (the opening quote).
-SourcePos inside(SourcePos pos, std::uint32_t line, std::uint32_t column) {
-    if (pos.line == 0) return {line, column, pos.source};
-    if (line == 1) return {pos.line, pos.column + column, pos.source};
-    return {pos.line + line - 1, column, pos.source};
-}
-
 // Why IoMemory::locate refused an address, in words.
 std::string located_error(std::string_view text, const plc::Plc& plc, std::error_code ec) {
     if (ec == EndCode::read_only) return fmt::format("{} is in a read-only area", text);
@@ -112,7 +104,7 @@ struct Compiler {
         ExpressionError e;
         auto parsed = Expression::parse(
             text.text, [this](const Address& a, std::string& m) { return resolve(a, m); }, e);
-        if (!parsed) return error(inside(text.pos, e.line, e.column), e.message);
+        if (!parsed) return error(text.position(e.line, e.column), e.message);
         return parsed;
     }
 };
@@ -147,9 +139,7 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
     for (std::size_t i = 0; i < def.tags.size(); ++i) {
         const TagDef& t = def.tags[i];
         auto address = parse_address(t.address.text);
-        if (!address)
-            return error(t.address.pos, fmt::format("\"{}\" is not an address: {}", t.address.text,
-                                                    address.error().message()));
+        if (!address) return error(t.address.pos, address_error(t.address.text, address.error()));
         auto r = c.locate(*address, t.type, t.address.text, plc::Intent::write,
                           static_cast<std::int32_t>(i));
         if (!r) return error(t.address.pos, r.error());
@@ -236,9 +226,7 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
     }
     for (const auto& in : def.inputs) {
         auto address = parse_address(in.address.text);
-        if (!address)
-            return error(in.address.pos, fmt::format("\"{}\" is not an address: {}",
-                                                     in.address.text, address.error().message()));
+        if (!address) return error(in.address.pos, address_error(in.address.text, address.error()));
         for (const auto& known : c.addresses)
             if (known == *address)
                 return error(in.address.pos,
@@ -363,7 +351,12 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
                                  "fault = \"end_code\" needs the address of the area");
                 auto code = to_memory_address(*address, Access::word);
                 if (!code) return error(e.address.pos, code.error().message());
-                es.area_code = code->area_code;
+                const auto* segment = find_segment(code->area_code, code->word);
+                if (segment == nullptr)
+                    return error(e.address.pos,
+                                 fmt::format("{} is not in an I/O memory area", e.address.text));
+                es.region = segment->region;
+                es.em_bank = segment->em_bank;
                 if (e.end_code == 0) return error(e.pos, "end_code must not be 0000");
                 break;
             }
@@ -418,6 +411,11 @@ tl::expected<std::unique_ptr<Scenario>, CompileError> Scenario::compile(Scenario
 }
 
 Scenario::Impl::~Impl() {
+    // A battery event holding the battery low ends with its scenario (a reload).
+    if (plc != nullptr && std::any_of(events.begin(), events.end(), [](const EventState& e) {
+            return e.holding && e.def->fault == FaultKind::battery;
+        }))
+        plc->errors().set_battery_cause(plc::ErrorState::battery_cause_scenario, false, host_now);
     if (plc != nullptr && !def.loop_items.empty()) plc->loop_control().clear_sources(this);
 }
 

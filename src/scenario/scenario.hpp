@@ -43,6 +43,7 @@
 
 #include <tl/expected.hpp>
 
+#include "fins/memory_area.hpp"
 #include "plc/io_memory.hpp"
 #include "scenario/definition.hpp"
 
@@ -58,14 +59,26 @@ struct CompileError {
 };
 
 // Unit faults the transport applies (node offline, latency, drop fraction) and the
-// dispatcher-level end-code fault. Read by the sessions on the io thread that ticks.
+// dispatcher-level end-code faults. Read by the sessions on the io thread that ticks.
+// Each is the combination of every event holding it (an active event, or a unit fault
+// of duration 0, which stays): offline while any offline event is; latency and drop the
+// largest of the active ones; an end code per area, several areas at once.
 struct TransportFaults {
+    // An area whose memory area commands (01 01-01 05, words and bits) answer end_code.
+    // An area is a region of I/O memory (CIO, W, H, A, D, an EM bank, ...), whatever
+    // code (word, bit, forced) names it.
+    struct AreaFault {
+        Region region = Region::dm;
+        std::uint8_t em_bank = 0;
+        std::uint16_t end_code = 0;
+    };
     bool offline = false;
     std::uint32_t latency_ms = 0;
     double drop_fraction = 0.0;
-    // end_code != 0: memory area commands on this area answer it.
-    std::uint8_t area_code = 0;  // the word code of the area (0x82 = DM, ...)
-    std::uint16_t end_code = 0;
+    std::vector<AreaFault> areas;  // one per area; the newest event's end code on each
+
+    // The end code of the area holding `address` (0: none, or not an I/O memory address).
+    [[nodiscard]] std::uint16_t end_code_for(const MemoryAddress& address) const noexcept;
 };
 
 struct EventStatus {

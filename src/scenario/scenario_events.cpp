@@ -1,5 +1,6 @@
 // A scenario's events: value faults attach to their tag (applied in the tick), unit
 // faults change the CPU Unit or the transport faults (contract in scenario.hpp).
+#include <algorithm>
 #include <cmath>
 
 #include "scenario/scenario_impl.hpp"
@@ -38,45 +39,62 @@ void civil_date(std::int64_t days, std::int64_t& year, unsigned& month, unsigned
     year = static_cast<std::int64_t>(year_of_era) + era * 400 + (month <= 2 ? 1 : 0);
 }
 
+std::uint16_t fal_code(const EventDef& e) {
+    return static_cast<std::uint16_t>((e.fault == FaultKind::fal ? 0x4100 : 0xC100) + e.number);
+}
+
 }  // namespace
 
+// Overlapping events of one kind combine instead of undoing each other (docs/scenarios.md
+// "Faults"): every unit fault with an end (and the transport faults and battery of
+// duration 0, which stay) holds while in force, and what the CPU Unit or the transport
+// shows is worked out from every holder, never from the one event starting or ending.
 void Scenario::Impl::start_event(EventState& event) noexcept {
     const EventDef& e = *event.def;
     event.active = true;
     event.start = now_s;
+    event.started = ++event_starts;
     // A value fault of duration 0 lasts one tick; a unit fault of duration 0 stays.
     event.end = e.duration_s > 0 ? now_s + e.duration_s
                                  : (is_value_fault(e.fault) ? now_s + def.tick_s : -1);
+    const bool timed = event.end >= 0;
     auto& errors = plc->errors();
     switch (e.fault) {
         case FaultKind::stuck:
             event.capture = true;
             break;
         case FaultKind::fal:
-            errors.raise_fal(e.number, e.message, host_now);
+        case FaultKind::fals: {
+            const auto error_code = fal_code(e);
+            const EventState* other = other_holder(event);
+            // The first holder notes whether someone else (the ladder, the operator, an
+            // event of duration 0) raised the error already; the others inherit it.
+            event.foreign = other != nullptr ? other->foreign : errors.is_active(error_code);
+            if (e.fault == FaultKind::fal)
+                errors.raise_fal(e.number, e.message, host_now);
+            else
+                errors.raise_fals(e.number, e.message, host_now);
+            event.holding = timed;
             break;
-        case FaultKind::fals:
-            errors.raise_fals(e.number, e.message, host_now);
-            break;
+        }
         case FaultKind::battery:
-            errors.set_battery_low(true, host_now);
+            event.holding = true;
+            errors.set_battery_cause(plc::ErrorState::battery_cause_scenario, true, host_now);
             break;
-        case FaultKind::mode:
-            event.previous_mode = plc->mode();
+        case FaultKind::mode: {
+            // The mode to go back to is the one before the first of overlapping events.
+            const EventState* other = other_holder(event);
+            event.previous_mode = other != nullptr ? other->previous_mode : plc->mode();
             plc->change_mode(operating_mode(e.mode), host_now);
+            event.holding = timed;
             break;
+        }
         case FaultKind::end_code:
-            transport.area_code = event.area_code;
-            transport.end_code = e.end_code;
-            break;
         case FaultKind::offline:
-            transport.offline = true;
-            break;
         case FaultKind::latency:
-            transport.latency_ms = static_cast<std::uint32_t>(std::llround(e.value));
-            break;
         case FaultKind::drop:
-            transport.drop_fraction = e.value;
+            event.holding = true;
+            combine_faults();
             break;
         case FaultKind::clock_jump: {
             const std::int64_t c = plc->clock().civil(host_now) + std::llround(e.value);
@@ -100,42 +118,128 @@ void Scenario::Impl::start_event(EventState& event) noexcept {
         default:
             break;
     }
-    if (event.end < 0 && !is_value_fault(e.fault)) event.active = false;
+    if (!timed && !is_value_fault(e.fault)) event.active = false;
 }
 
 void Scenario::Impl::end_event(EventState& event) noexcept {
     const EventDef& e = *event.def;
     event.active = false;
+    const bool held = event.holding;
+    event.holding = false;
     auto& errors = plc->errors();
     switch (e.fault) {
         case FaultKind::fal:
-            errors.clear(static_cast<std::uint16_t>(0x4100 + e.number), host_now);
-            break;
         case FaultKind::fals:
-            errors.clear(static_cast<std::uint16_t>(0xC100 + e.number), host_now);
+            if (!held) break;
+            if (EventState* other = other_holder(event); other != nullptr) {
+                // The error stays with the others, and so does whose it was.
+                for (auto& o : events)
+                    if (o.holding && o.def->fault == e.fault && o.def->number == e.number)
+                        o.foreign = o.foreign || event.foreign;
+            } else if (!event.foreign) {
+                errors.clear(fal_code(e), host_now);
+            }
             break;
         case FaultKind::battery:
-            errors.set_battery_low(false, host_now);
+            if (!held) break;
+            if (other_holder(event) == nullptr)
+                errors.set_battery_cause(plc::ErrorState::battery_cause_scenario, false, host_now);
             break;
-        case FaultKind::mode:
-            plc->change_mode(event.previous_mode, host_now);
+        case FaultKind::mode: {
+            if (!held) break;
+            // The newest of the mode events still active sets the mode; after the last,
+            // the mode from before the first.
+            const EventState* newest = nullptr;
+            for (const auto& o : events)
+                if (o.holding && o.def->fault == FaultKind::mode &&
+                    (newest == nullptr || o.started > newest->started))
+                    newest = &o;
+            if (newest != nullptr) {
+                if (plc->mode() != operating_mode(newest->def->mode))
+                    plc->change_mode(operating_mode(newest->def->mode), host_now);
+            } else {
+                plc->change_mode(event.previous_mode, host_now);
+            }
             break;
+        }
         case FaultKind::end_code:
-            transport.area_code = 0;
-            transport.end_code = 0;
-            break;
         case FaultKind::offline:
-            transport.offline = false;
-            break;
         case FaultKind::latency:
-            transport.latency_ms = 0;
-            break;
         case FaultKind::drop:
-            transport.drop_fraction = 0;
+            combine_faults();
             break;
         default:
             break;
     }
+}
+
+void Scenario::Impl::combine_faults() noexcept {
+    transport.offline = false;
+    transport.latency_ms = 0;
+    transport.drop_fraction = 0;
+    transport.areas.clear();
+    // The newest holder's end code on each area: holders in the order they started.
+    std::uint64_t newest_area = 0;
+    for (const auto& event : events) {
+        if (!event.holding) continue;
+        const EventDef& e = *event.def;
+        switch (e.fault) {
+            case FaultKind::offline:
+                transport.offline = true;
+                break;
+            case FaultKind::latency:
+                transport.latency_ms = std::max(transport.latency_ms,
+                                                static_cast<std::uint32_t>(std::llround(e.value)));
+                break;
+            case FaultKind::drop:
+                transport.drop_fraction = std::max(transport.drop_fraction, e.value);
+                break;
+            case FaultKind::end_code:
+                newest_area = std::max(newest_area, event.started);
+                break;
+            default:
+                break;
+        }
+    }
+    if (newest_area == 0) return;
+    // Few areas and few holders: each holder in start order overwrites its area's code.
+    for (std::uint64_t from = 1; from <= newest_area;) {
+        const EventState* next = nullptr;
+        for (const auto& event : events)
+            if (event.holding && event.def->fault == FaultKind::end_code && event.started >= from &&
+                (next == nullptr || event.started < next->started))
+                next = &event;
+        if (next == nullptr) break;
+        auto it = std::find_if(transport.areas.begin(), transport.areas.end(),
+                               [next](const TransportFaults::AreaFault& a) {
+                                   return a.region == next->region && a.em_bank == next->em_bank;
+                               });
+        if (it == transport.areas.end())
+            transport.areas.push_back({next->region, next->em_bank, next->def->end_code});
+        else
+            it->end_code = next->def->end_code;
+        from = next->started + 1;
+    }
+}
+
+EventState* Scenario::Impl::other_holder(const EventState& event) noexcept {
+    const EventDef& e = *event.def;
+    for (auto& o : events) {
+        if (&o == &event || !o.holding || o.def->fault != e.fault) continue;
+        if ((e.fault == FaultKind::fal || e.fault == FaultKind::fals) && o.def->number != e.number)
+            continue;
+        return &o;
+    }
+    return nullptr;
+}
+
+std::uint16_t TransportFaults::end_code_for(const MemoryAddress& address) const noexcept {
+    if (areas.empty()) return 0;
+    const auto* segment = find_segment(address.area_code, address.word);
+    if (segment == nullptr) return 0;
+    for (const auto& a : areas)
+        if (a.region == segment->region && a.em_bank == segment->em_bank) return a.end_code;
+    return 0;
 }
 
 void Scenario::Impl::run_events() noexcept {

@@ -135,8 +135,18 @@ struct EventState {
     const EventDef* def = nullptr;
     std::string name;
     std::int32_t tag = -1;  // value faults
-    std::uint8_t area_code = 0;
+    // end_code: the area of its address.
+    Region region = Region::dm;
+    std::uint8_t em_bank = 0;
     bool active = false;
+    // Its unit fault is in force (combine_faults): from its start to its end, or for good
+    // when a unit fault of duration 0 stays. `started` orders the holders (the newest
+    // mode or end code wins); `foreign`: fal/fals/mode, the error was present (or the
+    // mode set) by someone else when the first holder started, so the last holder's end
+    // leaves it as it found it (the error stays; the mode goes back to `previous_mode`).
+    bool holding = false;
+    bool foreign = false;
+    std::uint64_t started = 0;
     double start = 0;        // when it started
     double end = 0;          // when it ends (active)
     double next_start = -1;  // -1: never
@@ -164,6 +174,7 @@ struct Scenario::Impl final : ExpressionContext {
     std::vector<EventState> events;
     Random random;
     TransportFaults transport;
+    std::uint64_t event_starts = 0;  // EventState::started
     std::uint64_t tick_count = 0;
     // The host second of the last write access record (end_tick).
     std::int64_t recorded_second = std::numeric_limits<std::int64_t>::min();
@@ -233,6 +244,11 @@ struct Scenario::Impl final : ExpressionContext {
     void run_events() noexcept;
     void start_event(EventState& event) noexcept;
     void end_event(EventState& event) noexcept;
+    // transport and the scenario's battery cause from every holding event
+    // (scenario_events.cpp).
+    void combine_faults() noexcept;
+    // Another event holding the same fault (fal/fals: the same number), or null.
+    EventState* other_holder(const EventState& event) noexcept;
     // The three phases of a tick (Scenario::begin_tick, compute, end_tick).
     void begin_tick() noexcept;
     void compute_tags() noexcept;

@@ -58,6 +58,28 @@ TEST(ScenarioConfig, BadScenariosExit2WithTheirPosition) {
          "bad.toml:5:11: ", "CIO0.00 is a bit"},
         {"[[scenario.loop]]\nblock = 1\naddress = \"D0\"\n",
          "bad.toml:1:1: ", "scenario.loop[0]: item: missing"},
+        // Positions inside a multi-line string, after escapes, in characters (issue 26).
+        {"[[scenario.link]]\naddress = \"D1\"\nexpr = \"\"\"\n2 * D100 +\n  Q5\"\"\"\n",
+         "bad.toml:5:3: ", "'Q5' is neither an address nor a name"},
+        {"[[scenario.link]]\naddress = \"D1\"\nexpr = \"1 +\\t\\tQ5\"\n",
+         "bad.toml:3:16: ", "'Q5' is neither an address nor a name"},
+        {"[[scenario.link]]\naddress = \"D1\"\nexpr = '1 + \\t Q5'\n",
+         "bad.toml:3:13: ", "unexpected character '\\'"},
+        {"[[scenario.link]]\naddress = \"D1\"\nexpr = \"2 * D2\xC3\xA9\"\n",
+         "bad.toml:3:15: ", "unexpected character '\xC3\xA9'"},
+        {"[[scenario.link]]\naddress = \"D1\"\nexpr = \"\\u00E9\\u00E9 + 1\"\n",
+         "bad.toml:3:9: ", "unexpected character '\xC3\xA9'"},
+        {"[[scenario.link]]\naddress = \"D1\"\nexpr = \"D40000 + 1\"\n",
+         "bad.toml:3:9: ", "D40000 is out of range: D0-D32767"},
+        {"[[scenario.signal]]\naddress = \"D40000\"\nkind = \"constant\"\n",
+         "bad.toml:2:11: ", "D40000 is out of range: D0-D32767"},
+        // duty: only for a square wave, a fraction 0-1.
+        {"[[scenario.signal]]\naddress = \"D0\"\nkind = \"sine\"\nduty = 0.2\n",
+         "bad.toml:4:1: ", "scenario.signal[0].duty: unknown key for kind = \"sine\""},
+        {"[[scenario.signal]]\naddress = \"D0\"\nkind = \"square\"\nduty = 1.5\n",
+         "bad.toml:4:8: ", "scenario.signal[0].duty: 1.5 is not a fraction 0-1"},
+        {"[[scenario.signal]]\naddress = \"D0\"\nkind = \"square\"\nduty = -0.1\n",
+         "bad.toml:4:8: ", "scenario.signal[0].duty: -0.1 is not a fraction 0-1"},
     };
     for (const auto& c : cases) {
         Finsd d({"--config", dir.write("bad.toml", c.text)});

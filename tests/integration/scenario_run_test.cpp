@@ -86,6 +86,15 @@ TEST(ScenarioRun, TankFillsWhileThePumpRunsAndDrainsThroughTheValve) {
     run_for(socket, 10);
     EXPECT_EQ(read_int16(*c, "D14"), frozen);
     EXPECT_NE(ctl(socket, {"scenario", "trigger", "no_such_event"}).exit_code, 0);
+
+    // `finsd ctl advance S` is `finsd ctl scenario advance S`.
+    const auto alias = ctl(socket, {"advance", "2.5"});
+    ASSERT_EQ(alias.exit_code, 0) << alias.err;
+    const Json advanced = Json::parse(alias.out, nullptr, false);
+    EXPECT_EQ(advanced["ok"], true) << alias.out;
+    EXPECT_EQ(advanced["ticks"], 25) << alias.out;
+    EXPECT_NEAR(advanced["time_s"].get<double>(), 112.5, 1e-6) << alias.out;
+    EXPECT_NE(ctl(socket, {"advance"}).exit_code, 0);  // SECONDS is required
 }
 
 TEST(ScenarioRun, ConveyorCountsBoxesAndJamsOnSchedule) {

@@ -98,6 +98,54 @@ tl::expected<void, std::string> ScenarioLoader::table(const toml::node& node,
     return {};
 }
 
+namespace {
+
+// The byte offset of (line, column) in `text`; toml++ counts columns in characters.
+std::size_t offset_of(std::string_view text, std::size_t line, std::size_t column) {
+    std::size_t at = 0;
+    for (std::size_t l = 1; l < line && at < text.size(); ++l) {
+        const auto nl = text.find('\n', at);
+        if (nl == std::string_view::npos) return text.size();
+        at = nl + 1;
+    }
+    for (std::size_t c = 1; c < column && at < text.size(); ++c) {
+        ++at;
+        while (at < text.size() && (static_cast<unsigned char>(text[at]) & 0xC0) == 0x80)
+            ++at;
+    }
+    return at;
+}
+
+}  // namespace
+
+std::string ScenarioLoader::read_text(std::string_view file) {
+    std::ifstream in{std::filesystem::path(file), std::ios::binary};
+    if (!in) return {};
+    std::ostringstream text;
+    text << in.rdbuf();
+    return std::move(text).str();
+}
+
+std::string ScenarioLoader::raw(const toml::source_region& r) const {
+    if (text_.empty() || r.begin.line == 0) return {};
+    const std::size_t begin = offset_of(text_, r.begin.line, r.begin.column);
+    if (begin >= text_.size()) return {};
+    const char quote = text_[begin];
+    if (quote != '"' && quote != '\'') return {};
+    const std::string delimiter(text_.compare(begin, 3, std::string(3, quote)) == 0 ? 3 : 1, quote);
+    // Up to the closing delimiter (a basic string's \" does not close it).
+    for (std::size_t i = begin + delimiter.size(); i < text_.size(); ++i) {
+        if (quote == '"' && text_[i] == '\\') {
+            ++i;
+            continue;
+        }
+        if (text_.compare(i, delimiter.size(), delimiter) == 0)
+            return text_.substr(begin, i + delimiter.size() - begin);
+        if (delimiter.size() == 1 && text_[i] == '\n') break;
+    }
+    return {};
+}
+
 tl::expected<toml::table, std::string> ScenarioLoader::parse_file(
     const std::filesystem::path& file) {
     std::ifstream in(file, std::ios::binary);
@@ -154,9 +202,10 @@ tl::expected<ScenarioConfig, std::string> load_scenario_text(std::string_view te
                 fmt::format("{}:{}:{}: {}: unknown key (a scenario holds a "
                             "[scenario] table)",
                             source, key.source().begin.line, key.source().begin.column, key.str()));
-    auto config = load_scenario_table(*node, source, "scenario");
+    ScenarioConfig config;
+    ScenarioLoader loader(config, source, text);
+    if (auto r = loader.table(*node, "scenario", true); !r) return tl::unexpected(r.error());
     // Nothing to read again: reload answers that the scenario came from no file.
-    if (config) config->reload_file.clear();
     return config;
 }
 

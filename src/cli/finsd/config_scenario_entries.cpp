@@ -18,11 +18,12 @@ std::vector<std::string_view> kind_keys(SignalKind kind) {
     switch (kind) {
         case SignalKind::constant:
             return {"value"};
-        case SignalKind::sine:
         case SignalKind::square:
+            return {"min", "max", "period_s", "phase_s", "duty"};
+        case SignalKind::sine:
         case SignalKind::triangle:
         case SignalKind::sawtooth:
-            return {"min", "max", "period_s", "phase_s", "duty"};
+            return {"min", "max", "period_s", "phase_s"};
         case SignalKind::ramp:
             return {"min", "max", "period_s", "repeat"};
         case SignalKind::random_walk:
@@ -124,9 +125,12 @@ tl::expected<void, std::string> ScenarioLoader::tag(const toml::table& t, const 
                 d.period_s = *n;
             else if (k == "phase_s")
                 d.phase_s = *n;
-            else if (k == "duty")
+            else if (k == "duty") {
+                // The fraction of each period at max: 0 (always min) to 1 (always max).
+                if (!(*n >= 0 && *n <= 1))
+                    return fail(v, p, fmt::format("{} is not a fraction 0-1", *n));
                 d.duty = *n;
-            else if (k == "step")
+            } else if (k == "step")
                 d.step = *n;
             else if (k == "rate")
                 d.rate = *n;

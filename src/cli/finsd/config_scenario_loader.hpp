@@ -23,8 +23,13 @@ class ScenarioLoader {
     using Unexpected = tl::unexpected<std::string>;
 
   public:
-    ScenarioLoader(ScenarioConfig& out, std::string_view source)
-        : out_(out), source_(source), index_(static_cast<std::uint32_t>(out.sources.size())) {
+    // `text`: the source's TOML text, for positions inside string values (Text::raw);
+    // empty: read from the file `source` when there is one.
+    ScenarioLoader(ScenarioConfig& out, std::string_view source, std::string_view text = {})
+        : out_(out),
+          source_(source),
+          index_(static_cast<std::uint32_t>(out.sources.size())),
+          text_(text.empty() ? read_text(source) : std::string(text)) {
         out_.sources.emplace_back(source);
     }
 
@@ -77,8 +82,11 @@ class ScenarioLoader {
         auto s = text(v, p);
         if (!s) return tl::unexpected(s.error());
         if (s->empty()) return fail(v, p, "must not be empty");
-        return scenario::Text{*s, pos(v.source())};
+        return scenario::Text{*s, pos(v.source()), raw(v.source())};
     }
+    // The file's text of region `r` (a string value, quotes included); "" when unknown.
+    [[nodiscard]] std::string raw(const toml::source_region& r) const;
+    static std::string read_text(std::string_view file);
     tl::expected<scenario::ValueType, std::string> value_type(const toml::node& v,
                                                               const std::string& p) const {
         auto s = text(v, p);
@@ -103,6 +111,7 @@ class ScenarioLoader {
     ScenarioConfig& out_;
     std::string source_;
     std::uint32_t index_;
+    std::string text_;
 };
 
 }  // namespace fins::cli::finsd

@@ -21,6 +21,7 @@
 //                                   own exit codes)
 //   scenario status|pause|resume|advance SECONDS|trigger EVENT|reload
 //                                   the CPU Unit's scenario (ctl_scenario.hpp)
+//   advance SECONDS                 alias of scenario advance SECONDS
 //
 // Exit codes: 0 the server answered "ok"; 2 usage error or the server refused the
 // request (its message on stderr); 3 cannot connect, or no answer within 5 s.

@@ -31,6 +31,12 @@ void add_scenario_verbs(CLI::App& app, nlohmann::json& request) {
     trigger->callback([&request, event] {
         request = {{"cmd", "scenario"}, {"action", "trigger"}, {"event", *event}};
     });
+    // `finsd ctl advance S`: an alias of `scenario advance S`, the same request.
+    auto* alias = app.add_subcommand("advance", "Alias of `scenario advance SECONDS`");
+    alias->add_option("seconds", *seconds, "Scenario seconds, e.g. 2.5")->required();
+    alias->callback([&request, seconds] {
+        request = {{"cmd", "scenario"}, {"action", "advance"}, {"seconds", *seconds}};
+    });
 }
 
 }  // namespace fins::cli

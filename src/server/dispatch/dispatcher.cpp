@@ -139,13 +139,55 @@ std::size_t Dispatcher::handle(Bytes request, MutableBytes out, const RequestCon
     return run(reply, *info, *entry, decoded->parameters, context);
 }
 
-// A scenario's end code for an area (memory area commands name the area in their first
-// parameter byte) and its latency (the answer leaves through the session's deferred path).
+namespace {
+
+// The 4-byte I/O memory address at `at` of `parameters` (W342 5-2-1); false past the end.
+bool address_at(Bytes parameters, std::size_t at, MemoryAddress& address) noexcept {
+    if (parameters.size() < at + memory_address_size) return false;
+    address.area_code = parameters[at];
+    address.word = static_cast<std::uint16_t>(parameters[at + 1] << 8 | parameters[at + 2]);
+    address.bit = parameters[at + 3];
+    return true;
+}
+
+// A scenario's end code for the memory area command `sub` (01 01-01 05) when any address
+// it names is in a faulted area: the start of 01 01/02/03, each element of 01 04, the
+// source and the destination of 01 05. 0: none.
+std::uint16_t memory_area_fault(const FaultHook& faults, std::uint8_t sub,
+                                Bytes parameters) noexcept {
+    MemoryAddress address;
+    std::uint16_t code = 0;
+    switch (sub) {
+        case 0x01:
+        case 0x02:
+        case 0x03:
+            if (address_at(parameters, 0, address)) code = faults.area_end_code(address);
+            break;
+        case 0x04:
+            for (std::size_t at = 0; code == 0 && address_at(parameters, at, address);
+                 at += memory_address_size)
+                code = faults.area_end_code(address);
+            break;
+        case 0x05:
+            if (address_at(parameters, 0, address)) code = faults.area_end_code(address);
+            if (code == 0 && address_at(parameters, memory_address_size, address))
+                code = faults.area_end_code(address);
+            break;
+        default:
+            break;
+    }
+    return code;
+}
+
+}  // namespace
+
+// A scenario's end code for an area (memory_area_fault) and its latency (the answer
+// leaves through the session's deferred path).
 std::size_t Dispatcher::run_with_faults(Reply& reply, const CommandInfo& info,
                                         const handlers::HandlerEntry& entry, Bytes parameters,
                                         const RequestContext& context) {
-    if (reply.command.main == 0x01 && !parameters.empty())
-        if (const auto code = faults_->area_end_code(parameters[0]); code != 0)
+    if (reply.command.main == 0x01)
+        if (const auto code = memory_area_fault(*faults_, reply.command.sub, parameters); code != 0)
             return reply.answer(static_cast<EndCode>(code));
     const std::size_t n = run(reply, info, entry, parameters, context);
     if (n == 0 || faults_->latency().count() <= 0 || context.reply_path == nullptr) return n;

@@ -198,9 +198,8 @@ bool ScenarioRunner::silent() noexcept {
     return f.drop_fraction > 0 && drops_.uniform() < f.drop_fraction;
 }
 
-std::uint16_t ScenarioRunner::area_end_code(std::uint8_t area_code) const noexcept {
-    const auto& f = scenario_->transport();
-    return f.end_code != 0 && f.area_code == area_code ? f.end_code : 0;
+std::uint16_t ScenarioRunner::area_end_code(const MemoryAddress& address) const noexcept {
+    return scenario_->transport().end_code_for(address);
 }
 
 std::chrono::milliseconds ScenarioRunner::latency() const noexcept {

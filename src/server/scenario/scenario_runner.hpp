@@ -91,7 +91,7 @@ class ScenarioRunner final : public ScenarioControl,
     // FaultHook
     [[nodiscard]] bool offline() const noexcept override;
     bool silent() noexcept override;
-    [[nodiscard]] std::uint16_t area_end_code(std::uint8_t area_code) const noexcept override;
+    [[nodiscard]] std::uint16_t area_end_code(const MemoryAddress& address) const noexcept override;
     [[nodiscard]] std::chrono::milliseconds latency() const noexcept override;
     void send_later(Bytes response, Completion completion) override;
 
