@@ -36,6 +36,10 @@ set(CPACK_PACKAGE_VENDOR finskit)
 set(CPACK_PACKAGE_CONTACT "finskit maintainers <finskit-maintainers@example.org>")
 set(CPACK_DEB_COMPONENT_INSTALL ON)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
+# A cross build's packages are for its target (dpkg's name for the architecture).
+if(CMAKE_CROSSCOMPILING AND CMAKE_SYSTEM_PROCESSOR STREQUAL aarch64)
+  set(CPACK_DEBIAN_PACKAGE_ARCHITECTURE arm64)
+endif()
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
 set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION ON)
 # Debian policy 10.1-10.2 (lintian errors otherwise): stripped binaries, a shlibs file

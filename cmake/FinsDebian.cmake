@@ -42,6 +42,19 @@ if(FINS_MAN)
     message(FATAL_ERROR "FINS_MAN needs help2man (apt install help2man)")
   endif()
   set(fins_man_pages)
+  # help2man runs each program from PATH: the build's bin/, or in a cross build (arm64)
+  # wrappers that run them under the emulator (qemu-user), so the pages are the same.
+  set(fins_man_run_dir ${CMAKE_RUNTIME_OUTPUT_DIRECTORY})
+  if(CMAKE_CROSSCOMPILING_EMULATOR)
+    set(fins_man_run_dir ${PROJECT_BINARY_DIR}/emulated)
+    string(JOIN " " fins_emulator ${CMAKE_CROSSCOMPILING_EMULATOR})
+    foreach(program fins finsd fins-bridge)
+      file(GENERATE OUTPUT ${fins_man_run_dir}/${program}
+        CONTENT "#!/bin/sh\nexec ${fins_emulator} $<TARGET_FILE:${program}> \"$@\"\n"
+        FILE_PERMISSIONS OWNER_READ OWNER_WRITE OWNER_EXECUTE GROUP_READ GROUP_EXECUTE
+                         WORLD_READ WORLD_EXECUTE)
+    endforeach()
+  endif()
   foreach(page fins:1 finsd:8)
     string(REPLACE ":" ";" page ${page})
     list(GET page 0 program)
@@ -50,7 +63,7 @@ if(FINS_MAN)
     # Run from PATH so the usage line says "fins", not the build tree's path.
     add_custom_command(OUTPUT ${out}.gz
       COMMAND ${CMAKE_COMMAND} -E make_directory ${PROJECT_BINARY_DIR}/man
-      COMMAND ${CMAKE_COMMAND} -E env PATH=$<TARGET_FILE_DIR:${program}>:$ENV{PATH}
+      COMMAND ${CMAKE_COMMAND} -E env PATH=${fins_man_run_dir}:$ENV{PATH}
               ${FINS_HELP2MAN} --no-info --section ${section} --version-option=--version
               --include ${PROJECT_SOURCE_DIR}/packaging/man/${program}.h2m --output ${out}
               ${program}

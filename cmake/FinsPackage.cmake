@@ -98,11 +98,14 @@ endif()
 # The finskit Python module (python/): on by default when pybind11 and the Python
 # headers are found, off in sanitizer and fuzz builds (an instrumented extension cannot
 # be loaded into an uninstrumented interpreter).
-find_package(Python3 3.9 QUIET COMPONENTS Interpreter Development.Module)
-find_package(pybind11 CONFIG QUIET)
+# A cross build (arm64, Windows) leaves it out: the host's interpreter cannot load it.
 set(fins_python_default OFF)
-if(Python3_FOUND AND pybind11_FOUND AND NOT FINS_SANITIZE AND NOT FINS_FUZZ)
-  set(fins_python_default ON)
+if(NOT CMAKE_CROSSCOMPILING AND NOT FINS_SANITIZE AND NOT FINS_FUZZ)
+  find_package(Python3 3.9 QUIET COMPONENTS Interpreter Development.Module)
+  find_package(pybind11 CONFIG QUIET)
+  if(Python3_FOUND AND pybind11_FOUND)
+    set(fins_python_default ON)
+  endif()
 endif()
 option(FINS_PYTHON "Build the finskit Python module (pybind11)" ${fins_python_default})
 if(FINS_PYTHON)

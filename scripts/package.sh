@@ -7,10 +7,22 @@
 #            also installs the .deb with apt, starts finsd from the installed files with
 #            the unit's ExecStart line (no systemd needed), reads and writes through the
 #            installed fins, and purges the package (needs root: CI).
+#        scripts/package.sh arm64
+#            the arm64 .debs (finskit, libfins0.1, libfins-dev; no python3-finskit: the
+#            module is built for the host's interpreter) from the cross tree build-arm64
+#            (scripts/build.sh arm64, docs/platforms.md), man pages made under qemu-user.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build="$root/build-pkg"
 jobs=${FINS_JOBS:-$(nproc)}
+if [[ "${1:-}" == arm64 ]]; then
+  # One arm64 tree for the tests and the packages: everything it builds, then CPack.
+  "$root/scripts/build.sh" arm64 all
+  rm -f "$root"/build-arm64/*.deb
+  (cd "$root/build-arm64" && cpack -G DEB >/dev/null)
+  printf 'package: %s\n' "$root"/build-arm64/*.deb
+  exit 0
+fi
 # No tests, benchmarks or in-tree examples: the ASan tree builds those, consumers.sh the
 # examples against the install.
 args=(-DCMAKE_BUILD_TYPE=Release -DCMAKE_INSTALL_PREFIX=/usr -DFINS_TESTS=OFF -DFINS_BENCH=OFF

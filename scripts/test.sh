@@ -5,7 +5,10 @@
 #   2. a short soak of the ASan+UBSan finsd (scripts/soak.sh: verifying UDP and TCP
 #      clients, garbage datagrams, connection churn; counts as one test);
 #   3. the libFuzzer targets over every decoder, the dispatcher and a whole session,
-#      briefly each, from the committed corpus (fuzz/corpus/).
+#      briefly each, from the committed corpus (fuzz/corpus/);
+#   4. the Linux arm64 cross build: its unit tests and a round trip under qemu-user, and
+#      its .debs (docs/platforms.md);
+#   5. the installable package: Release tree, consumers, Python tests, the .deb.
 # (One instrumented build instead of a Release one and an instrumented one keeps the
 # suite inside its time budget on 2 cores; scripts/run.sh builds Release.)
 set -euo pipefail
@@ -60,6 +63,19 @@ for target in "${fuzzers[@]}"; do
 done
 summary+=("fuzz: $fuzz_ok targets ran clean")
 
+# ---- issue 28: Linux arm64 (docs/platforms.md). The cross tree's unit tests and a
+# finsd/fins/fins-bridge round trip under qemu-aarch64, then its .debs, checked.
+echo "== arm64: cross build, tests under qemu-user"
+"$root/scripts/build.sh" arm64
+run_ctest build-arm64 arm64
+echo "== arm64: packages"
+"$root/scripts/package.sh" arm64
+log=$(mktemp)
+"$root/scripts/package_check_arm64.sh" "$root"/build-arm64/*.deb | tee "$log"
+arm64_packages=$(grep -Eo 'arm64 packages: [0-9]+ checks passed' "$log" | grep -Eo '[0-9]+')
+summary+=("arm64 packages: $arm64_packages checks passed")
+rm -f "$log"
+
 # ---- issue 11: the installable package. A Release tree (build-pkg, prefix /usr) with
 # libfins, finsd, fins, the examples, the finskit Python module and the API reference
 # (Doxygen, warnings as errors); consumers built against it installed in a temporary
@@ -92,4 +108,5 @@ rm -f "$log"
 echo "== summary"
 printf '%s\n' "${summary[@]}"
 asan_total=$(ctest --test-dir build-asan -N | grep -Eo 'Total Tests: [0-9]+' | grep -Eo '[0-9]+')
-echo "$((asan_total + soak_ok + fuzz_ok + ${package_passed:-0})) passed, 0 failed"
+arm64_total=$(ctest --test-dir build-arm64 -N | grep -Eo 'Total Tests: [0-9]+' | grep -Eo '[0-9]+')
+echo "$((asan_total + soak_ok + fuzz_ok + arm64_total + arm64_packages + ${package_passed:-0})) passed, 0 failed"
