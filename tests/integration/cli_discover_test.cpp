@@ -92,6 +92,14 @@ TEST_F(CliDiscover, NobodyAnsweringExits3) {
     EXPECT_NE(r.err.find("discover 127.0.0.6-8"), std::string::npos) << r.err;
 }
 
+TEST_F(CliDiscover, Newcomer13_NobodyAnsweringWithJsonPrintsAnEmptyListAndExits3) {
+    const auto doc = discover_json({"--hosts", "127.0.0.6-8", "--retries", "0"}, 3);
+    EXPECT_EQ(doc["hosts"], 3) << doc.dump();
+    ASSERT_TRUE(doc["nodes"].is_array()) << doc.dump();
+    EXPECT_TRUE(doc["nodes"].empty()) << doc.dump();
+    EXPECT_EQ(doc["port"], std::stoi(port_));
+}
+
 TEST_F(CliDiscover, BadOrOversizedRangesAreUsageErrors) {
     for (const auto& hosts : {"10.0.0.0/16", "10.0.0.0/21", "127.0.0.9-3", "127.0.0.1-300",
                               "127.0.0", "example.com", "127.0.0.1/33", "10.0.0.0-10.0.8.0", ""}) {

@@ -265,7 +265,14 @@ int run_discover(const GlobalOptions& g, const DiscoverArgs& a, Output& out) {
                             t.version.empty() ? "-" : t.version);
     }
     const auto context = fmt::format("discover {} (UDP port {})", a.hosts, g.port);
-    if (answered == 0) return out.failure(make_error_code(ClientError::timeout), context);
+    if (answered == 0) {
+        // Nobody answered is a result a script reads like any other (an empty list),
+        // with exit 3 and the reason on stderr.
+        if (!out.json()) return out.failure(make_error_code(ClientError::timeout), context);
+        out.print({{"port", g.port}, {"hosts", targets.size()}, {"nodes", nodes}}, text);
+        fmt::print(stderr, "fins: {}: no node answered\n", context);
+        return exit_transport;
+    }
     text += fmt::format("{} of {} answered (UDP port {})\n", answered,
                         plural(targets.size(), "host"), g.port);
     out.print({{"port", g.port}, {"hosts", targets.size()}, {"nodes", nodes}}, text);
