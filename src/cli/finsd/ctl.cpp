@@ -1,7 +1,8 @@
 // `finsd ctl [--socket PATH] [--plc NAME|NET.NODE] VERB ...` (options before or after the
 // verb): sends one request to a running finsd's control channel (server/control/control.hpp)
 // and prints the answer line. Without --socket: $FINSD_SOCKET, else the first of the default
-// places finsd itself uses that holds a socket (control_setup.hpp). --plc picks a CPU Unit of a plant (default the first).
+// places finsd itself uses that holds a socket (control_setup.hpp). --plc picks a CPU Unit of a
+// plant (default the first).
 //
 //   status                          the JSON snapshot
 //   battery-error on|off            low battery (error 00F7) / battery replaced
