@@ -72,7 +72,7 @@ echo "== arm64: packages"
 "$root/scripts/package.sh" arm64
 log=$(mktemp)
 "$root/scripts/package_check_arm64.sh" "$root"/build-arm64/*.deb | tee "$log"
-arm64_packages=$(grep -Eo 'arm64 packages: [0-9]+ checks passed' "$log" | grep -Eo '[0-9]+')
+arm64_packages=$(sed -n 's/^arm64 packages: \([0-9]*\) checks passed$/\1/p' "$log")
 summary+=("arm64 packages: $arm64_packages checks passed")
 rm -f "$log"
 
