@@ -96,9 +96,8 @@ std::optional<std::string> send_request(const std::string& path, const std::stri
     }
     std::string answer;
     const auto deadline =
-        std::chrono::steady_clock::now() +
-        std::max(wait.value_or(std::chrono::milliseconds(0)),
-                 std::chrono::milliseconds(answer_timeout_ms));
+        std::chrono::steady_clock::now() + std::max(wait.value_or(std::chrono::milliseconds(0)),
+                                                    std::chrono::milliseconds(answer_timeout_ms));
     while (answer.size() < max_answer_size) {
         const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
             deadline - std::chrono::steady_clock::now());
@@ -262,11 +261,12 @@ int run_ctl(int argc, char** argv) {
     }
     // A scenario advance answers when its ticks have run (finsd serves FINS requests
     // meanwhile): a day at 1 ms takes a while, so no fixed limit.
-    const bool advance = !raw_line && request.is_object() && request.value("cmd", "") == "scenario" &&
+    const bool advance = !raw_line && request.is_object() &&
+                         request.value("cmd", "") == "scenario" &&
                          request.value("action", "") == "advance";
-    const auto answer = send_request(socket, line,
-                                     advance ? std::nullopt
-                                             : std::optional<std::chrono::milliseconds>(verbs.wait));
+    const auto answer =
+        send_request(socket, line,
+                     advance ? std::nullopt : std::optional<std::chrono::milliseconds>(verbs.wait));
     if (!answer) return exit_io;
     const Json doc = Json::parse(*answer, nullptr, false);
     const bool instruction =

@@ -86,10 +86,12 @@ void dispatch_unguarded(std::span<const ControlTarget> targets, const Json& j,
         if (handle_instruction_request(target->instructions, target->schedule, j, reply)) return;
         // A scenario verb may answer later (an advance runs in slices).
         if (j["cmd"] == "scenario") {
-            return handle_scenario_request(target->scenario, j, [reply, name = target->name](Json a) {
-                if (!name.empty() && a.contains("status")) a["status"]["plc"] = name;
-                reply(std::move(a));
-            });
+            return handle_scenario_request(target->scenario, j,
+                                           [reply, name = target->name](Json a) {
+                                               if (!name.empty() && a.contains("status"))
+                                                   a["status"]["plc"] = name;
+                                               reply(std::move(a));
+                                           });
         }
         answer = handle_control_request(*target->plc, j);
     } catch (const Json::exception& e) {

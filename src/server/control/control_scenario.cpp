@@ -86,9 +86,9 @@ Json handle_scenario_request(ScenarioControl* scenario, const Json& j) {
     if (action == "status")
         return Json{{"ok", true}, {"scenario", status_json(scenario->run_status())}};
     // While an advance runs in slices, the verbs that change the run wait for its answer.
-    if (const auto why = scenario->busy(); !why.empty() &&
-        (action == "pause" || action == "resume" || action == "advance" ||
-         action == "trigger" || action == "reload"))
+    if (const auto why = scenario->busy();
+        !why.empty() && (action == "pause" || action == "resume" || action == "advance" ||
+                         action == "trigger" || action == "reload"))
         return control_error(why);
     if (action == "pause") {
         scenario->pause();

@@ -5,8 +5,8 @@
 #include <cmath>
 
 #include <fmt/core.h>
-#include <boost/asio/post.hpp>
 #include <spdlog/spdlog.h>
+#include <boost/asio/post.hpp>
 
 namespace fins::server {
 

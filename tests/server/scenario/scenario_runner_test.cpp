@@ -12,10 +12,10 @@
 #include <memory>
 #include <string>
 
-#include <boost/asio/post.hpp>
-#include <nlohmann/json.hpp>
 #include <spdlog/sinks/ringbuffer_sink.h>
 #include <spdlog/spdlog.h>
+#include <boost/asio/post.hpp>
+#include <nlohmann/json.hpp>
 
 #include "plc/plc.hpp"
 #include "scenario/scenario.hpp"
@@ -146,10 +146,9 @@ TEST(ScenarioRunner, FallingBehindRealTimeIsCountedAndLoggedOnce) {
               1);
     runner.run_due(t0 + 63s);  // a minute later: said again, with the total
     lines = sink->last_formatted();
-    EXPECT_EQ(std::count_if(lines.begin(), lines.end(),
-                            [](const std::string& l) {
-                                return l.find("falls behind") != std::string::npos;
-                            }),
+    EXPECT_EQ(std::count_if(
+                  lines.begin(), lines.end(),
+                  [](const std::string& l) { return l.find("falls behind") != std::string::npos; }),
               2);
     // The control status carries it.
     const Json status = handle_scenario_request(&runner, Json{{"action", "status"}});
@@ -177,7 +176,8 @@ TEST(ScenarioRunner, AnAdvanceRunsInSlicesAndGivesTheMemoryOfOnePiece) {
     const Json st = handle_scenario_request(&runner, Json{{"action", "status"}});
     EXPECT_EQ(st["scenario"]["advancing"]["ticks"], 600'000);
     for (const char* verb : {"pause", "resume", "reload", "trigger"}) {
-        const Json refused = handle_scenario_request(&runner, Json{{"action", verb}, {"event", "x"}});
+        const Json refused =
+            handle_scenario_request(&runner, Json{{"action", verb}, {"event", "x"}});
         EXPECT_NE(refused.value("error", "").find("an advance is running"), std::string::npos)
             << verb << ": " << refused.dump();
     }
