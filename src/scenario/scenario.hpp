@@ -3,25 +3,33 @@
 // glue (src/server/scenario) calls tick() from a steady timer, or advance() for virtual
 // time, and passes the host time only for what the CPU Unit stamps (error log, clock).
 //
-// One tick at scenario time t = ticks() * tick_s, in three phases:
+// Time: memory holds the tags at scenario time t = ticks() * tick_s. start() computes
+// them at the start time (0) without moving it; each tick then moves time one tick on
+// and computes at the new time. tick(), begin_tick() and advance() start a scenario that
+// was not started first.
+//
+// One tick, in three phases:
 //   begin_tick (on the thread that owns the CPU Unit):
-//     1. events whose start time has come start (value faults attach to their tag, unit
-//        faults change the CPU Unit or transport()); events whose duration ran out end;
+//     1. time moves to t = (ticks() + 1) * tick_s; events whose duration ran out by t end
+//        (an event is in force for at_s <= t < at_s + duration_s), events whose start
+//        time has come start (value faults attach to their tag, unit faults change the
+//        CPU Unit or transport());
 //     2. the words the tags read and write are copied into the scenario's image, with
 //        their forced-bit masks (the CPU Unit's input refresh);
 //   compute (on any thread, when offloadable(): it touches the image and the
 //   scenario's own state only, never the CPU Unit):
 //     3. every tag, in dependency order (a tag after the tags its expressions read; a
-//        cycle is a compile error), computes its value and writes it on the image the
-//        way a FINS 01 02 write does: a forced bit keeps its forced state, exactly as a
-//        ladder program cannot override it;
+//        cycle is a compile error), computes its value at t and writes it on the image
+//        the way a FINS 01 02 write does: a forced bit keeps its forced state, exactly as
+//        a ladder program cannot override it. Stateful kinds integrate over the tick that
+//        just ended (t - tick_s to t, their input read at t); a tag with `when` has its
+//        own clock, the ticks that ended with its `when` holding;
 //   end_tick (on the owning thread again):
 //     4. the words the tick changed are copied to memory (the output refresh), forced
 //        bits kept; a word a client wrote since begin_tick keeps the client's value, and
 //        a stateful tag adopts it on the next tick;
 //     5. when anything was written, the FINS write access log gets one record from node
-//        0.0.0 (the CPU Unit itself), so a client sees that the scenario wrote;
-//     6. events whose duration ends at the new time end.
+//        0.0.0 (the CPU Unit itself), so a client sees that the scenario wrote.
 // tick() runs the three back to back. Words the image cannot hold (timers' and counters'
 // completion flags, EM banks by number) are read and written through IoMemory during
 // compute; a scenario with such a tag is not offloadable().
@@ -106,6 +114,18 @@ class Scenario {
     Scenario& operator=(const Scenario&) = delete;
 
     [[nodiscard]] const ScenarioDef& definition() const noexcept;
+    // Computes the tags at the current time (0) without moving it, once: memory holds
+    // f(0) before any tick. Later calls do nothing.
+    void start(plc::TimePoint now) noexcept;
+    [[nodiscard]] bool started() const noexcept;
+    // For a scenario replacing `previous` (a reload), before its start(): it goes on at
+    // previous's time (the same tick count with the same tick_s, else that time rounded
+    // down to a whole tick), its start() computes the tags at that time with stateful
+    // tags going on from the value memory holds, a `when` clock goes on for the tag of
+    // the same address, and events are placed at that time: a one-shot event whose start
+    // is past is not replayed, an every_s event next starts at its first time at or after
+    // it. Nothing when this one started or `previous` did not.
+    void continue_from(const Scenario& previous) noexcept;
     // One tick of tick_s. `now` stamps what the CPU Unit records (error log, clock jump).
     void tick(plc::TimePoint now) noexcept;
     // tick() in its three phases, for a caller that computes on another thread: between
@@ -118,6 +138,10 @@ class Scenario {
     // Runs the whole ticks that fit in `seconds` (plus what earlier calls left over);
     // returns how many ran.
     std::uint64_t advance(double seconds, plc::TimePoint now) noexcept;
+    // advance() without running them: the whole ticks that fit in `seconds` (plus what
+    // earlier calls left over), the rest kept for the next call. A caller running them
+    // in slices calls tick() that many times: the same memory as advance().
+    [[nodiscard]] std::uint64_t plan_advance(double seconds) noexcept;
     // Starts the event named `name` now (its duration from now). False: no such event.
     bool trigger(std::string_view name, plc::TimePoint now) noexcept;
 

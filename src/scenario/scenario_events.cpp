@@ -261,7 +261,9 @@ bool Scenario::trigger(std::string_view name, plc::TimePoint now) noexcept {
     for (auto& event : impl_->events) {
         if (event.name != name) continue;
         impl_->host_now = now;
-        impl_->now_s = time();
+        // Memory holds the tags at time(): a unit fault starts now, a value fault at the
+        // next tick, the first that computes with it (its duration counts from there).
+        impl_->now_s = time() + (is_value_fault(event.def->fault) ? impl_->def.tick_s : 0.0);
         if (event.active) impl_->end_event(event);
         impl_->start_event(event);
         return true;

@@ -129,6 +129,10 @@ struct TagCold {
     std::vector<double> delay;    // ring of delay_s / tick_s samples
     std::size_t delay_next = 0;
     std::vector<std::uint32_t> faults;  // events that may fault this tag
+    // The tag's own clock (TagState::has_when): the ticks that ended with its `when`
+    // holding. A time-based kind (sine ... ramp, steps) is computed at active_ticks x
+    // tick_s, so it does not advance while off.
+    std::uint64_t active_ticks = 0;
 };
 
 struct EventState {
@@ -176,6 +180,14 @@ struct Scenario::Impl final : ExpressionContext {
     TransportFaults transport;
     std::uint64_t event_starts = 0;  // EventState::started
     std::uint64_t tick_count = 0;
+    // Memory holds the tags at tick_count x tick_s once started (start_refresh computed
+    // them at the start time); `elapsed`: the tick being computed ends a tick of time
+    // (false for the start's refresh: stateful kinds integrate nothing, draw no step).
+    bool started = false;
+    bool elapsed = false;
+    // The start's refresh after a reload (continue_from): stateful kinds take memory's value
+    // as their state.
+    bool resuming = false;
     // The host second of the last write access record (end_tick).
     std::int64_t recorded_second = std::numeric_limits<std::int64_t>::min();
     double pending = 0;  // advance() seconds not yet ticked
@@ -249,8 +261,15 @@ struct Scenario::Impl final : ExpressionContext {
     void combine_faults() noexcept;
     // Another event holding the same fault (fal/fals: the same number), or null.
     EventState* other_holder(const EventState& event) noexcept;
-    // The three phases of a tick (Scenario::begin_tick, compute, end_tick).
-    void begin_tick() noexcept;
+    // The three phases of a tick (Scenario::begin_tick, compute, end_tick). begin_tick
+    // moves time one tick on (`elapsed`), or not (the start's refresh), then starts and
+    // ends the events due at the new time and copies the image in.
+    void begin_tick(bool elapse = true) noexcept;
+    // The start's refresh, once: the tags computed at the current time, time unchanged.
+    void start_refresh() noexcept;
+    // Events placed at a kept time `now_s` (a reload): one-shot events past are not
+    // replayed, every_s events next start at their first time after it.
+    void place_events() noexcept;
     void compute_tags() noexcept;
     void end_tick() noexcept;
 };

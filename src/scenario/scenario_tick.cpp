@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <cstring>
 #include <numbers>
+#include <string_view>
+#include <unordered_map>
 
 #include "scenario/expression_eval.hpp"
 #include "scenario/scenario_impl.hpp"
@@ -65,18 +67,26 @@ double Scenario::Impl::compute(std::uint32_t index, bool& skip) noexcept {
     TagState& tag = tags[index];
     const TagState& d = tag;
     skip = false;
-    if (tag.has_when && !truth(run(cold[index].when))) {
-        skip = true;
-        return 0.0;
+    // A time-based kind reads the scenario time, or with `when` its own clock: the ticks
+    // that ended with `when` holding (off, it does not advance).
+    double t = now_s;
+    if (tag.has_when) {
+        TagCold& c = cold[index];
+        if (!truth(run(c.when))) {
+            skip = true;
+            return 0.0;
+        }
+        if (elapsed) ++c.active_ticks;
+        t = static_cast<double>(c.active_ticks) * def.tick_s;
     }
-    const double t = now_s;
     const double span = d.max - d.min;
-    // Stateful kinds take a client's write to the tag as their new state.
+    // Stateful kinds take a client's write to the tag as their new state (and after a
+    // reload, the value memory holds).
     auto adopt = [&] {
-        if (!tag.written) return;
+        if (!tag.written && !resuming) return;
         std::uint64_t raw = 0;
         const double held = read_own(tag, raw);
-        if (raw != tag.last_raw && std::isfinite(held)) tag.state = held;
+        if ((resuming || raw != tag.last_raw) && std::isfinite(held)) tag.state = held;
     };
     switch (tag.kind) {
         case SignalKind::constant:
@@ -95,9 +105,11 @@ double Scenario::Impl::compute(std::uint32_t index, bool& skip) noexcept {
             const double f = d.repeat ? fraction(t / d.period_s) : std::min(t / d.period_s, 1.0);
             return d.min + span * f;
         }
+        // The stateful kinds integrate over the tick that just ended (input at its end);
+        // the start's refresh (no tick ended) shows their state as it is.
         case SignalKind::random_walk:
             adopt();
-            tag.state = std::clamp(tag.state + d.step * random.normal(), d.min, d.max);
+            if (elapsed) tag.state = std::clamp(tag.state + d.step * random.normal(), d.min, d.max);
             return tag.state;
         case SignalKind::steps: {
             const TagDef& schedule = *cold[index].def;
@@ -112,7 +124,9 @@ double Scenario::Impl::compute(std::uint32_t index, bool& skip) noexcept {
         case SignalKind::counter: {
             adopt();
             const bool on = truth(run(tag.input));
-            if (d.rate > 0) {
+            if (!elapsed) {
+                // The start: an input already on is no rising edge.
+            } else if (d.rate > 0) {
                 if (on) tag.state += d.rate * def.tick_s;
             } else if (on && !tag.previous_input) {
                 tag.state += 1;
@@ -123,14 +137,14 @@ double Scenario::Impl::compute(std::uint32_t index, bool& skip) noexcept {
         }
         case SignalKind::totaliser:
             adopt();
-            tag.state += run(tag.input) * def.tick_s;
+            if (elapsed) tag.state += run(tag.input) * def.tick_s;
             return tag.state;
         case SignalKind::lag: {
             adopt();
             const double setpoint = run(tag.input);
             const double noise = d.noise > 0 ? d.noise * random.normal() : 0.0;
             // gain = 1 - exp(-tick_s / tau_s), computed once at compile.
-            if (std::isfinite(setpoint)) tag.state += (setpoint - tag.state) * d.gain;
+            if (elapsed && std::isfinite(setpoint)) tag.state += (setpoint - tag.state) * d.gain;
             return tag.state + noise;
         }
         case SignalKind::hysteresis: {
@@ -183,7 +197,11 @@ void Scenario::Impl::apply_faults(std::uint32_t index, double& value) noexcept {
     }
 }
 
-void Scenario::Impl::begin_tick() noexcept {
+void Scenario::Impl::begin_tick(bool elapse) noexcept {
+    // Time first, then what is due at the new time: memory ends up holding the tags at
+    // tick_count x tick_s, computed with the events of that time.
+    if (elapse) ++tick_count;
+    elapsed = elapse;
     now_s = static_cast<double>(tick_count) * def.tick_s;
     run_events();
     gather();
@@ -230,16 +248,68 @@ void Scenario::Impl::end_tick() noexcept {
                                        EndCode::normal_completion, host_now);
         recorded_second = second;
     }
-    ++tick_count;
-    // Events whose duration runs out at the new time end now: after advance(5) an event
-    // of 0-5 s is over (a unit fault is cleared before the next request is served).
-    now_s = static_cast<double>(tick_count) * def.tick_s;
-    for (auto& event : events)
-        if (event.active && event.end >= 0 && now_s >= event.end - epsilon) end_event(event);
+    resuming = false;
+}
+
+void Scenario::Impl::start_refresh() noexcept {
+    if (started) return;
+    started = true;
+    concurrent = false;
+    begin_tick(false);
+    compute_tags();
+    end_tick();
+}
+
+void Scenario::start(plc::TimePoint now) noexcept {
+    impl_->host_now = now;
+    impl_->start_refresh();
+}
+
+bool Scenario::started() const noexcept {
+    return impl_->started;
+}
+
+void Scenario::continue_from(const Scenario& previous) noexcept {
+    Impl& s = *impl_;
+    const Impl& p = *previous.impl_;
+    if (s.started || !p.started) return;
+    // The same tick keeps the count (and what advance() left over); another tick takes
+    // the time rounded down to a whole tick of its own.
+    if (p.def.tick_s == s.def.tick_s) {
+        s.tick_count = p.tick_count;
+        s.pending = p.pending;
+    } else {
+        const double ticks = static_cast<double>(p.tick_count) * p.def.tick_s / s.def.tick_s;
+        s.tick_count = static_cast<std::uint64_t>(std::floor(ticks + 1e-6));
+    }
+    s.now_s = static_cast<double>(s.tick_count) * s.def.tick_s;
+    // `when` clocks go on for the tags of the same address.
+    std::unordered_map<std::string_view, std::uint64_t> clocks;
+    for (std::size_t i = 0; i < p.tags.size(); ++i)
+        if (p.tags[i].has_when) clocks.emplace(p.cold[i].def->address.text, p.cold[i].active_ticks);
+    for (std::size_t i = 0; i < s.tags.size(); ++i)
+        if (s.tags[i].has_when)
+            if (const auto it = clocks.find(s.cold[i].def->address.text); it != clocks.end())
+                s.cold[i].active_ticks = it->second;
+    s.place_events();
+    s.resuming = true;
+}
+
+void Scenario::Impl::place_events() noexcept {
+    for (auto& event : events) {
+        if (event.next_start < 0 || event.next_start >= now_s - epsilon) continue;
+        if (!event.def->every_s) {
+            event.next_start = -1;
+            continue;
+        }
+        const double every = *event.def->every_s;
+        event.next_start += std::ceil((now_s - event.next_start) / every - 1e-6) * every;
+    }
 }
 
 void Scenario::tick(plc::TimePoint now) noexcept {
     impl_->host_now = now;
+    impl_->start_refresh();
     impl_->concurrent = false;
     impl_->begin_tick();
     impl_->compute_tags();
@@ -275,6 +345,7 @@ bool Scenario::offloadable() const noexcept {
 
 void Scenario::begin_tick(plc::TimePoint now) noexcept {
     impl_->host_now = now;
+    impl_->start_refresh();
     impl_->concurrent = true;
     impl_->begin_tick();
 }
@@ -287,17 +358,26 @@ void Scenario::end_tick() noexcept {
     impl_->end_tick();
 }
 
-std::uint64_t Scenario::advance(double seconds, plc::TimePoint now) noexcept {
+std::uint64_t Scenario::plan_advance(double seconds) noexcept {
     if (!(seconds > 0)) return 0;
-    impl_->pending += seconds;
-    std::uint64_t ran = 0;
-    while (impl_->pending >= impl_->def.tick_s - epsilon) {
-        impl_->pending -= impl_->def.tick_s;
+    Impl& s = *impl_;
+    s.pending += seconds;
+    // Whole ticks, counted at once (a week at 1 ms is 6e8 ticks: subtracting the tick
+    // that often would lose one); within a millionth of a tick counts as whole.
+    const double ticks = s.pending / s.def.tick_s;
+    double whole = std::floor(ticks);
+    if (ticks - whole > 1 - 1e-6) whole += 1;
+    s.pending = std::max(0.0, s.pending - whole * s.def.tick_s);
+    if (s.pending < s.def.tick_s * 1e-6) s.pending = 0;
+    return static_cast<std::uint64_t>(whole);
+}
+
+std::uint64_t Scenario::advance(double seconds, plc::TimePoint now) noexcept {
+    start(now);
+    const auto ticks = plan_advance(seconds);
+    for (std::uint64_t i = 0; i < ticks; ++i)
         tick(now);
-        ++ran;
-    }
-    if (impl_->pending < 0) impl_->pending = 0;
-    return ran;
+    return ticks;
 }
 
 }  // namespace fins::scenario

@@ -107,7 +107,9 @@ TEST(ScenarioRun, ConveyorCountsBoxesAndJamsOnSchedule) {
     write_bit(*c, "CIO1.00", true);  // start the belt
     run_for(socket, 20);
     EXPECT_EQ(read_int16(*c, "D20"), 30);
-    EXPECT_EQ(read_int16(*c, "D21"), 10);  // a box every 2 s
+    // A box every 2 s: at 0.1 (the belt started after the t = 0 refresh), 2, 4 ... and
+    // the one arriving at t = 20, which memory at t = 20 shows.
+    EXPECT_EQ(read_int16(*c, "D21"), 11);
     run_for(socket, 285);                  // t = 305: jammed since 300
     EXPECT_EQ(read_int16(*c, "D20"), 0);
     const auto during = read_int16(*c, "D21");

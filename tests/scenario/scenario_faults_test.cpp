@@ -34,11 +34,12 @@ std::unique_ptr<Scenario> with_events(plc::Plc& plc, std::vector<EventDef> event
     return test::compile(std::move(def), plc);
 }
 
-// Ticks until the last tick ran at scenario time `t` (tick 0.1 s; the first tick is t = 0).
-// A tick ends the events whose end is the time after it: run_to(29.9) shows an event
-// ending at 30 ended.
+// Ticks until scenario time `t` (tick 0.1 s): memory and the faults are those of time t,
+// an event in force for at_s <= t < at_s + duration_s (run_to(29.9) shows an event ending
+// at 30 still holding, run_to(30) ended).
 void run_to(Scenario& s, double t) {
-    for (int bound = 0; bound < 100000 && s.time() < t + 0.05; ++bound)
+    s.start(now);
+    for (int bound = 0; bound < 100000 && s.time() < t - 0.05; ++bound)
         s.tick(now);
 }
 
@@ -59,9 +60,9 @@ TEST(ScenarioFaults, AnOfflineEventInsideAnotherDoesNotBringTheUnitBack) {
     EXPECT_TRUE(s->transport().offline);
     run_to(*s, 15);  // the short one ended at 14, the long one still holds
     EXPECT_TRUE(s->transport().offline);
-    run_to(*s, 29.8);
-    EXPECT_TRUE(s->transport().offline);
     run_to(*s, 29.9);
+    EXPECT_TRUE(s->transport().offline);
+    run_to(*s, 30);
     EXPECT_FALSE(s->transport().offline);
 }
 

@@ -75,20 +75,24 @@ TEST(ScenarioPhases, BeginComputeEndGiveWhatTickGivesByteForByte) {
 TEST(ScenarioPhases, MemoryChangesOnlyAtEndTick) {
     plc::Plc plc;
     ScenarioDef def;
-    TagDef c = tag("D10", SignalKind::constant);
-    c.value = 42;
+    TagDef c = tag("D10", SignalKind::sawtooth);
+    c.max = 100;
+    c.period_s = 10;
     def.tags.push_back(c);
     auto s = compile(def, plc);
     ASSERT_TRUE(s);
-    s->begin_tick(now);
+    s->start(now);  // t = 0: memory holds the tag at 0
+    EXPECT_EQ(s->status().writes, 1u);
+    plc.write_access_log().clear();
+    s->begin_tick(now + std::chrono::seconds(1));  // another host second: a new record
     s->compute();
     EXPECT_EQ(plc.memory().words(Region::dm)[10], 0);  // computed on the image only
     EXPECT_EQ(plc.write_access_log().size(), 0u);
-    EXPECT_EQ(s->status().writes, 0u);
-    s->end_tick();
-    EXPECT_EQ(plc.memory().words(Region::dm)[10], 42);
-    EXPECT_EQ(plc.write_access_log().size(), 1u);
     EXPECT_EQ(s->status().writes, 1u);
+    s->end_tick();
+    EXPECT_EQ(plc.memory().words(Region::dm)[10], 1);  // t = 0.1
+    EXPECT_EQ(plc.write_access_log().size(), 1u);
+    EXPECT_EQ(s->status().writes, 2u);
 }
 
 // A client's write between begin_tick and end_tick (while finsd's scenario thread

@@ -50,7 +50,7 @@ TEST(Scenario, SineFollowsTheIssueFormulaAndLinksReadItInTheSameTick) {
     def.tags.push_back(sine);
     auto s = compile(def, plc);
     ASSERT_TRUE(s);
-    s->tick(now);  // t = 0
+    s->start(now);  // t = 0
     EXPECT_EQ(dm(plc, 100), 500);
     EXPECT_EQ(dm(plc, 101), 1000);
     EXPECT_EQ(s->advance(2.5, now), 25u);  // ticks at 0.1 ... 2.5
@@ -58,7 +58,7 @@ TEST(Scenario, SineFollowsTheIssueFormulaAndLinksReadItInTheSameTick) {
     EXPECT_EQ(dm(plc, 101), 2000);
     s->advance(5.0, now);  // t = 7.5
     EXPECT_EQ(dm(plc, 100), 0);
-    EXPECT_DOUBLE_EQ(s->time(), 7.6);
+    EXPECT_DOUBLE_EQ(s->time(), 7.5);
 }
 
 // Values are rounded half away from zero (std::llround) and clamped to the type.
@@ -107,8 +107,9 @@ TEST(Scenario, SineMatchesTheFormulaOverALongRun) {
     auto s = compile(def, plc);
     ASSERT_TRUE(s);
     const auto w = plc.memory().words(Region::dm);
+    s->start(now);
     for (int i = 0; i < 3000; ++i) {
-        s->tick(now);
+        if (i > 0) s->tick(now);
         const double t = 0.1 * i;
         const double expected =
             (sine.min + sine.max) / 2 +
@@ -141,7 +142,7 @@ TEST(Scenario, WaveformsAndSteps) {
     k.value = 1.5;
     def.tags.push_back(k);
     auto s = compile(def, plc);
-    s->tick(now);  // t = 0
+    s->start(now);  // t = 0
     EXPECT_EQ(dm(plc, 0), 100);
     EXPECT_EQ(dm(plc, 1), 0);
     EXPECT_EQ(dm(plc, 4), 5);
@@ -239,7 +240,7 @@ TEST(Scenario, HysteresisAndDelay) {
     auto s = compile(def, plc);
     s->advance(0.5, now);
     EXPECT_EQ(dm(plc, 41), 0);  // nothing written before the delay has passed
-    s->advance(5.6, now);       // t = 6.0
+    s->advance(5.5, now);       // t = 6.0
     EXPECT_EQ(plc.memory().words(Region::work)[1] & 1, 1);
     EXPECT_EQ(dm(plc, 41), 50);  // D40 of t = 5.0
 }
@@ -347,10 +348,12 @@ TEST(Scenario, ValueFaultsAndUnitFaults) {
     off.fault = FaultKind::offline;
     def.events.push_back(off);
     auto s = compile(def, plc);
-    s->advance(4.0, now);  // t = 3.9
+    s->advance(3.9, now);  // t = 3.9
     EXPECT_EQ(dm(plc, 50), 20);
     EXPECT_FALSE(s->transport().offline);
-    s->advance(0.2, now);  // t = 4.1
+    s->advance(0.1, now);  // t = 4.0: offline from 4
+    EXPECT_TRUE(s->transport().offline);
+    s->advance(0.1, now);  // t = 4.1
     EXPECT_TRUE(s->transport().offline);
     s->advance(1.0, now);  // t = 5.1: stuck ended at 5, offline at 5
     EXPECT_EQ(dm(plc, 50), 51);

@@ -25,7 +25,8 @@
 //   advance SECONDS                 alias of scenario advance SECONDS
 //
 // Exit codes: 0 the server answered "ok"; 2 usage error or the server refused the
-// request (its message on stderr); 3 cannot connect, or no answer within 5 s.
+// request (its message on stderr); 3 cannot connect, or no answer within 5 s (an advance
+// waits for its answer without a limit: finsd answers when its ticks have run).
 #include "cli/finsd/ctl.hpp"
 #include "cli/finsd/control_setup.hpp"
 #include "cli/finsd/ctl_instructions.hpp"
@@ -37,6 +38,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -64,9 +66,11 @@ struct Fd {
     }
 };
 
-// Sends `request` (one line) and returns the answer line, or prints why not.
+// Sends `request` (one line) and returns the answer line, or prints why not. `wait`
+// (at least answer_timeout_ms) bounds the wait for the answer; nullopt: no bound, until
+// the answer comes or finsd closes the connection (a long scenario advance).
 std::optional<std::string> send_request(const std::string& path, const std::string& request,
-                                        std::chrono::milliseconds wait) {
+                                        std::optional<std::chrono::milliseconds> wait) {
     sockaddr_un address{};
     if (path.size() >= sizeof address.sun_path) {
         std::fprintf(stderr, "finsd ctl: socket path too long: %s\n", path.c_str());
@@ -91,13 +95,20 @@ std::optional<std::string> send_request(const std::string& path, const std::stri
         sent += static_cast<std::size_t>(n);
     }
     std::string answer;
-    const auto deadline = std::chrono::steady_clock::now() +
-                          std::max(wait, std::chrono::milliseconds(answer_timeout_ms));
+    const auto deadline =
+        std::chrono::steady_clock::now() + std::max(wait.value_or(std::chrono::milliseconds(0)),
+                                                    std::chrono::milliseconds(answer_timeout_ms));
     while (answer.size() < max_answer_size) {
         const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
             deadline - std::chrono::steady_clock::now());
         pollfd p{s.fd, POLLIN, 0};
-        if (left.count() <= 0 || ::poll(&p, 1, static_cast<int>(left.count())) <= 0) break;
+        if (wait && left.count() <= 0) break;
+        const int timeout = wait ? static_cast<int>(left.count()) : -1;
+        int ready = 0;
+        do {
+            ready = ::poll(&p, 1, timeout);
+        } while (ready < 0 && errno == EINTR && !wait);
+        if (ready <= 0) break;
         char buf[4096];
         const auto n = ::recv(s.fd, buf, sizeof buf, 0);
         if (n <= 0) break;
@@ -248,7 +259,14 @@ int run_ctl(int argc, char** argv) {
         std::fprintf(stderr, "finsd ctl: a request is one line\n");
         return exit_usage;
     }
-    const auto answer = send_request(socket, line, verbs.wait);
+    // A scenario advance answers when its ticks have run (finsd serves FINS requests
+    // meanwhile): a day at 1 ms takes a while, so no fixed limit.
+    const bool advance = !raw_line && request.is_object() &&
+                         request.value("cmd", "") == "scenario" &&
+                         request.value("action", "") == "advance";
+    const auto answer =
+        send_request(socket, line,
+                     advance ? std::nullopt : std::optional<std::chrono::milliseconds>(verbs.wait));
     if (!answer) return exit_io;
     const Json doc = Json::parse(*answer, nullptr, false);
     const bool instruction =

@@ -84,8 +84,16 @@ void dispatch_unguarded(std::span<const ControlTarget> targets, const Json& j,
     Json answer;
     try {
         if (handle_instruction_request(target->instructions, target->schedule, j, reply)) return;
-        answer = j["cmd"] == "scenario" ? handle_scenario_request(target->scenario, j)
-                                        : handle_control_request(*target->plc, j);
+        // A scenario verb may answer later (an advance runs in slices).
+        if (j["cmd"] == "scenario") {
+            return handle_scenario_request(target->scenario, j,
+                                           [reply, name = target->name](Json a) {
+                                               if (!name.empty() && a.contains("status"))
+                                                   a["status"]["plc"] = name;
+                                               reply(std::move(a));
+                                           });
+        }
+        answer = handle_control_request(*target->plc, j);
     } catch (const Json::exception& e) {
         // A key of the wrong type (handle_control_request's contract): the client's
         // mistake. Anything else a verb throws is this server's: the boundary below.

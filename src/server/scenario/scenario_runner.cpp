@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include <fmt/core.h>
 #include <spdlog/spdlog.h>
+#include <boost/asio/post.hpp>
 
 namespace fins::server {
 
@@ -41,6 +43,11 @@ void ScenarioRunner::prefetch() const noexcept {
 }
 
 ScenarioRunner::~ScenarioRunner() {
+    if (advancing_) {
+        advancing_ = false;
+        auto done = std::move(advance_done_);
+        done(tl::unexpected(std::string("the scenario stopped before the advance ended")));
+    }
     settle();
     ticker_.cancel(*this);
     *alive_ = false;
@@ -70,7 +77,10 @@ void ScenarioRunner::start(std::optional<double> phase) {
     if (period_ <= std::chrono::steady_clock::duration::zero())
         period_ = std::chrono::microseconds(1);
     running_ = true;
-    if (def.virtual_time || paused_) return;
+    // Memory holds the tags at the scenario's time from the start (f(0), or the time a
+    // reload kept: continue_from).
+    scenario_->start(host_now());
+    if (def.virtual_time || paused_ || advancing_) return;
     if (phase) {
         const auto now = std::chrono::steady_clock::now();
         const auto offset = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
@@ -81,12 +91,16 @@ void ScenarioRunner::start(std::optional<double> phase) {
         schedule();
         return;
     }
-    scenario_->tick(host_now());
     next_ = std::chrono::steady_clock::now() + period_;
     schedule();
 }
 
 void ScenarioRunner::stop() {
+    if (advancing_) {
+        advancing_ = false;
+        auto done = std::move(advance_done_);
+        done(tl::unexpected(std::string("the scenario stopped before the advance ended")));
+    }
     settle();
     running_ = false;
     ticker_.cancel(*this);
@@ -99,20 +113,24 @@ void ScenarioRunner::schedule() {
 }
 
 void ScenarioRunner::due() noexcept {
-    on_tick();
+    run_due(std::chrono::steady_clock::now());
 }
 
-void ScenarioRunner::on_tick() {
-    if (!running_ || paused_ || virtual_time_) return;
+void ScenarioRunner::run_due(std::chrono::steady_clock::time_point now) {
+    if (!running_ || paused_ || virtual_time_ || advancing_) return;
     if (in_flight_) return;  // its finish() schedules the next
-    const auto now = std::chrono::steady_clock::now();
     if (worker_ != nullptr && offloadable_) {
-        // One tick per hand-over; a backlog beyond max_catch_up periods is dropped.
+        // One tick per hand-over; a backlog beyond max_catch_up periods is dropped (the
+        // grid's phase kept).
         if (next_ > now) {
             schedule();
             return;
         }
-        if (now - next_ >= period_ * max_catch_up) next_ = now;
+        if (now - next_ >= period_ * max_catch_up) {
+            const auto missed = (now - next_) / period_;
+            fall_behind(static_cast<std::uint64_t>(missed), now);
+            next_ += missed * period_;
+        }
         scenario_->begin_tick(host_now());
         next_ += period_;
         in_flight_ = true;
@@ -125,9 +143,28 @@ void ScenarioRunner::on_tick() {
         next_ += period_;
         ++ran;
     }
-    // Too far behind: drop the backlog rather than stall every request behind it.
-    if (next_ <= now) next_ = now + period_;
+    // Too far behind: drop the backlog rather than stall every request behind it (the
+    // ticks due by now, the grid's phase kept).
+    if (next_ <= now) {
+        const auto missed = (now - next_) / period_ + 1;
+        fall_behind(static_cast<std::uint64_t>(missed), now);
+        next_ += missed * period_;
+    }
     schedule();
+}
+
+void ScenarioRunner::fall_behind(std::uint64_t ticks, std::chrono::steady_clock::time_point now) {
+    if (ticks == 0) return;
+    late_ticks_ += ticks;
+    if (late_ticks_ != ticks && now < next_behind_log_) return;
+    next_behind_log_ = now + behind_log_interval;
+    const auto& def = scenario_->definition();
+    spdlog::warn(
+        "finsd: scenario {} falls behind real time: {} ticks dropped so far ({:.3f} s of "
+        "scenario time; tick_ms {}, time_scale {}): the host cannot compute its ticks in "
+        "time (finsd ctl scenario status: late_ticks, behind_s)",
+        source_, late_ticks_, static_cast<double>(late_ticks_) * def.tick_s,
+        std::llround(def.tick_s * 1000), def.time_scale);
 }
 
 ScenarioRunStatus ScenarioRunner::run_status() const {
@@ -141,6 +178,11 @@ ScenarioRunStatus ScenarioRunner::run_status() const {
     s.seed = def.seed;
     s.reloads = reloads_;
     s.source = source_;
+    s.late_ticks = late_ticks_;
+    s.behind_s = static_cast<double>(late_ticks_) * def.tick_s;
+    s.advancing = advancing_;
+    s.advance_ticks = advancing_ ? advance_ticks_ : 0;
+    s.advance_done = advancing_ ? advance_ticks_ - advance_left_ : 0;
     return s;
 }
 
@@ -166,6 +208,52 @@ std::uint64_t ScenarioRunner::advance(double seconds) {
     return scenario_->advance(seconds, host_now());
 }
 
+std::string ScenarioRunner::busy() const {
+    if (!advancing_) return {};
+    return fmt::format("an advance is running ({} of {} ticks done): wait for its answer",
+                       advance_ticks_ - advance_left_, advance_ticks_);
+}
+
+void ScenarioRunner::advance_async(double seconds, AdvanceDone done) {
+    if (advancing_) return done(tl::unexpected(busy()));
+    settle();
+    scenario_->start(host_now());
+    advance_ticks_ = advance_left_ = scenario_->plan_advance(seconds);
+    advance_done_ = std::move(done);
+    advancing_ = true;
+    // The timer's ticks wait for the advance (run_due does nothing meanwhile).
+    ticker_.cancel(*this);
+    advance_slice_run();
+}
+
+void ScenarioRunner::advance_slice_run() {
+    if (!advancing_) return;
+    using Clock = std::chrono::steady_clock;
+    const auto until = Clock::now() + advance_slice;
+    // The clock read every few ticks: a small scenario's tick costs less than reading it.
+    constexpr std::uint64_t between_reads = 4;
+    for (std::uint64_t n = 1; advance_left_ > 0; ++n) {
+        scenario_->tick(host_now());
+        --advance_left_;
+        if (n % between_reads == 0 && Clock::now() >= until) break;
+    }
+    if (advance_left_ > 0) {
+        asio::post(io_, [this, alive = alive_] {
+            if (*alive) advance_slice_run();
+        });
+        return;
+    }
+    advancing_ = false;
+    auto done = std::move(advance_done_);
+    advance_done_ = nullptr;
+    if (running_ && !paused_ && !virtual_time_) {
+        // Real time goes on from now (the advance's wall-clock time is not made up).
+        next_ = Clock::now() + period_;
+        schedule();
+    }
+    done(AdvanceAnswer{advance_ticks_, scenario_->time()});
+}
+
 bool ScenarioRunner::trigger(std::string_view event) {
     settle();
     return scenario_->trigger(event, host_now());
@@ -173,10 +261,14 @@ bool ScenarioRunner::trigger(std::string_view event) {
 
 tl::expected<void, std::string> ScenarioRunner::reload() {
     if (!reload_) return tl::unexpected(std::string("this scenario has no file to reload"));
+    if (advancing_) return tl::unexpected(busy());
     auto fresh = reload_();
     if (!fresh) return tl::unexpected(fresh.error());
     settle();
     ticker_.cancel(*this);
+    // The new scenario goes on at the old one's time, from the memory it left (computed
+    // by start(), once the old one is gone with its unit faults).
+    (*fresh)->continue_from(*scenario_);
     scenario_ = std::move(*fresh);
     adopt_scenario();
     ++reloads_;

@@ -2,14 +2,23 @@
 // io_context's ScenarioTicker, the control verbs (ScenarioControl) and the unit faults the network
 // side consults (FaultHook). One per CPU Unit; everything runs on the io_context's one thread.
 //
+// start() computes the tags at time 0 (Scenario::start): memory holds f(0) before the
+// first tick, in real and virtual time.
 // Real time: ticks every tick_s / time_scale wall-clock seconds, drift-free (each expiry
 // is the previous one plus the period, not "now" plus the period). A late timer (a busy
-// host) runs the missed ticks, at most max_catch_up at once; beyond that scenario time
-// falls behind rather than stalling the requests. Scenario time is always ticks * tick_s,
-// so a run is the same whatever the host's timing.
+// host) runs the missed ticks, at most max_catch_up at once; beyond that the ticks due
+// are dropped and scenario time falls behind rather than stalling the requests: the
+// status counts them (late_ticks, behind_s) and the log says so (once a minute at
+// most). Scenario time is always ticks * tick_s, so a run is the same whatever the
+// host's timing.
 // Virtual time: no timer; time moves only by advance() (`finsd ctl scenario advance`).
-// Reload compiles the new file first and swaps only on success; the unit faults the old
-// one had started are cleared with it.
+// advance_async runs the ticks in slices of about advance_slice, posted back to the
+// io_context between slices so the FINS requests are served meanwhile; until it answers
+// the timer's ticks wait, and every other verb but status is refused (busy()). The
+// memory after a sliced advance is the memory after the same ticks in one piece.
+// Reload compiles the new file first and swaps only on success; the new scenario goes on
+// at the old one's time (Scenario::continue_from); the unit faults the old one had started
+// are cleared with it.
 // With a ScenarioWorker (finsd's), a real-time tick of an offloadable scenario is handed
 // over: begin_tick here, compute on the worker, end_tick here when it comes back (one tick
 // in flight at most; the next is due one period later). Every control verb settles a tick
@@ -57,6 +66,10 @@ class ScenarioRunner final : public ScenarioControl,
         return static_cast<double>(unit % phase_groups) / phase_groups;
     }
     static constexpr std::size_t max_delayed_answers = 1024;
+    // An advance_async slice: ticks run back to back for about this long.
+    static constexpr std::chrono::milliseconds advance_slice{5};
+    // The "falls behind" warning, at most once per this much time.
+    static constexpr std::chrono::seconds behind_log_interval{60};
 
     // `worker` (may be null: every tick on this thread) must outlive the runner.
     ScenarioRunner(asio::io_context& io, std::unique_ptr<scenario::Scenario> scenario,
@@ -76,12 +89,18 @@ class ScenarioRunner final : public ScenarioControl,
     [[nodiscard]] const scenario::Scenario& scenario() const noexcept { return *scenario_; }
     // Ends a tick in flight on the worker now (waiting for its compute if needed).
     void settle();
+    // What the timer's expiry runs, at steady time `now` (tests pass the time in), and
+    // when the next tick is due.
+    void run_due(std::chrono::steady_clock::time_point now);
+    [[nodiscard]] std::chrono::steady_clock::time_point next_due() const noexcept { return next_; }
 
     // ScenarioControl
     [[nodiscard]] ScenarioRunStatus run_status() const override;
     void pause() override;
     void resume() override;
     std::uint64_t advance(double seconds) override;
+    void advance_async(double seconds, AdvanceDone done) override;
+    [[nodiscard]] std::string busy() const override;
     bool trigger(std::string_view event) override;
     tl::expected<void, std::string> reload() override;
     [[nodiscard]] const scenario::ScenarioDef* definition() const override {
@@ -108,8 +127,11 @@ class ScenarioRunner final : public ScenarioControl,
     void adopt_scenario() noexcept;
 
     void schedule();
-    void on_tick();
     void flush_delayed();
+    // The ticks due at `now` the timer drops: counted, and logged (rate-limited).
+    void fall_behind(std::uint64_t ticks, std::chrono::steady_clock::time_point now);
+    // Runs a slice of the advance in progress; posts the next, or answers.
+    void advance_slice_run();
 
     // What a tick reads of the runner first, on the object's first lines (the ticker
     // prefetches them a unit ahead): the scenario, the schedule, the flags, and where the
@@ -140,6 +162,14 @@ class ScenarioRunner final : public ScenarioControl,
         std::vector<std::uint8_t> frame;
         Completion completion;
     };
+    // Falling behind (fall_behind).
+    std::uint64_t late_ticks_ = 0;
+    std::chrono::steady_clock::time_point next_behind_log_{};
+    // The advance running in slices (advance_async).
+    bool advancing_ = false;
+    std::uint64_t advance_left_ = 0;
+    std::uint64_t advance_ticks_ = 0;
+    AdvanceDone advance_done_;
     std::deque<Delayed> delayed_;
     asio::steady_timer delay_timer_;
     bool delay_armed_ = false;
