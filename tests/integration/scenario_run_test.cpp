@@ -110,7 +110,7 @@ TEST(ScenarioRun, ConveyorCountsBoxesAndJamsOnSchedule) {
     // A box every 2 s: at 0.1 (the belt started after the t = 0 refresh), 2, 4 ... and
     // the one arriving at t = 20, which memory at t = 20 shows.
     EXPECT_EQ(read_int16(*c, "D21"), 11);
-    run_for(socket, 285);                  // t = 305: jammed since 300
+    run_for(socket, 285);  // t = 305: jammed since 300
     EXPECT_EQ(read_int16(*c, "D20"), 0);
     const auto during = read_int16(*c, "D21");
     const Json jammed = Json::parse(ctl(socket, {"status"}).out)["status"];
