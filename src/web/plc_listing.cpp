@@ -14,6 +14,7 @@
 
 #include "plc/plc.hpp"
 #include "plc/routing_tables.hpp"
+#include "server/control/control_requests.hpp"
 #include "web/cpu_facts.hpp"
 
 namespace fins::web {
@@ -22,18 +23,6 @@ namespace {
 
 using Json = nlohmann::json;
 using Clock = std::chrono::steady_clock;
-
-const char* mode_text(plc::OperatingMode m) {
-    switch (m) {
-        case plc::OperatingMode::program:
-            return "program";
-        case plc::OperatingMode::monitor:
-            return "monitor";
-        case plc::OperatingMode::run:
-            return "run";
-    }
-    return "run";
-}
 
 // Decimal digits only, as a std::size_t.
 std::optional<std::size_t> count_param(const std::string& text) {
@@ -154,7 +143,7 @@ Json plc_entry(const WebContext& context, const server::ControlTarget& t) {
                {"net", t.addresses.empty() ? 0 : t.addresses.front().first},
                {"node", t.addresses.empty() ? 0 : t.addresses.front().second},
                {"unit", 0},
-               {"mode", mode_text(t.plc->mode())},
+               {"mode", server::mode_name(t.plc->mode())},
                {"em_banks", t.plc->profile().em_banks},
                {"areas", memory_areas(t.plc->profile())}};
     // The CPU Unit's routing tables (parameter area 8013, W342 5-3-8): what the router uses.

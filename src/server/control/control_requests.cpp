@@ -12,6 +12,18 @@
 
 namespace fins::server {
 
+const char* mode_name(plc::OperatingMode m) noexcept {
+    switch (m) {
+        case plc::OperatingMode::program:
+            return "program";
+        case plc::OperatingMode::monitor:
+            return "monitor";
+        case plc::OperatingMode::run:
+            return "run";
+    }
+    return "run";
+}
+
 namespace {
 
 using Json = nlohmann::json;
@@ -22,18 +34,6 @@ Json fail(const std::string& message) {
 
 std::string hex4(std::uint16_t v) {
     return fmt::format("{:04X}", v);
-}
-
-const char* mode_name(plc::OperatingMode m) {
-    switch (m) {
-        case plc::OperatingMode::program:
-            return "program";
-        case plc::OperatingMode::monitor:
-            return "monitor";
-        case plc::OperatingMode::run:
-            return "run";
-    }
-    return "run";
 }
 
 std::optional<bool> flag(const Json& j, const char* key) {

@@ -21,18 +21,23 @@
 // Anything else answers {"error":"..."}.
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
 namespace fins::plc {
 class Plc;
-}
+enum class OperatingMode : std::uint8_t;
+}  // namespace fins::plc
 
 namespace fins::server {
 
 // {"error": message}
 nlohmann::json control_error(const std::string& message);
+
+// "program", "monitor" or "run": the mode as the control status and the web API name it.
+const char* mode_name(plc::OperatingMode m) noexcept;
 
 // One request object with a string "cmd" -> its answer. Throws only what nlohmann::json
 // throws for a mistyped key (the caller answers "bad request: ...").
