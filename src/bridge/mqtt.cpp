@@ -280,8 +280,12 @@ void MqttClient::on_connect(mosquitto* m, void* p, int rc) {
 void MqttClient::on_disconnect(mosquitto*, void* p, int rc) {
     auto* self = static_cast<MqttClient*>(p);
     self->connected_ = false;
-    if (rc != 0 && !self->closing_)
-        spdlog::warn("MQTT connection lost: {}", mosquitto_strerror(rc));
+    if (rc == 0 || self->closing_) return;
+    // libmosquitto 2.0.11 has no text for MOSQ_ERR_KEEPALIVE.
+    spdlog::warn("MQTT connection lost: {}",
+                 rc == MOSQ_ERR_KEEPALIVE
+                     ? "no answer from the broker within the keepalive (or no CONNACK)"
+                     : mosquitto_strerror(rc));
 }
 
 void MqttClient::on_publish(mosquitto*, void* p, int) {
