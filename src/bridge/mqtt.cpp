@@ -1,7 +1,10 @@
 #include "bridge/mqtt.hpp"
 
 #include <mosquitto.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
 #include <poll.h>
+#include <sys/socket.h>
 
 #include <algorithm>
 #include <random>
@@ -52,8 +55,10 @@ bool MqttClient::start(std::string& error) {
         error = "mosquitto_new failed";
         return false;
     }
-    // Not threaded: publish() writes to the socket itself when it can, the io_context does
-    // the rest.
+    // "Threaded" for libmosquitto means only that publish() queues and does not write: the
+    // io_context writes what was queued when the socket is writable, all of it at once
+    // (writable()), so that the messages of one turn of the loop share TCP segments.
+    mosquitto_threaded_set(mosq_, true);
     mosquitto_int_option(mosq_, MOSQ_OPT_PROTOCOL_VERSION, MQTT_PROTOCOL_V311);
     mosquitto_int_option(mosq_, MOSQ_OPT_TCP_NODELAY, 1);
     mosquitto_connect_callback_set(mosq_, &MqttClient::on_connect);
@@ -99,9 +104,7 @@ void MqttClient::connect() {
     unwrap();
     const int rc = mosquitto_connect_async(mosq_, b.host.c_str(), b.port,
                                            static_cast<int>(config_.keepalive.count()));
-    if (rc == MOSQ_ERR_SUCCESS)
-        will_sent_ = true;  // connected or connecting: the CONNECT with this Will is queued
-    else
+    if (rc != MOSQ_ERR_SUCCESS)
         spdlog::warn("MQTT broker {}:{}: {}", b.host, b.port, mosquitto_strerror(rc));
     sync();
 }
@@ -197,7 +200,19 @@ void MqttClient::writable() {
         mosquitto_loop_read(mosq_, 1);
         if (mosquitto_socket(mosq_) != fd_) return sync();
     }
+    // Corked: the packets written now leave in as few segments as they fill (TCP_NODELAY
+    // would send each on its own), and uncorking sends the rest at once.
+    int on = 1;
+    ::setsockopt(fd_, IPPROTO_TCP, TCP_CORK, &on, sizeof on);
     mosquitto_loop_write(mosq_, 1);
+    if (const int fd = mosquitto_socket(mosq_); fd == fd_ && fd >= 0) {
+        on = 0;
+        ::setsockopt(fd, IPPROTO_TCP, TCP_CORK, &on, sizeof on);
+        // Written, CONNECT included: its Will reached a broker (with TLS: once CONNACK says so;
+        // until the handshake ends nothing is written).
+        if (!will_sent_ && config_.ca_file.empty() && !mosquitto_want_write(mosq_))
+            will_sent_ = true;
+    }
     sync();
 }
 
@@ -265,6 +280,7 @@ void MqttClient::on_connect(mosquitto* m, void* p, int rc) {
         return;
     }
     self->accepted_ = true;
+    self->will_sent_ = true;
     self->connected_ = true;
     ++self->connects_;
     for (const auto& s : self->subscriptions_)
@@ -309,7 +325,7 @@ bool MqttClient::publish(const Message& m) {
         ++dropped_;
         return false;
     }
-    ++queued_;  // before: libmosquitto may write it, and call on_publish, right here
+    ++queued_;
     const int rc =
         mosquitto_publish(mosq_, nullptr, m.topic.c_str(), static_cast<int>(m.payload.size()),
                           m.payload.data(), m.qos, m.retain);
@@ -320,7 +336,7 @@ bool MqttClient::publish(const Message& m) {
         return false;
     }
     ++published_;
-    // What the socket did not take now goes when it is writable.
+    // Written when the socket is writable (writable()).
     if (socket_ && !writing_ && mosquitto_want_write(mosq_)) wait_write();
     return true;
 }

@@ -139,8 +139,8 @@ class MqttClient {
     std::shared_ptr<int> alive_ = std::make_shared<int>(0);  // for handlers that outlive this
     std::size_t broker_ = 0;
     std::uint64_t generation_ = 0;
-    // A new Will (Sparkplug: the next bdSeq) only once the last one went out in a CONNECT:
-    // an attempt that reached no broker sent none.
+    // A new Will (Sparkplug: the next bdSeq) only once the last one went out in a CONNECT
+    // (written, or answered by CONNACK): an attempt that reached no broker sent none.
     bool will_sent_ = true;
     bool accepted_ = false;  // the current attempt got a CONNACK
     bool connected_ = false;
