@@ -11,8 +11,9 @@
 // calls: its handshake is driven by loop_read on either readiness. Every callback
 // (connected, message, disconnected, will) therefore runs on the io_context's thread, and
 // nothing here is shared with another thread.
-// - outgoing: publish() hands the message to libmosquitto, which writes it at once when the
-//   socket takes it; at most Mqtt::queue_limit messages may wait to be written. Beyond that
+// - outgoing: publish() hands the message to libmosquitto's queue, written when the socket
+//   is writable (everything queued at once, corked into full segments); at most
+//   Mqtt::queue_limit messages may wait to be written. Beyond that
 //   (or while disconnected) data messages (QoS 0) are dropped and counted in
 //   stats().dropped; statuses are published again after every connect, so nothing retained
 //   is lost for good.
