@@ -5,7 +5,6 @@
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
-#include <boost/asio/post.hpp>
 
 namespace fins::bridge {
 
@@ -59,27 +58,17 @@ Bridge::~Bridge() = default;
 
 bool Bridge::start(std::string& error) {
     const bool session = format_->own_session();
-    // The format's births and statuses follow the connection that carries them.
-    auto births = [this] {
-        asio::post(io_, [this] {
-            if (stopped_) return;
-            format_->connected(sink_);
-            for (const auto& [name, st] : statuses_)
-                format_->status(st, sink_);
-            for (auto& [name, p] : pollers_)
-                p->request_full();
-        });
-    };
-    auto message = [this](std::string topic, std::string payload, bool retained) {
+    // Everything below runs on the io_context's thread, the MQTT callbacks included
+    // (mqtt.hpp): the births of a connection are published from its CONNACK, before any
+    // message of the pollers can follow them on it.
+    MqttClient::Handlers h;
+    if (!session) h.connected = [this](std::uint64_t generation) { births(generation); };
+    const auto message = [this](std::string topic, std::string payload, bool retained) {
         incoming(std::move(topic), std::move(payload), retained);
     };
-    MqttClient::Handlers h;
-    if (!session) h.connected = births;
     h.message = message;
     h.disconnected = [this] {
-        asio::post(io_, [this] {
-            if (!stopped_) ownership_->connection_lost();
-        });
+        if (!stopped_) ownership_->connection_lost();
     };
     auto subscriptions = ownership_->subscriptions();
     if (!session) {
@@ -90,7 +79,7 @@ bool Bridge::start(std::string& error) {
     // published while the bridge reconnects or is stopped are queued by the broker and
     // delivered on the next connect (docs/bridge.md "Writes"). Sparkplug's Edge Node session
     // must start clean (its specification); its status connection stays as it was.
-    mqtt_ = std::make_unique<MqttClient>(config_.mqtt, format_->bridge_status(false),
+    mqtt_ = std::make_unique<MqttClient>(io_, config_.mqtt, format_->bridge_status(false),
                                          format_->bridge_status(true), std::move(subscriptions),
                                          std::move(h), !session);
     if (!mqtt_->start(error)) return false;
@@ -99,17 +88,32 @@ bool Bridge::start(std::string& error) {
         Mqtt sc = config_.mqtt;
         sc.client_id += "-session";
         MqttClient::Handlers sh;
-        sh.connected = births;
+        sh.connected = [this](std::uint64_t generation) { births(generation); };
         sh.message = message;
         sh.will = [this] { return format_->session_will(); };
-        session_ = std::make_unique<MqttClient>(sc, Message{}, Message{}, format_->subscriptions(),
-                                                std::move(sh));
+        session_ = std::make_unique<MqttClient>(io_, sc, Message{}, Message{},
+                                                format_->subscriptions(), std::move(sh));
         if (!session_->start(error)) return false;
     }
     reconcile();
     last_report_ = Clock::now();
     report();
     return true;
+}
+
+void Bridge::births(std::uint64_t generation) {
+    // Only for the connection that carries the format's messages now: a connection that is
+    // already gone (or replaced) gets no births, and nothing of the format goes out on the
+    // new one before its own (Sparkplug: no DDATA before this session's NBIRTH).
+    const MqttClient* carrier = session_ ? session_.get() : mqtt_.get();
+    if (stopped_ || carrier == nullptr || carrier->generation() != generation ||
+        !carrier->connected())
+        return;
+    format_->connected(sink_);
+    for (const auto& [name, st] : statuses_)
+        format_->status(st, sink_);
+    for (auto& [name, p] : pollers_)
+        p->request_full();
 }
 
 void Bridge::stop() {
@@ -188,22 +192,8 @@ Bridge::IdMemory::Entry& Bridge::remember(const std::string& plc, const std::str
 }
 
 void Bridge::incoming(std::string topic, std::string payload, bool retained) {
-    if (pending_commands_.fetch_add(1) >= max_pending_commands) {
-        pending_commands_.fetch_sub(1);
-        ++dropped_commands_;
-        return;
-    }
-    try {
-        asio::post(io_, [this, topic = std::move(topic), payload = std::move(payload), retained,
-                         arrival = Clock::now()] {
-            pending_commands_.fetch_sub(1);
-            if (!stopped_) handle(topic, payload, retained, arrival);
-        });
-    } catch (...) {
-        // Not queued (out of memory): dropped, like a message beyond the bound.
-        pending_commands_.fetch_sub(1);
-        ++dropped_commands_;
-    }
+    // On the io_context's thread (the MQTT client's callbacks run there): handled now.
+    if (!stopped_) handle(topic, payload, retained, Clock::now());
 }
 
 void Bridge::handle(const std::string& topic, const std::string& payload, bool retained,
@@ -433,7 +423,7 @@ void Bridge::report() {
             {"published", m.published},
             {"dropped", m.dropped},
             {"connects", m.connects},
-            {"commands_dropped", dropped_commands_.load()},
+            {"commands_dropped", dropped_commands_},
             {"commands_rejected", format_->rejected_commands()},
             {"commands_failed", failed_commands_}};
         if (session_) j["session_connects"] = s.connects;

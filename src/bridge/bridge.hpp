@@ -3,7 +3,10 @@
 //
 //   PLC --FINS--> PlcPoller (plan, window, timeouts) --GroupSample--> PayloadFormat
 //       --Message--> MqttClient --> broker
-//   broker --> MqttClient --(bounded post)--> Bridge::command --> PlcPoller::write
+//   broker --> MqttClient --> Bridge::command --> PlcPoller::write
+//
+// One thread: the pollers, the MQTT clients (mqtt.hpp) and the write path all run on the
+// io_context's thread, so nothing here is shared with another thread.
 //
 // Ownership (ownership.hpp) decides which PLCs this instance polls: reconcile() starts
 // and stops pollers when it changes, and a write is executed only for an owned PLC.
@@ -27,7 +30,6 @@
 // of the process.
 #pragma once
 
-#include <atomic>
 #include <chrono>
 #include <deque>
 #include <functional>
@@ -49,7 +51,7 @@
 
 namespace fins::bridge {
 
-// Commands received and not yet taken by the io_context; more are dropped (and counted).
+// Commands held until this instance has joined (below); more are dropped (and counted).
 inline constexpr std::size_t max_pending_commands = 1024;
 
 class Bridge final : public PollerEvents {
@@ -66,7 +68,8 @@ class Bridge final : public PollerEvents {
     // Starts polling owned PLCs that are not polled and stops the others.
     void reconcile();
 
-    // Incoming MQTT message (any thread): posted to the io_context, bounded.
+    // Incoming MQTT message (on the io_context's thread, from the MQTT client): handled at
+    // once.
     void incoming(std::string topic, std::string payload, bool retained);
 
     [[nodiscard]] PayloadFormat& format() noexcept { return *format_; }
@@ -120,6 +123,8 @@ class Bridge final : public PollerEvents {
     void execute(const WriteCommand& w, std::chrono::steady_clock::time_point arrival);
     void refuse(const Refusal& r, bool retained);
     void rebirth();
+    // The birth sequence for the MQTT connection of `generation`, if it is still the one.
+    void births(std::uint64_t generation);
     void failed(const std::string& topic, bool retained, const std::optional<ParsedCommand>& parsed,
                 std::string_view what) noexcept;
     // Commands that came before this instance joined, handled in order once it has.
@@ -140,8 +145,7 @@ class Bridge final : public PollerEvents {
     std::map<std::string, PlcStatus, std::less<>> statuses_;
     std::map<std::string, IdMemory, std::less<>> ids_;
     std::deque<Held> held_;  // at most max_pending_commands
-    std::atomic<std::size_t> pending_commands_{0};
-    std::atomic<std::uint64_t> dropped_commands_{0};
+    std::uint64_t dropped_commands_ = 0;
     std::uint64_t failed_commands_ = 0;
     std::uint64_t failures_unlogged_ = 0;  // since the last failure log line
     std::chrono::steady_clock::time_point last_failure_log_{};

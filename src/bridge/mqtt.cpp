@@ -1,13 +1,15 @@
 #include "bridge/mqtt.hpp"
 
 #include <mosquitto.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <poll.h>
+#include <sys/socket.h>
 
 #include <algorithm>
 #include <random>
 
 #include <spdlog/spdlog.h>
-
-#include "bridge/poll_schedule.hpp"
 
 namespace fins::bridge {
 
@@ -18,19 +20,29 @@ void init_library() {
     (void)once;
 }
 
+std::uint64_t seed() {
+    std::random_device r;
+    return (std::uint64_t{r()} << 32) | r();
+}
+
 }  // namespace
 
-MqttClient::MqttClient(const Mqtt& config, Message will, Message online,
+MqttClient::MqttClient(asio::io_context& io, const Mqtt& config, Message will, Message online,
                        std::vector<std::string> subscriptions, Handlers handlers, bool persistent)
-    : config_(config),
+    : io_(io),
+      config_(config),
       will_(std::move(will)),
       online_(std::move(online)),
       subscriptions_(std::move(subscriptions)),
       handlers_(std::move(handlers)),
-      persistent_(persistent) {}
+      persistent_(persistent),
+      misc_timer_(io),
+      retry_timer_(io),
+      backoff_(config.backoff_min, config.backoff_max, seed()) {}
 
 MqttClient::~MqttClient() {
-    if (thread_.joinable()) stop(will_);
+    if (mosq_ != nullptr && !closing_) stop(will_);
+    unwrap();
     if (mosq_ != nullptr) mosquitto_destroy(mosq_);
 }
 
@@ -43,6 +55,9 @@ bool MqttClient::start(std::string& error) {
         error = "mosquitto_new failed";
         return false;
     }
+    // "Threaded" for libmosquitto means only that publish() queues and does not write: the
+    // io_context writes what was queued when the socket is writable, all of it at once
+    // (writable()), so that the messages of one turn of the loop share TCP segments.
     mosquitto_threaded_set(mosq_, true);
     mosquitto_int_option(mosq_, MOSQ_OPT_PROTOCOL_VERSION, MQTT_PROTOCOL_V311);
     mosquitto_int_option(mosq_, MOSQ_OPT_TCP_NODELAY, 1);
@@ -68,82 +83,193 @@ bool MqttClient::start(std::string& error) {
         error = fmt::format("MQTT settings refused: {}", mosquitto_strerror(rc));
         return false;
     }
-    thread_ = std::thread([this] { loop(); });
+    connect();
     return true;
 }
 
-void MqttClient::stop(const Message& last) {
-    {
-        std::lock_guard lock(mutex_);
-        if (closing_) return;
-        closing_ = true;
-        last_ = last;
+void MqttClient::connect() {
+    retrying_ = false;
+    if (closing_) return;
+    const Broker& b = config_.brokers[broker_ % config_.brokers.size()];
+    accepted_ = false;
+    if (handlers_.will && will_sent_) {
+        will_ = handlers_.will();
+        mosquitto_will_set(mosq_, will_.topic.c_str(), static_cast<int>(will_.payload.size()),
+                           will_.payload.data(), will_.qos, will_.retain);
+        will_sent_ = false;
     }
-    wake_.notify_all();
-    if (thread_.joinable()) thread_.join();
+    ++generation_;
+    // The old socket (if any) is closed by libmosquitto here and the new one may get its
+    // number: stop watching it first.
+    unwrap();
+    const int rc = mosquitto_connect_async(mosq_, b.host.c_str(), b.port,
+                                           static_cast<int>(config_.keepalive.count()));
+    if (rc != MOSQ_ERR_SUCCESS)
+        spdlog::warn("MQTT broker {}:{}: {}", b.host, b.port, mosquitto_strerror(rc));
+    sync();
 }
 
-bool MqttClient::wait(std::chrono::milliseconds d) {
-    std::unique_lock lock(mutex_);
-    return !wake_.wait_for(lock, d, [this] { return closing_; });
+void MqttClient::unwrap() noexcept {
+    if (socket_) {
+        // Ends the waits (operation_aborted) without closing libmosquitto's socket.
+        (void)socket_->release();
+        socket_.reset();
+    }
+    fd_ = -1;
+    ++wraps_;
+    reading_ = false;
+    writing_ = false;
 }
 
-void MqttClient::loop() {
-    Backoff backoff(config_.backoff_min, config_.backoff_max,
-                    (std::uint64_t{std::random_device{}()} << 32) | std::random_device{}());
-    std::size_t broker = 0;
-    const auto closing = [this] {
-        std::lock_guard lock(mutex_);
-        return closing_;
-    };
-    // A new Will (Sparkplug: the next bdSeq) only once the last one went out in a CONNECT:
-    // an attempt that reached no broker sent none.
-    bool will_sent = true;
-    while (!closing()) {
-        const Broker& b = config_.brokers[broker % config_.brokers.size()];
-        accepted_ = false;
-        if (handlers_.will && will_sent) {
-            will_ = handlers_.will();
-            mosquitto_will_set(mosq_, will_.topic.c_str(), static_cast<int>(will_.payload.size()),
-                               will_.payload.data(), will_.qos, will_.retain);
-            will_sent = false;
-        }
-        int rc = mosquitto_connect(mosq_, b.host.c_str(), b.port,
-                                   static_cast<int>(config_.keepalive.count()));
-        if (rc == MOSQ_ERR_SUCCESS) {
-            will_sent = true;  // connected: the CONNECT with this Will is on its way
-            while (rc == MOSQ_ERR_SUCCESS && !closing())
-                rc = mosquitto_loop(mosq_, 100, 1);
-            if (closing() && connected_) {
-                // A clean goodbye: the offline status, then DISCONNECT (no Will).
-                Message last;
-                {
-                    std::lock_guard lock(mutex_);
-                    last = last_;
-                }
-                mosquitto_publish(mosq_, nullptr, last.topic.c_str(),
-                                  static_cast<int>(last.payload.size()), last.payload.data(),
-                                  last.qos, last.retain);
+void MqttClient::sync() {
+    if (closing_ || mosq_ == nullptr) return;
+    const int fd = mosquitto_socket(mosq_);
+    if (fd != fd_) {
+        unwrap();
+        if (fd >= 0) {
+            socket_.emplace(io_);
+            boost::system::error_code ec;
+            socket_->assign(fd, ec);
+            if (ec) {
+                spdlog::warn("MQTT socket cannot be watched: {}", ec.message());
+                socket_.reset();
                 mosquitto_disconnect(mosq_);
-                for (int i = 0; i < 20 && mosquitto_loop(mosq_, 100, 1) == MOSQ_ERR_SUCCESS; ++i) {
-                }
-                connected_ = false;
+                lost();
                 return;
             }
-        } else {
-            spdlog::warn("MQTT broker {}:{}: {}", b.host, b.port, mosquitto_strerror(rc));
+            fd_ = fd;
         }
-        connected_ = false;
-        queued_ = 0;  // what libmosquitto held for the lost connection is gone
-        if (accepted_ && handlers_.disconnected) handlers_.disconnected();
-        if (closing()) return;
-        if (accepted_) {
-            backoff.reset();  // a lost session: the same broker first
-        } else {
-            ++broker;  // refused or unreachable: the next one
-        }
-        if (!wait(backoff.next())) return;
     }
+    if (fd < 0) {
+        lost();
+        return;
+    }
+    if (!reading_) wait_read();
+    if (!writing_ && mosquitto_want_write(mosq_)) wait_write();
+    if (!misc_armed_) misc();
+}
+
+void MqttClient::wait_read() {
+    reading_ = true;
+    socket_->async_wait(
+        asio::posix::descriptor_base::wait_read,
+        [this, alive = std::weak_ptr<int>(alive_), w = wraps_](boost::system::error_code ec) {
+            if (alive.expired() || ec || w != wraps_) return;
+            reading_ = false;
+            readable();
+        });
+}
+
+void MqttClient::wait_write() {
+    writing_ = true;
+    socket_->async_wait(
+        asio::posix::descriptor_base::wait_write,
+        [this, alive = std::weak_ptr<int>(alive_), w = wraps_](boost::system::error_code ec) {
+            if (alive.expired() || ec || w != wraps_) return;
+            writing_ = false;
+            writable();
+        });
+}
+
+void MqttClient::misc() {
+    misc_armed_ = true;
+    misc_timer_.expires_after(std::chrono::seconds(1));
+    misc_timer_.async_wait(
+        [this, alive = std::weak_ptr<int>(alive_)](boost::system::error_code ec) {
+            if (alive.expired() || ec) return;
+            misc_armed_ = false;
+            if (closing_ || fd_ < 0) return;
+            // Keepalive: PINGREQ when due; closes a connection whose broker went quiet (also an
+            // attempt whose CONNACK did not come within the keepalive).
+            mosquitto_loop_misc(mosq_);
+            sync();
+        });
+}
+
+void MqttClient::readable() {
+    // Also drives the TLS handshake while it wants to read.
+    mosquitto_loop_read(mosq_, 1);
+    sync();
+}
+
+void MqttClient::writable() {
+    // Before CONNACK a TLS handshake may wait for the socket to take its bytes: only
+    // loop_read drives the handshake (loop_write waits for it to end), and it is harmless
+    // when nothing is to be read.
+    if (!accepted_ && !config_.ca_file.empty()) {
+        mosquitto_loop_read(mosq_, 1);
+        if (mosquitto_socket(mosq_) != fd_) return sync();
+    }
+    // Corked: the packets written now leave in as few segments as they fill (TCP_NODELAY
+    // would send each on its own), and uncorking sends the rest at once.
+    int on = 1;
+    ::setsockopt(fd_, IPPROTO_TCP, TCP_CORK, &on, sizeof on);
+    mosquitto_loop_write(mosq_, 1);
+    if (const int fd = mosquitto_socket(mosq_); fd == fd_ && fd >= 0) {
+        on = 0;
+        ::setsockopt(fd, IPPROTO_TCP, TCP_CORK, &on, sizeof on);
+        // Written, CONNECT included: its Will reached a broker (with TLS: once CONNACK says so;
+        // until the handshake ends nothing is written).
+        if (!will_sent_ && config_.ca_file.empty() && !mosquitto_want_write(mosq_))
+            will_sent_ = true;
+    }
+    sync();
+}
+
+void MqttClient::lost() {
+    unwrap();
+    if (retrying_ || closing_) return;
+    retrying_ = true;
+    misc_timer_.cancel();
+    misc_armed_ = false;
+    connected_ = false;
+    queued_ = 0;  // what libmosquitto held for the lost connection is gone
+    const bool was_accepted = accepted_;
+    accepted_ = false;
+    if (was_accepted) {
+        backoff_.reset();  // a lost session: the same broker first
+    } else {
+        ++broker_;  // refused or unreachable: the next one
+    }
+    retry_timer_.expires_after(backoff_.next());
+    retry_timer_.async_wait(
+        [this, alive = std::weak_ptr<int>(alive_)](boost::system::error_code ec) {
+            if (alive.expired() || ec) return;
+            connect();
+        });
+    if (was_accepted && handlers_.disconnected) handlers_.disconnected();
+}
+
+void MqttClient::stop(const Message& last) {
+    if (closing_ || mosq_ == nullptr) return;
+    closing_ = true;
+    retry_timer_.cancel();
+    misc_timer_.cancel();
+    unwrap();  // from here on the socket is driven below, bounded in time
+    if (connected_) {
+        // A clean goodbye: the offline status, then DISCONNECT (no Will). libmosquitto closes
+        // the socket once the DISCONNECT is written.
+        mosquitto_publish(mosq_, nullptr, last.topic.c_str(), static_cast<int>(last.payload.size()),
+                          last.payload.data(), last.qos, last.retain);
+        mosquitto_disconnect(mosq_);
+        const auto deadline = std::chrono::steady_clock::now() + stop_timeout;
+        for (int fd = mosquitto_socket(mosq_); fd >= 0; fd = mosquitto_socket(mosq_)) {
+            const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+                deadline - std::chrono::steady_clock::now());
+            if (left.count() <= 0) break;
+            pollfd p{fd, static_cast<short>(POLLIN | (mosquitto_want_write(mosq_) ? POLLOUT : 0)),
+                     0};
+            if (::poll(&p, 1, static_cast<int>(left.count())) < 0) break;
+            if ((p.revents & (POLLOUT | POLLERR | POLLHUP)) != 0)
+                mosquitto_loop_write(mosq_, 1);
+            else if ((p.revents & POLLIN) != 0)
+                mosquitto_loop_read(mosq_, 1);
+        }
+    }
+    connected_ = false;
+    // Whatever is still open is closed now, without waiting for the broker.
+    mosquitto_destroy(mosq_);
+    mosq_ = nullptr;
 }
 
 void MqttClient::on_connect(mosquitto* m, void* p, int rc) {
@@ -154,6 +280,7 @@ void MqttClient::on_connect(mosquitto* m, void* p, int rc) {
         return;
     }
     self->accepted_ = true;
+    self->will_sent_ = true;
     self->connected_ = true;
     ++self->connects_;
     for (const auto& s : self->subscriptions_)
@@ -163,26 +290,29 @@ void MqttClient::on_connect(mosquitto* m, void* p, int rc) {
         mosquitto_publish(m, nullptr, o.topic.c_str(), static_cast<int>(o.payload.size()),
                           o.payload.data(), o.qos, o.retain);
     spdlog::info("MQTT connected");
-    if (self->handlers_.connected) self->handlers_.connected();
+    if (self->handlers_.connected) self->handlers_.connected(self->generation_);
 }
 
 void MqttClient::on_disconnect(mosquitto*, void* p, int rc) {
     auto* self = static_cast<MqttClient*>(p);
     self->connected_ = false;
-    if (rc != 0) spdlog::warn("MQTT connection lost: {}", mosquitto_strerror(rc));
+    if (rc == 0 || self->closing_) return;
+    // libmosquitto 2.0.11 has no text for MOSQ_ERR_KEEPALIVE.
+    spdlog::warn("MQTT connection lost: {}",
+                 rc == MOSQ_ERR_KEEPALIVE
+                     ? "no answer from the broker within the keepalive (or no CONNACK)"
+                     : mosquitto_strerror(rc));
 }
 
 void MqttClient::on_publish(mosquitto*, void* p, int) {
     auto* self = static_cast<MqttClient*>(p);
-    std::size_t q = self->queued_.load();
-    while (q > 0 && !self->queued_.compare_exchange_weak(q, q - 1)) {
-    }
+    if (self->queued_ > 0) --self->queued_;
 }
 
 void MqttClient::on_message(mosquitto*, void* p, const mosquitto_message* m) {
     auto* self = static_cast<MqttClient*>(p);
     ++self->received_;
-    if (!self->handlers_.message) return;
+    if (!self->handlers_.message || self->closing_) return;
     self->handlers_.message(m->topic,
                             std::string(static_cast<const char*>(m->payload),
                                         static_cast<std::size_t>(std::max(m->payloadlen, 0))),
@@ -190,30 +320,25 @@ void MqttClient::on_message(mosquitto*, void* p, const mosquitto_message* m) {
 }
 
 bool MqttClient::publish(const Message& m) {
-    if (!connected_ && m.qos == 0) {
+    if (mosq_ == nullptr || closing_ || (!connected_ && m.qos == 0) ||
+        queued_ >= config_.queue_limit) {
         ++dropped_;
         return false;
     }
-    if (queued_.fetch_add(1) >= config_.queue_limit) {
-        queued_.fetch_sub(1);
-        ++dropped_;
-        return false;
-    }
+    ++queued_;
     const int rc =
         mosquitto_publish(mosq_, nullptr, m.topic.c_str(), static_cast<int>(m.payload.size()),
                           m.payload.data(), m.qos, m.retain);
     // QoS 1 while disconnected: libmosquitto keeps it and sends it after the reconnect.
     if (rc != MOSQ_ERR_SUCCESS && !(rc == MOSQ_ERR_NO_CONN && m.qos > 0)) {
-        queued_.fetch_sub(1);
+        if (queued_ > 0) --queued_;
         ++dropped_;
         return false;
     }
     ++published_;
+    // Written when the socket is writable (writable()).
+    if (socket_ && !writing_ && mosquitto_want_write(mosq_)) wait_write();
     return true;
-}
-
-MqttStats MqttClient::stats() const {
-    return {published_.load(), dropped_.load(), connects_.load(), received_.load()};
 }
 
 }  // namespace fins::bridge

@@ -126,7 +126,8 @@ class PayloadFormat {
     // CONNECT) says so here. Its subscriptions and messages then travel on that second
     // connection, and the bridge's status and membership stay on the first.
     [[nodiscard]] virtual bool own_session() const { return false; }
-    // The Will for the session's next CONNECT (called on the MQTT thread before each one).
+    // The Will for the session's next CONNECT (asked for by the MQTT client before each one,
+    // on the bridge's thread).
     virtual Message session_will() { return {}; }
     // Published on the session before a clean disconnect.
     [[nodiscard]] virtual Message session_goodbye() const { return {}; }

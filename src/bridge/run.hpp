@@ -1,5 +1,5 @@
-// Runs the bridge until SIGINT/SIGTERM: the poller on one io_context, MQTT on its own
-// thread (mqtt.hpp). Returns the process exit code (0 clean, 3 start-up failure).
+// Runs the bridge until SIGINT/SIGTERM: the pollers and MQTT (mqtt.hpp) on one io_context,
+// on one thread. Returns the process exit code (0 clean, 3 start-up failure).
 #pragma once
 
 #include <string>

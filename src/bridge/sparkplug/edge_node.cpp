@@ -70,14 +70,15 @@ void EdgeNode::finish(std::string t, int qos, std::vector<Message>& out) {
 Message EdgeNode::next_will(std::uint64_t now_ms) {
     // bdSeq starts at 0 and steps by one per CONNECT, 255 -> 0 (chapter 5, "Edge Node Session
     // Establishment").
-    if (have_will_.exchange(true)) bd_seq_ = (bd_seq_.load() + 1) % 256;
+    if (have_will_) bd_seq_ = (bd_seq_ + 1) % 256;
+    have_will_ = true;
     return death(now_ms);
 }
 
 Message EdgeNode::death(std::uint64_t now_ms) const {
     PbPayload p;
     p.set_timestamp(now_ms);
-    add_bdseq(p, bd_seq_.load(), now_ms);
+    add_bdseq(p, bd_seq_, now_ms);
     Message m;
     m.topic = topic("NDEATH");
     m.qos = 1;  // the Will is QoS 1, not retained; NDEATH carries no seq
@@ -116,7 +117,7 @@ void EdgeNode::birth(std::uint64_t now_ms, std::vector<Message>& out) {
     scratch_.Clear();
     scratch_.set_timestamp(now_ms);
     scratch_.set_seq(take_seq());
-    add_bdseq(scratch_, bd_seq_.load(), now_ms);
+    add_bdseq(scratch_, bd_seq_, now_ms);
     add_node_metric_bool(scratch_, rebirth_metric, false, now_ms);
     finish(topic("NBIRTH"), 0, out);
     born_ = true;

@@ -18,7 +18,6 @@
 // the Will is QoS 1. Nothing is published for a device before the NBIRTH of the session.
 #pragma once
 
-#include <atomic>
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -81,10 +80,8 @@ class EdgeNode {
     const std::string& edge_node_id() const noexcept { return edge_node_id_; }
 
     // The NDEATH Will for the next MQTT CONNECT; advances bdSeq (the first call gives 0).
-    // Thread-safe against the other members: the MQTT thread calls it before connecting
-    // while the bridge's thread publishes.
     Message next_will(std::uint64_t now_ms);
-    std::uint64_t bd_seq() const noexcept { return bd_seq_.load(); }
+    std::uint64_t bd_seq() const noexcept { return bd_seq_; }
 
     // Topic filters to subscribe to (QoS 1) before birth().
     std::vector<std::string> subscriptions() const;
@@ -144,8 +141,8 @@ class EdgeNode {
     std::string edge_node_id_;
     std::map<std::string, Device, std::less<>> devices_;
     std::uint64_t next_alias_base_ = 1;
-    std::atomic<std::uint64_t> bd_seq_{0};
-    std::atomic<bool> have_will_{false};
+    std::uint64_t bd_seq_ = 0;
+    bool have_will_ = false;
     bool born_ = false;
     std::uint8_t seq_ = 0;
     PbPayload scratch_;  // reused for every message: its repeated fields keep their capacity

@@ -19,7 +19,6 @@
 // failed command is logged and counted (rejected(), rejected_commands()), never executed.
 #pragma once
 
-#include <atomic>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -53,7 +52,8 @@ class SparkplugPayload final : public PayloadFormat {
 
     // The Edge Node session is a connection of its own: its Will is the NDEATH.
     [[nodiscard]] bool own_session() const override { return true; }
-    // The NDEATH Will for the session's next CONNECT (bdSeq + 1); on the MQTT thread. Until
+    // The NDEATH Will for the session's next CONNECT (bdSeq + 1), asked for by the MQTT
+    // client on the bridge's thread before it connects. Until
     // the births that follow the CONNECT nothing else is published (DDATA before NBIRTH
     // would make host applications ask for a rebirth).
     bridge::Message session_will() override;
@@ -86,7 +86,7 @@ class SparkplugPayload final : public PayloadFormat {
     std::vector<MetricUpdate> updates_;
     std::uint64_t next_id_ = 0;
     std::uint64_t rejected_ = 0;
-    std::atomic<bool> awaiting_birth_{true};
+    bool awaiting_birth_ = true;
 };
 
 }  // namespace fins::bridge::sparkplug
