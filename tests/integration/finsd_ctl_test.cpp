@@ -181,10 +181,22 @@ TEST(FinsdCtl, Issue26_8_FinsdAndCtlMeetAtTheDefaultSocketWithoutFlags) {
 
 // Issue 26 point 8: with no finsd at the default places, `finsd ctl` names the place and
 // says how to start finsd with a control channel (the exact flag).
+// A finsd another test (or a user) runs may hold /run/finsd/finsd.sock or /tmp/finsd-UID:
+// as root the command runs in its own mount namespace with empty /run and /tmp, so that
+// no default place holds a socket.
 TEST(FinsdCtl, Issue26_8_CtlErrorSaysHowToStartFinsdWithAChannel) {
     ScratchDir dir("ctlnone");
-    const auto r = run({"/usr/bin/env", "-u", "FINSD_SOCKET",
-                        "XDG_RUNTIME_DIR=" + dir.path().string(), finsd_path, "ctl", "status"});
+    std::vector<std::string> command{"/usr/bin/env", "-u", "FINSD_SOCKET",
+                                     "XDG_RUNTIME_DIR=" + dir.path().string(), finsd_path,
+                                     "ctl", "status"};
+    if (::geteuid() == 0 && ::access("/usr/bin/unshare", X_OK) == 0) {
+        std::string line = "mount -t tmpfs none /run && mount -t tmpfs none /tmp && exec";
+        for (const auto& word : command)
+            line += " '" + word + "'";
+        command = {"/usr/bin/unshare", "--mount", "--propagation", "private", "/bin/sh", "-c",
+                   line};
+    }
+    const auto r = run(command);
     EXPECT_NE(r.exit_code, 0);
     // The first default place that holds a socket, else the first: a stale socket another
     // run left at /run/finsd or /tmp/finsd-UID may be named instead of the scratch one.
