@@ -103,7 +103,7 @@ TEST(ScenarioRealTime, StartLogNamesTheScenarioAndTheSerialPorts) {
              "cpu=" + host_link_line.a()});
     // In the order finsd starts them (each wait reads on from the line before).
     EXPECT_TRUE(d.wait_for_stderr("finsd: serial gateway port scu1.2 on " + gateway_line.a() +
-                                  ", unit address"));
+                                  ", unit address 85"));
     EXPECT_TRUE(d.wait_for_stderr("finsd: scenario " + examples +
                                   "live.toml: 6 tags, 0 events, real time x1, tick 100 ms"));
     EXPECT_TRUE(d.wait_for_stderr("finsd: serial cpu on " + host_link_line.a()));
