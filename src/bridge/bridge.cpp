@@ -27,13 +27,6 @@ std::int64_t epoch_ms() {
         .count();
 }
 
-const Tag* find_tag(const Plc& plc, std::string_view name) {
-    for (const auto& g : plc.groups)
-        for (const auto& t : g.tags)
-            if (t.name == name) return &t;
-    return nullptr;
-}
-
 }  // namespace
 
 Bridge::Bridge(asio::io_context& io, const BridgeConfig& config,
@@ -151,14 +144,21 @@ void Bridge::publish(Message&& m) {
 
 void Bridge::group_done(const GroupSample& sample) {
     format_->values(sample, sink_);
+    const auto st = statuses_.find(sample.plc->name);
+    const auto p = pollers_.find(sample.plc->name);
+    if (st != statuses_.end() && p != pollers_.end())
+        if (auto next = tag_failures_.cycle(sample, st->second, p->second->destination()))
+            status_changed(*next);
 }
 
 void Bridge::status_changed(const PlcStatus& status) {
     statuses_[status.plc->name] = status;
-    if (status.online)
+    if (!status.failing) tag_failures_.reset(status.plc->name);
+    if (status.online && !status.failing)
         spdlog::info("PLC {} online", status.plc->name);
     else
-        spdlog::warn("PLC {} offline: {}", status.plc->name, status.last_error);
+        spdlog::warn("PLC {} {}: {}", status.plc->name, status.online ? "failing" : "offline",
+                     status.last_error);
     format_->status(status, sink_);
 }
 
@@ -368,7 +368,7 @@ void Bridge::execute(const WriteCommand& w, Clock::time_point arrival) {
         return refuse(fmt::format("command older than the TTL ({} ms)", ttl.count()));
     if (Clock::now() - arrival > ttl)
         return refuse(fmt::format("command waited longer than the TTL ({} ms)", ttl.count()));
-    const Tag* tag = find_tag(plc, w.tag);
+    const Tag* tag = plc.find_tag(w.tag);
     if (tag == nullptr) return refuse(fmt::format("no tag '{}' on PLC '{}'", w.tag, plc.name));
     if (!tag->writable) return refuse(fmt::format("tag '{}' is not writable", w.tag));
     Encoded value;

@@ -48,6 +48,7 @@
 #include "bridge/ownership.hpp"
 #include "bridge/payload.hpp"
 #include "bridge/poller.hpp"
+#include "bridge/tag_failures.hpp"
 
 namespace fins::bridge {
 
@@ -142,6 +143,7 @@ class Bridge final : public PollerEvents {
     std::unique_ptr<MqttClient> session_;  // the format's own connection (own_session())
     Sink sink_;
     std::map<std::string, std::unique_ptr<PlcPoller>, std::less<>> pollers_;
+    TagFailures tag_failures_;  // PLCs online whose every tag fails
     std::map<std::string, PlcStatus, std::less<>> statuses_;
     std::map<std::string, IdMemory, std::less<>> ids_;
     std::deque<Held> held_;  // at most max_pending_commands

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <tl/expected.hpp>
@@ -73,6 +74,14 @@ struct Plc {
     std::chrono::milliseconds backoff_min{500};
     std::chrono::milliseconds backoff_max{30000};
     std::vector<Group> groups;
+
+    // The tag named `tag` of any group; null when there is none.
+    [[nodiscard]] const Tag* find_tag(std::string_view tag) const {
+        for (const auto& g : groups)
+            for (const auto& t : g.tags)
+                if (t.name == tag) return &t;
+        return nullptr;
+    }
 };
 
 struct Broker {

@@ -52,8 +52,11 @@ void JsonPayload::values(const GroupSample& s, const Sink& out) {
 void JsonPayload::status(const PlcStatus& st, const Sink& out) {
     // The owner: a retained "online" outlives a bridge killed with -9, and is current only
     // while {prefix}/$bridge/{instance}/status says online too (docs/bridge.md).
-    nlohmann::json j{
-        {"state", st.online ? "online" : "offline"}, {"ts", st.ts_ms}, {"instance", instance_}};
+    nlohmann::json j{{"state", !st.online   ? "offline"
+                               : st.failing ? "failing"
+                                            : "online"},
+                     {"ts", st.ts_ms},
+                     {"instance", instance_}};
     if (!st.last_error.empty()) j["error"] = st.last_error;
     out({fmt::format("{}/{}/status", prefix_, st.plc->name), j.dump(), 1, true});
 }

@@ -1,7 +1,8 @@
 // The JSON payload format (docs/bridge.md "Topics and payloads"):
 //   {prefix}/{plc}/{group}            {"ts":1700000000000,"values":{"speed":12,"run":true,
 //                                      "temp":{"error":"timeout"}}[,"full":true]}
-//   {prefix}/{plc}/status             retained {"state":"online"|"offline","ts":..,"error":..}
+//   {prefix}/{plc}/status             retained {"state":"online"|"offline"|"failing","ts":..,
+//                                      "error":..} (failing: tag_failures.hpp)
 //   {prefix}/$bridge/{instance}/status retained {"state":"online"|"offline","instance":..}
 //   {prefix}/{plc}/write              in:  {"id":"..","tag":"temp","value":1.5[,"ts":ms]}
 //   {prefix}/{plc}/write/response     out: {"id":..,"ok":..,"end_code":..,"value":..,"error":..}

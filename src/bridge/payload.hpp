@@ -66,6 +66,9 @@ struct PlcStatus {
     bool online = false;
     std::string last_error;  // empty when none
     std::int64_t ts_ms = 0;
+    // Online, but every tag fails with an end code (tag_failures.hpp): state "failing",
+    // last_error says why and what to set.
+    bool failing = false;
 };
 
 // A write command, parsed. `id` is the caller's; `tag` a tag name of the PLC.

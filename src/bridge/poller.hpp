@@ -86,6 +86,8 @@ class PlcPoller {
     [[nodiscard]] bool running() const noexcept { return running_; }
     [[nodiscard]] bool online() const noexcept { return state_ == State::online; }
     [[nodiscard]] const Plc& plc() const noexcept { return plc_; }
+    // The node its frames go to (dest, the IP's last number, or the TCP handshake's).
+    [[nodiscard]] const NodeAddress& destination() const noexcept { return destination_; }
     [[nodiscard]] const PollerStats& stats() const noexcept { return stats_; }
     // The next cycle of every group publishes all its tags (after an MQTT reconnect: what
     // was published while disconnected was dropped).

@@ -39,10 +39,11 @@ TEST(NodeFromAddress, LastOctetAndLoopback) {
     EXPECT_EQ(node_of("192.168.250.10"), 10);
     EXPECT_EQ(node_of("10.0.0.254"), 254);
     EXPECT_EQ(node_of("127.0.0.1"), 1);
-    EXPECT_EQ(node_of("127.0.0.9"), 1) << "any loopback address is node 1";
+    EXPECT_EQ(node_of("127.0.0.9"), 9) << "loopback: the last octet too (W420 5-2)";
     EXPECT_EQ(node_of("::1"), 1);
     EXPECT_EQ(node_of("::ffff:192.168.0.7"), 7);
     EXPECT_EQ(node_of("::ffff:127.0.0.1"), 1);
+    EXPECT_EQ(node_of("::ffff:127.0.1.5"), 5);
     EXPECT_EQ(node_of("fe80::1:12"), 0x12);
 }
 

@@ -53,7 +53,8 @@ TEST_F(CliDiscover, W342_5_3_15_ListsTheNodesThatAnswerInRangeOrder) {
     EXPECT_EQ(doc["hosts"], 9);
     ASSERT_EQ(doc["nodes"].size(), 2u) << doc.dump();
     EXPECT_EQ(doc["nodes"][0]["host"], "127.0.0.2");
-    EXPECT_EQ(doc["nodes"][0]["node"], "0.1.0");  // finsd on loopback: node 1
+    // finsd --bind 127.0.0.2: node 2, the last octet on loopback too (W420 5-2)
+    EXPECT_EQ(doc["nodes"][0]["node"], "0.2.0");
     EXPECT_EQ(doc["nodes"][0]["model"], "CJ2H-CPU68-EIP");
     EXPECT_FALSE(doc["nodes"][0]["version"].get<std::string>().empty());
     EXPECT_EQ(doc["nodes"][1]["host"], "127.0.0.5");

@@ -209,7 +209,14 @@ tl::expected<ScenarioConfig, std::string> load_scenario_text(std::string_view te
     return config;
 }
 
-tl::expected<ScenarioConfig, std::string> reload_scenario(const ScenarioConfig& old) {
+void set_scenario_time(ScenarioConfig& config, bool virtual_time) {
+    config.def.virtual_time = virtual_time;
+    config.virtual_time = virtual_time;
+}
+
+namespace {
+
+tl::expected<ScenarioConfig, std::string> read_again(const ScenarioConfig& old) {
     if (old.reload_file.empty())
         return Unexpected("the scenario was given as text, not a file: nothing to reload");
     if (old.plc.empty()) {
@@ -239,6 +246,14 @@ tl::expected<ScenarioConfig, std::string> reload_scenario(const ScenarioConfig& 
     }
     return tl::unexpected(fmt::format("{}: the [[plc]] named {} has no scenario table any more",
                                       old.reload_file.string(), old.plc));
+}
+
+}  // namespace
+
+tl::expected<ScenarioConfig, std::string> reload_scenario(const ScenarioConfig& old) {
+    auto fresh = read_again(old);
+    if (fresh && old.virtual_time) set_scenario_time(*fresh, *old.virtual_time);
+    return fresh;
 }
 
 tl::expected<std::unique_ptr<scenario::Scenario>, std::string> compile_scenario(

@@ -45,6 +45,8 @@ struct ScenarioConfig {
     // with `plc` the one of the [[plc]] of that name.
     std::filesystem::path reload_file;
     std::string plc;
+    // finsd --scenario-time: replaces the file's `time` (true: virtual), on reload too.
+    std::optional<bool> virtual_time;
 };
 
 // The [scenario] table `node` of `source` (path "scenario" or "plc[N].scenario").
@@ -57,7 +59,10 @@ tl::expected<ScenarioConfig, std::string> load_scenario_file(const std::filesyst
 // in errors, and a `file = ...` it names is relative to the working directory.
 tl::expected<ScenarioConfig, std::string> load_scenario_text(std::string_view text,
                                                              std::string_view source);
-// Reads the scenario again from where it came from (reload_file, plc).
+// Sets the scenario's time, real or virtual, for this run and its reloads (--scenario-time).
+void set_scenario_time(ScenarioConfig& config, bool virtual_time);
+// Reads the scenario again from where it came from (reload_file, plc), with the time
+// --scenario-time set.
 tl::expected<ScenarioConfig, std::string> reload_scenario(const ScenarioConfig& old);
 // Compiles the definition against `plc`, wording errors with their file position.
 tl::expected<std::unique_ptr<scenario::Scenario>, std::string> compile_scenario(

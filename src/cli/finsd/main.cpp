@@ -131,7 +131,7 @@ int configure(int argc, char** argv, Settings& settings) {
                        "[[plc.ethernet]] unit without a port of its own");
     auto* o_node =
         app.add_option("--node", node,
-                       "FINS node address 1-254 (default: last octet of --bind, 1 on loopback)")
+                       "FINS node address 1-254 (default: last octet of --bind; 1 for 0.0.0.0, ::)")
             ->check(CLI::Range(1, 254));
     auto* o_network =
         app.add_option("--network", network, "FINS network address 0-127 (0 = local network)")
@@ -190,6 +190,10 @@ int configure(int argc, char** argv, Settings& settings) {
         "--scenario", scenario_file,
         "A file with a [scenario] table: signals, links and events that make memory move "
         "(docs/scenarios.md); replaces the configuration's [scenario]");
+    std::string scenario_time;
+    auto* o_time = app.add_option("--scenario-time", scenario_time,
+                                  "real or virtual: replaces every scenario's `time`")
+                       ->check(CLI::IsMember({"real", "virtual"}));
     app.add_flag("--reset-state", o.reset_state,
                  "Move a refused state file aside (never deleted) and start with a new one");
     try {
@@ -213,6 +217,9 @@ int configure(int argc, char** argv, Settings& settings) {
         if (!loaded) return fail(2, loaded.error());
         settings.scenario = std::move(*loaded);
     }
+    if (o_time->count() > 0)
+        if (auto r = fins::cli::finsd::override_scenario_time(settings, scenario_time); !r)
+            return fail(2, r.error());
     take(o_profile, profile, o.profile);
     take(o_mode, mode, o.mode);
     take(o_data, data_dir, o.data_dir);

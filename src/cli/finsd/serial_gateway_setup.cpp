@@ -81,6 +81,9 @@ void open_gateway_ports(asio::io_context& io, const std::vector<SerialPortConfig
         if (const auto ec = gateway->open())
             spdlog::warn("finsd: serial gateway port {}: {}: {} (answering 0205 until it opens)",
                          port.name, port.line.device, ec.message());
+        else
+            spdlog::info("finsd: serial gateway port {} on {}, unit address {:02X}", port.name,
+                         port.line.device, gateway_port_config(port).unit_address);
         out.add(std::move(gateway));
     }
 }
