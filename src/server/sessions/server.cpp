@@ -1,6 +1,6 @@
 #include "server/sessions/server.hpp"
 
-#include <arpa/inet.h>
+#include "transport/socket_headers.hpp"
 
 #include <algorithm>
 #include <array>

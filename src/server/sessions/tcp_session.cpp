@@ -1,8 +1,6 @@
 #include "server/sessions/tcp_session.hpp"
 
-#include <netinet/in.h>
-#include <netinet/tcp.h>
-#include <sys/socket.h>
+#include "transport/socket_headers.hpp"
 
 #include <algorithm>
 #include <cassert>
