@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
 
 namespace fins::transport::os {
 
@@ -105,5 +106,70 @@ Peek peek(NativeSocket s) noexcept {
     return errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR ? Peek::nothing : Peek::failed;
 #endif
 }
+
+#ifdef _WIN32
+
+void prepare_nonblocking(NativeSocket s) noexcept {
+    u_long on = 1;
+    ::ioctlsocket(s, static_cast<long>(FIONBIO), &on);
+}
+
+namespace {
+
+Moved moved(int n) noexcept {
+    if (n != SOCKET_ERROR) return {Moved::Kind::done, static_cast<std::size_t>(n), 0};
+    const int e = ::WSAGetLastError();
+    if (e == WSAEWOULDBLOCK) return {Moved::Kind::would_block, 0, e};
+    if (e == WSAEINTR) return {Moved::Kind::interrupted, 0, e};
+    return {Moved::Kind::failed, 0, e};
+}
+
+int int_size(std::size_t size) noexcept {
+    return static_cast<int>(std::min<std::size_t>(size, 0x7FFFFFFF));
+}
+
+}  // namespace
+
+Moved receive_now(NativeSocket s, std::uint8_t* into, std::size_t size) noexcept {
+    return moved(::recv(s, reinterpret_cast<char*>(into), int_size(size), 0));
+}
+
+Moved send_now(NativeSocket s, const std::uint8_t* data, std::size_t size) noexcept {
+    return moved(::send(s, reinterpret_cast<const char*>(data), int_size(size), 0));
+}
+
+std::string error_text(int error) {
+    return boost::system::error_code(error, boost::system::system_category()).message();
+}
+
+#else
+
+void prepare_nonblocking(NativeSocket) noexcept {}
+
+namespace {
+
+Moved moved(ssize_t n) noexcept {
+    if (n >= 0) return {Moved::Kind::done, static_cast<std::size_t>(n), 0};
+    const int e = errno;
+    if (e == EAGAIN || e == EWOULDBLOCK) return {Moved::Kind::would_block, 0, e};
+    if (e == EINTR) return {Moved::Kind::interrupted, 0, e};
+    return {Moved::Kind::failed, 0, e};
+}
+
+}  // namespace
+
+Moved receive_now(NativeSocket s, std::uint8_t* into, std::size_t size) noexcept {
+    return moved(::recv(s, into, size, MSG_DONTWAIT));
+}
+
+Moved send_now(NativeSocket s, const std::uint8_t* data, std::size_t size) noexcept {
+    return moved(::send(s, data, size, MSG_DONTWAIT | MSG_NOSIGNAL));
+}
+
+std::string error_text(int error) {
+    return std::strerror(error);
+}
+
+#endif
 
 }  // namespace fins::transport::os

@@ -3,7 +3,9 @@
 // (docs/windows.md): TCP keep-alive timing, a peek that tells a closed peer, and
 // clearing a pending socket error. Everything else goes through Asio.
 #include <chrono>
+#include <cstddef>
 #include <cstdint>
+#include <string>
 
 #include <boost/system/error_code.hpp>
 
@@ -38,5 +40,21 @@ enum class Peek { closed, data, nothing, failed };
 // Looks at the stream without consuming or blocking: closed (orderly end), data waiting,
 // nothing yet, or failed (reset and other errors).
 Peek peek(NativeSocket s) noexcept;
+
+// Puts the socket in non-blocking mode for receive_now/send_now on Windows; Linux passes
+// MSG_DONTWAIT on each call instead (nothing to do).
+void prepare_nonblocking(NativeSocket s) noexcept;
+
+// A read or write that never waits.
+struct Moved {
+    enum class Kind { done, would_block, interrupted, failed } kind = Kind::done;
+    std::size_t bytes = 0;  // when done (a read of 0: the peer closed its side)
+    int error = 0;          // when failed: errno, or the WSA error on Windows
+};
+Moved receive_now(NativeSocket s, std::uint8_t* into, std::size_t size) noexcept;
+// Never raises SIGPIPE on a closed peer (MSG_NOSIGNAL).
+Moved send_now(NativeSocket s, const std::uint8_t* data, std::size_t size) noexcept;
+// The text of a Moved::error.
+std::string error_text(int error);
 
 }  // namespace fins::transport::os

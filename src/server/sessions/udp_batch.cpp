@@ -1,8 +1,6 @@
 #include "server/sessions/udp_batch.hpp"
 
-#ifdef _WIN32
-#include <mstcpip.h>
-#else
+#ifndef _WIN32
 #include <sys/uio.h>
 #endif
 
@@ -33,13 +31,13 @@ Batch::Batch() = default;
 Batch::~Batch() = default;
 
 void prepare(transport::os::NativeSocket s) noexcept {
-    u_long on = 1;
-    ::ioctlsocket(s, FIONBIO, &on);
+    transport::os::prepare_nonblocking(s);
     // Without this, an ICMP port unreachable for an earlier reply fails the next recvfrom.
+    // SIO_UDP_CONNRESET is _WSAIOW(IOC_VENDOR, 12) (mstcpip.h of newer SDKs).
+    constexpr DWORD udp_connreset = 0x9800000C;
     BOOL report = FALSE;
     DWORD returned = 0;
-    ::WSAIoctl(s, SIO_UDP_CONNRESET, &report, sizeof report, nullptr, 0, &returned, nullptr,
-               nullptr);
+    ::WSAIoctl(s, udp_connreset, &report, sizeof report, nullptr, 0, &returned, nullptr, nullptr);
 }
 
 std::size_t receive(transport::os::NativeSocket s, Batch& b) noexcept {
