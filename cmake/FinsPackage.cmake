@@ -36,13 +36,20 @@ foreach(lib fins_shared fins_static)
   target_compile_features(${lib} PUBLIC cxx_std_20)
   # The public headers use tl::expected (fins::Result); fmt and threads are used inside.
   target_link_libraries(${lib} PUBLIC tl::expected PRIVATE fmt::fmt Threads::Threads)
+  if(WIN32)
+    # Winsock 2 and its extensions, under Asio's sockets.
+    target_link_libraries(${lib} PRIVATE ws2_32 mswsock)
+  endif()
 endforeach()
+# MinGW: fins.dll exports every symbol, as libfins.so does (no dllexport annotations).
+set_target_properties(fins_shared PROPERTIES WINDOWS_EXPORT_ALL_SYMBOLS ON)
 add_library(fins::fins ALIAS fins_shared)
 add_library(fins::fins_static ALIAS fins_static)
 
 set(FINS_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/fins)
 install(TARGETS fins_shared fins_static EXPORT finsTargets
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT lib NAMELINK_COMPONENT dev
+  RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT lib
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT dev)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/fins
   DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} COMPONENT dev)
@@ -64,7 +71,12 @@ foreach(pc fins fins-static)
     DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig COMPONENT dev)
 endforeach()
 
-install(TARGETS finsd fins RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
+if(WIN32)
+  # finsd is not ported to Windows yet (docs/windows.md); fins.dll beside the programs.
+  install(TARGETS fins RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
+else()
+  install(TARGETS finsd fins RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
+endif()
 # README.md and its pages under docs/ keep their relative links.
 install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR} COMPONENT runtime)
 file(GLOB fins_doc_pages CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/docs/*.md)
@@ -112,5 +124,9 @@ if(FINS_PYTHON)
   add_subdirectory(${PROJECT_SOURCE_DIR}/python ${PROJECT_BINARY_DIR}/python)
 endif()
 
-include(${CMAKE_CURRENT_LIST_DIR}/FinsDebian.cmake)
-include(${CMAKE_CURRENT_LIST_DIR}/FinsCPack.cmake)
+if(WIN32)
+  include(${CMAKE_CURRENT_LIST_DIR}/FinsWindowsPackage.cmake)
+else()
+  include(${CMAKE_CURRENT_LIST_DIR}/FinsDebian.cmake)
+  include(${CMAKE_CURRENT_LIST_DIR}/FinsCPack.cmake)
+endif()

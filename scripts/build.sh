@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Configures and builds one tree. Usage: scripts/build.sh [release|asan|fuzz|arm64] [TARGET...]
+# Configures and builds one tree. Usage: scripts/build.sh [release|asan|fuzz|arm64|windows] [TARGET...]
 # (no targets: everything the tree builds; for fuzz, every fuzzer: fuzz/CMakeLists.txt's
-# fuzz_all; for arm64, the programs and the unit tests it runs: tests/CMakeLists.txt's
+# fuzz_all; for arm64 and windows, the programs and the unit tests it runs: tests/CMakeLists.txt's
 # fins_cross_all). FINS_BUILD_DIR puts the tree elsewhere; FINS_NINJA_ARGS are extra ninja
 # options (-n: print what would be built, build nothing).
 set -euo pipefail
@@ -29,7 +29,15 @@ case "$kind" in
       -DCMAKE_INSTALL_PREFIX=/usr -DFINS_MAN=ON
       # GNUInstallDirs picks Debian's multiarch libdir only when not cross compiling.
       -DCMAKE_INSTALL_LIBDIR=lib/aarch64-linux-gnu) ;;
-  *) echo "usage: $0 [release|asan|fuzz|arm64]" >&2; exit 2 ;;
+  # Windows x86-64 (docs/windows.md): Debian's MinGW-w64 g++ (posix threads), the
+  # header-only libraries staged by cmake/FinsWindowsDeps.cmake, tests under wine.
+  windows) dir=build-windows
+    "$root/scripts/deps.sh" windows
+    args=(-DCMAKE_TOOLCHAIN_FILE="$root/cmake/toolchains/x86_64-w64-mingw32.cmake"
+      -DCMAKE_BUILD_TYPE=Release -DFINS_WERROR=ON
+      "-DCMAKE_CXX_FLAGS=-Wno-error=restrict -Wno-error=array-bounds -Wno-error=stringop-overflow"
+      -DFINS_BENCH=OFF -DFINS_EXAMPLES=OFF -DFINS_DOCS=OFF) ;;
+  *) echo "usage: $0 [release|asan|fuzz|arm64|windows]" >&2; exit 2 ;;
 esac
 # The finskit Python module (release tree) is for Debian's interpreter, whatever python3
 # comes first on PATH (a pyenv one may lack the headers, or be another version).
@@ -43,6 +51,6 @@ cmake -S "$root" -B "$dir" -G Ninja "${args[@]}" >/dev/null
 # The fuzz tree's "everything" would also build the libraries' other programs: its
 # default is the fuzzers alone, which CMake lists (fuzz_all).
 if [[ "$kind" == fuzz && $# -eq 0 ]]; then set -- fuzz_all; fi
-if [[ "$kind" == arm64 && $# -eq 0 ]]; then set -- fins_cross_all; fi
+if [[ ( "$kind" == arm64 || "$kind" == windows ) && $# -eq 0 ]]; then set -- fins_cross_all; fi
 read -r -a ninja_args <<<"${FINS_NINJA_ARGS:-}"
 ninja -C "$dir" -j "$jobs" "${ninja_args[@]}" "$@"

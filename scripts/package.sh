@@ -11,10 +11,21 @@
 #            the arm64 .debs (finskit, libfins0.1, libfins-dev; no python3-finskit: the
 #            module is built for the host's interpreter) from the cross tree build-arm64
 #            (scripts/build.sh arm64, docs/platforms.md), man pages made under qemu-user.
+#        scripts/package.sh windows
+#            finskit-VERSION-windows-x86_64.zip from the cross tree build-windows
+#            (scripts/build.sh windows, docs/windows.md).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build="$root/build-pkg"
 jobs=${FINS_JOBS:-$(nproc)}
+if [[ "${1:-}" == windows ]]; then
+  # The Windows zip (docs/windows.md) from the cross tree build-windows.
+  "$root/scripts/build.sh" windows all
+  rm -f "$root"/build-windows/finskit-*-windows-x86_64.zip
+  (cd "$root/build-windows" && cpack -G ZIP >/dev/null)
+  printf 'package: %s\n' "$root"/build-windows/finskit-*-windows-x86_64.zip
+  exit 0
+fi
 if [[ "${1:-}" == arm64 ]]; then
   # One arm64 tree for the tests and the packages: everything it builds, then CPack.
   "$root/scripts/build.sh" arm64 all

@@ -8,7 +8,9 @@
 #      briefly each, from the committed corpus (fuzz/corpus/);
 #   4. the Linux arm64 cross build: its unit tests and a round trip under qemu-user, and
 #      its .debs (docs/platforms.md);
-#   5. the installable package: Release tree, consumers, Python tests, the .deb.
+#   5. the Windows cross build: its unit tests and fins.exe under wine, and its .zip
+#      (docs/windows.md);
+#   6. the installable package: Release tree, consumers, Python tests, the .deb.
 # (One instrumented build instead of a Release one and an instrumented one keeps the
 # suite inside its time budget on 2 cores; scripts/run.sh builds Release.)
 set -euo pipefail
@@ -76,6 +78,20 @@ arm64_packages=$(sed -n 's/^arm64 packages: \([0-9]*\) checks passed$/\1/p' "$lo
 summary+=("arm64 packages: $arm64_packages checks passed")
 rm -f "$log"
 
+# ---- issue 28: Windows (docs/windows.md). The MinGW-w64 tree's unit tests and fins.exe
+# against the ASan finsd under wine, then the zip, checked (a CMake project built against it).
+echo "== windows: cross build, tests under wine"
+"$root/scripts/build.sh" windows
+run_ctest build-windows windows
+echo "== windows: zip"
+"$root/scripts/package.sh" windows
+log=$(mktemp)
+"$root/scripts/package_check_windows.sh" "$root"/build-windows/finskit-*-windows-x86_64.zip \
+  "$root/build-asan/bin" | tee "$log"
+windows_packages=$(sed -n 's/^windows package: \([0-9]*\) checks passed$/\1/p' "$log")
+summary+=("windows package: $windows_packages checks passed")
+rm -f "$log"
+
 # ---- issue 11: the installable package. A Release tree (build-pkg, prefix /usr) with
 # libfins, finsd, fins, the examples, the finskit Python module and the API reference
 # (Doxygen, warnings as errors); consumers built against it installed in a temporary
@@ -109,4 +125,5 @@ echo "== summary"
 printf '%s\n' "${summary[@]}"
 asan_total=$(ctest --test-dir build-asan -N | grep -Eo 'Total Tests: [0-9]+' | grep -Eo '[0-9]+')
 arm64_total=$(ctest --test-dir build-arm64 -N | grep -Eo 'Total Tests: [0-9]+' | grep -Eo '[0-9]+')
-echo "$((asan_total + soak_ok + fuzz_ok + arm64_total + arm64_packages + ${package_passed:-0})) passed, 0 failed"
+windows_total=$(ctest --test-dir build-windows -N | grep -Eo 'Total Tests: [0-9]+' | grep -Eo '[0-9]+')
+echo "$((asan_total + soak_ok + fuzz_ok + arm64_total + arm64_packages + windows_total + windows_packages + ${package_passed:-0})) passed, 0 failed"

@@ -1,8 +1,12 @@
 #include "transport/serial_port.hpp"
 
+#ifdef _WIN32
+#include <windows.h>
+#else
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
 #include <termios.h>
+#endif
 
 #include <cerrno>
 
@@ -40,16 +44,25 @@ boost::system::error_code SerialPort::open(const SerialSettings& line) {
 }
 
 bool SerialPort::is_pseudo_terminal() noexcept {
+#ifdef _WIN32
+    return false;  // COM ports, real or (Wine, com0com) mapped: no pty rule to bend
+#else
     struct stat st {};
     if (!port_.is_open() || ::fstat(port_.native_handle(), &st) != 0) return false;
     // Unix98 pty slaves: character devices with majors 136-143 (Documentation/admin-guide/
     // devices.txt).
     const auto major_number = major(st.st_rdev);
     return S_ISCHR(st.st_mode) && major_number >= 136 && major_number <= 143;
+#endif
 }
 
 void SerialPort::flush() noexcept {
-    if (port_.is_open()) ::tcflush(port_.native_handle(), TCIOFLUSH);
+    if (!port_.is_open()) return;
+#ifdef _WIN32
+    ::PurgeComm(port_.native_handle(), PURGE_RXCLEAR | PURGE_TXCLEAR);
+#else
+    ::tcflush(port_.native_handle(), TCIOFLUSH);
+#endif
 }
 
 void SerialPort::close() noexcept {

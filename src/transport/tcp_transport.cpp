@@ -1,9 +1,5 @@
 #include "transport/tcp_transport.hpp"
 
-#include <netinet/in.h>
-#include <netinet/tcp.h>
-#include <sys/socket.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
@@ -171,11 +167,9 @@ void TcpTransport::uncork() {
 
 bool TcpTransport::peer_gone() {
     if (state_ != State::open) return false;
-    std::uint8_t byte = 0;
-    const auto r = ::recv(socket_.native_handle(), &byte, 1, MSG_PEEK | MSG_DONTWAIT);
-    if (r == 0) return true;  // end of stream
-    if (r > 0) return false;  // data waits: the reader handles it (and a close after it)
-    return errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR;
+    // Waiting data is the reader's (and so is a close after it).
+    const auto p = os::peek(fd_);
+    return p == os::Peek::closed || p == os::Peek::failed;
 }
 
 void TcpTransport::consume(std::size_t n) noexcept {
@@ -250,27 +244,18 @@ void TcpTransport::write_next() {
 void TcpTransport::set_keepalive(boost::system::error_code& ec) {
     const auto& k = options_.keepalive;
     if (k.idle.count() <= 0) return;
-    const auto fd = fd_;
-    const auto seconds = [](std::chrono::seconds s) { return static_cast<int>(s.count()); };
-    const int on = 1;
-    const int idle = seconds(k.idle);
-    const int interval = std::max(seconds(k.interval), 1);
-    const int count = std::max(k.count, 1);
-    const auto user_timeout = static_cast<unsigned>((idle + interval * count) * 1000);
-    const auto set = [&](int level, int name, const auto& value) {
-        if (!ec && ::setsockopt(fd, level, name, &value, sizeof value) != 0)
-            ec = boost::system::error_code(errno, boost::system::system_category());
-    };
-    set(SOL_SOCKET, SO_KEEPALIVE, on);
-    set(IPPROTO_TCP, TCP_KEEPIDLE, idle);
-    set(IPPROTO_TCP, TCP_KEEPINTVL, interval);
-    set(IPPROTO_TCP, TCP_KEEPCNT, count);
-    set(IPPROTO_TCP, TCP_USER_TIMEOUT, user_timeout);
+    os::KeepAliveTiming timing;
+    timing.idle = k.idle;
+    timing.interval = std::max(k.interval, std::chrono::seconds(1));
+    timing.probes = std::max(k.count, 1);
+    // Unacknowledged data fails the connection when the probes would have.
+    timing.user_timeout = timing.idle + timing.interval * timing.probes;
+    ec = os::set_keepalive(fd_, timing);
 }
 
 void TcpTransport::close() {
     close_connection();
-    fd_ = -1;
+    fd_ = os::invalid_socket;
     front_written_ = 0;
     rx_size_ = 0;
     corked_ = false;

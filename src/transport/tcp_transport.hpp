@@ -31,6 +31,7 @@
 
 #include "fins/tcp.hpp"
 #include "transport/asio.hpp"
+#include "transport/socket_os.hpp"
 #include "transport/socket_transport.hpp"
 
 namespace fins::transport {
@@ -47,8 +48,8 @@ class TcpTransport final : public SocketTransport<asio::ip::tcp> {
     // Reads that returned bytes since construction (handshake included); lets tests see
     // how the bytes of a packet actually arrived.
     [[nodiscard]] std::uint64_t reads() const noexcept { return reads_; }
-    // The socket, for inspecting its options (tests); -1 while closed.
-    [[nodiscard]] int native_handle() const noexcept { return fd_; }
+    // The socket, for inspecting its options (tests); os::invalid_socket (-1) while closed.
+    [[nodiscard]] os::NativeSocket native_handle() const noexcept { return fd_; }
 
   private:
     void on_connected();
@@ -65,8 +66,8 @@ class TcpTransport final : public SocketTransport<asio::ip::tcp> {
     void consume(std::size_t n) noexcept;
     void uncork();
 
-    int fd_ = -1;                    // socket_'s, once connected
-    std::size_t front_written_ = 0;  // bytes of queue_.front() already written
+    os::NativeSocket fd_ = os::invalid_socket;  // socket_'s, once connected
+    std::size_t front_written_ = 0;             // bytes of queue_.front() already written
     std::array<std::uint8_t, 20> hello_{};
     // Room for two maximal packets: whatever is left after parsing fits with room to read.
     std::array<std::uint8_t, 2 * tcp_max_packet> rx_{};

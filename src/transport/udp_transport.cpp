@@ -1,7 +1,5 @@
 #include "transport/udp_transport.hpp"
 
-#include <sys/socket.h>
-
 #include <cerrno>
 
 #include <string>
@@ -10,6 +8,7 @@
 #include <boost/asio/connect.hpp>
 
 #include "transport/asio.hpp"
+#include "transport/socket_os.hpp"
 
 namespace fins::transport {
 
@@ -68,12 +67,28 @@ void UdpTransport::finish_open(Result<LinkInfo> result) {
 
 ReceiveError classify_receive_error(boost::system::error_code ec) noexcept {
     if (ec == asio::error::connection_refused) return ReceiveError::nothing_listening;
-    if (ec == asio::error::host_unreachable || ec == asio::error::network_unreachable ||
+#ifdef _WIN32
+    // An ICMP port unreachable: WSAECONNRESET from a synchronous receive, and from an
+    // overlapped one ERROR_PORT_UNREACHABLE (Windows) or ERROR_CONNECTION_REFUSED (Wine).
+    const auto win32 = [&](DWORD code) {
+        return ec ==
+               boost::system::error_code(static_cast<int>(code), boost::system::system_category());
+    };
+    if (ec == asio::error::connection_reset || win32(ERROR_PORT_UNREACHABLE) ||
+        win32(ERROR_CONNECTION_REFUSED))
+        return ReceiveError::nothing_listening;
+    const bool host_down =
+        ec == boost::system::error_code(WSAEHOSTDOWN, boost::system::system_category());
+#else
+    const bool host_down =
         ec == boost::system::error_code(EHOSTDOWN, boost::system::system_category()) ||
-        ec == boost::system::error_code(ENONET, boost::system::system_category()) ||
-        ec == asio::error::network_down || ec == asio::error::connection_reset ||
-        ec == asio::error::timed_out || ec == std::errc::protocol_error ||
-        ec == std::errc::message_size || ec == asio::error::interrupted)
+        ec == boost::system::error_code(ENONET, boost::system::system_category());
+#endif
+    if (host_down || ec == asio::error::host_unreachable ||
+        ec == asio::error::network_unreachable || ec == asio::error::network_down ||
+        ec == asio::error::connection_reset || ec == asio::error::timed_out ||
+        ec == std::errc::protocol_error || ec == std::errc::message_size ||
+        ec == asio::error::interrupted)
         return ReceiveError::transient;
     return ReceiveError::fatal;
 }
@@ -123,9 +138,7 @@ bool UdpTransport::peer_gone() {
     if (state_ != State::open) return false;
     // Reading SO_ERROR clears an ICMP error left by earlier traffic, so it cannot fail
     // the request about to be sent.
-    int error = 0;
-    socklen_t size = sizeof error;
-    ::getsockopt(socket_.native_handle(), SOL_SOCKET, SO_ERROR, &error, &size);
+    os::clear_pending_error(socket_.native_handle());
     return false;
 }
 

@@ -1,7 +1,7 @@
 // finsd's HTTP API (contract in api.hpp).
 #include "web/api.hpp"
 
-#include <arpa/inet.h>
+#include "transport/socket_headers.hpp"
 
 #include <algorithm>
 #include <charconv>

@@ -5,21 +5,14 @@
 // DA1), which a PLC answers with its own address in the response's source field: one
 // 05 01 CPU UNIT DATA READ sent that way tells the node and the model. Over TCP the
 // FINS/TCP handshake reports the server's node.
-#include <netdb.h>
-#include <poll.h>
-#include <sys/socket.h>
-#include <unistd.h>
-
 #include <array>
-#include <cerrno>
 #include <chrono>
-#include <cstring>
-#include <memory>
 #include <string>
 
 #include <fmt/core.h>
 
 #include "cli/fins/commands.hpp"
+#include "cli/fins/udp_socket.hpp"
 #include "fins/commands/configuration.hpp"
 #include "fins/frame.hpp"
 
@@ -32,45 +25,22 @@ constexpr std::uint8_t probe_service_id = 0x5A;
 // to IP addresses (automatic generation) answers to its network's host SA1.
 constexpr std::uint8_t probe_source_node = 254;
 
-struct Fd {
-    int fd = -1;
-    ~Fd() {
-        if (fd >= 0) ::close(fd);
-    }
-};
-
-std::uint8_t local_node(int fd) {
-    sockaddr_storage local{};
-    socklen_t size = sizeof local;
-    if (::getsockname(fd, reinterpret_cast<sockaddr*>(&local), &size) != 0 ||
-        local.ss_family != AF_INET)
-        return probe_source_node;
-    const auto* in = reinterpret_cast<const sockaddr_in*>(&local);
-    const auto bytes = reinterpret_cast<const std::uint8_t*>(&in->sin_addr.s_addr);
-    if (bytes[0] == 127 || bytes[3] == 0 || bytes[3] == 255) return probe_source_node;
-    return bytes[3];
-}
-
-std::error_code last_error() {
-    return {errno, std::generic_category()};
+std::uint8_t local_node(const UdpSocket& socket) {
+    const auto local = socket.local_v4();
+    if (!local) return probe_source_node;
+    const auto first = *local >> 24;
+    const auto last = *local & 0xFF;
+    if (first == 127 || last == 0 || last == 255) return probe_source_node;
+    return static_cast<std::uint8_t>(last);
 }
 
 Result<FoundNode> discover_udp(const GlobalOptions& g) {
-    addrinfo hints{};
-    hints.ai_family = AF_UNSPEC;
-    hints.ai_socktype = SOCK_DGRAM;
-    addrinfo* found = nullptr;
-    const auto port = std::to_string(g.port);
-    if (::getaddrinfo(g.host.c_str(), port.c_str(), &hints, &found) != 0 || found == nullptr)
-        return Unexpected(std::make_error_code(std::errc::host_unreachable));
-    std::unique_ptr<addrinfo, void (*)(addrinfo*)> list(found, ::freeaddrinfo);
-    Fd s{::socket(found->ai_family, SOCK_DGRAM | SOCK_CLOEXEC, 0)};
-    if (s.fd < 0 || ::connect(s.fd, found->ai_addr, found->ai_addrlen) != 0)
-        return Unexpected(last_error());
+    UdpSocket s;
+    if (auto ec = s.connect(g.host, g.port)) return Unexpected(ec);
 
     Header h;
     h.destination = NodeAddress{0, 0, 0};
-    h.source = NodeAddress{0, local_node(s.fd), 0};
+    h.source = NodeAddress{0, local_node(s), 0};
     if (auto src = parse_node_address(g.source); src && !g.source.empty()) h.source = *src;
     const NodeAddress source = h.source;
     h.service_id = probe_service_id;
@@ -80,22 +50,19 @@ Result<FoundNode> discover_udp(const GlobalOptions& g) {
 
     const auto wait = std::chrono::milliseconds(static_cast<long>(g.timeout_seconds * 1000.0));
     for (unsigned attempt = 0; attempt <= g.retries; ++attempt) {
-        if (::send(s.fd, frame.data(), *size, 0) != static_cast<ssize_t>(*size))
-            return Unexpected(last_error());
+        if (auto ec = s.send({frame.data(), *size})) return Unexpected(ec);
         const auto deadline = std::chrono::steady_clock::now() + wait;
         // Bounded: every turn either returns or moves towards the deadline.
         while (true) {
             const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
                 deadline - std::chrono::steady_clock::now());
-            pollfd p{s.fd, POLLIN, 0};
-            if (left.count() <= 0 || ::poll(&p, 1, static_cast<int>(left.count())) <= 0) break;
+            if (left.count() <= 0) break;
             std::array<std::uint8_t, 2048> in{};
-            const auto n = ::recv(s.fd, in.data(), in.size(), 0);
             // ICMP port unreachable: nothing listens there, as `fins read` says too.
-            if (n <= 0)
-                return Unexpected(n < 0 ? last_error()
-                                        : make_error_code(ClientError::malformed_response));
-            auto r = decode_response(Bytes(in.data(), static_cast<std::size_t>(n)));
+            const auto n = s.receive(in, left);
+            if (!n) return Unexpected(n.error());
+            if (*n == 0) break;  // nothing by the deadline (an empty datagram is not FINS)
+            auto r = decode_response(Bytes(in.data(), *n));
             if (!r || r->header.service_id != probe_service_id ||
                 r->command != CpuUnitDataRead::code)
                 continue;

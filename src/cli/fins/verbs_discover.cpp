@@ -10,17 +10,9 @@
 // host gets --timeout per attempt and --retries more attempts, so the run is bounded.
 // Prints one line per node that answered (host, node, model, version) in RANGE's order; exit
 // 0 when at least one did, 3 when none did.
-#include <arpa/inet.h>
-#include <netinet/in.h>
-#include <poll.h>
-#include <sys/socket.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <array>
-#include <cerrno>
 #include <chrono>
-#include <cstring>
 #include <deque>
 #include <memory>
 #include <optional>
@@ -31,6 +23,7 @@
 #include <fmt/core.h>
 
 #include "cli/fins/commands.hpp"
+#include "cli/fins/udp_socket.hpp"
 #include "cli/fins/verb_support.hpp"
 #include "fins/commands/configuration.hpp"
 #include "fins/frame.hpp"
@@ -51,9 +44,10 @@ struct DiscoverArgs {
 };
 
 std::optional<std::uint32_t> ipv4(std::string_view text) {
-    in_addr a{};
-    if (::inet_pton(AF_INET, std::string(text).c_str(), &a) != 1) return std::nullopt;
-    return ntohl(a.s_addr);
+    boost::system::error_code ec;
+    const auto a = boost::asio::ip::make_address_v4(std::string(text), ec);
+    if (ec) return std::nullopt;
+    return a.to_uint();
 }
 
 std::string ipv4_text(std::uint32_t host) {
@@ -128,17 +122,15 @@ class Sweep {
   public:
     Sweep(const GlobalOptions& g, std::vector<Target>& targets, unsigned parallel)
         : g_(g), targets_(targets), parallel_(parallel) {
-        fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+        error_ = socket_.open_v4();
         wait_ = std::chrono::milliseconds(static_cast<long>(g.timeout_seconds * 1000.0 + 0.5));
         if (auto s = parse_node_address(g.source); s && !g.source.empty()) source_ = *s;
-    }
-    ~Sweep() {
-        if (fd_ >= 0) ::close(fd_);
     }
     Sweep(const Sweep&) = delete;
     Sweep& operator=(const Sweep&) = delete;
 
-    [[nodiscard]] bool ok() const { return fd_ >= 0; }
+    // Why the socket could not be opened, if it could not.
+    [[nodiscard]] std::error_code error() const { return error_; }
 
     // Bounded: every target is sent at most retries + 1 times, each attempt ends at its
     // deadline, and a target leaves `in_flight_` on its answer or its last deadline.
@@ -155,8 +147,13 @@ class Sweep {
                 earliest = std::min(earliest, targets_[i].deadline);
             const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
                 earliest - std::chrono::steady_clock::now());
-            pollfd p{fd_, POLLIN, 0};
-            if (::poll(&p, 1, static_cast<int>(std::max<long>(left.count(), 0) + 1)) > 0) receive();
+            std::array<std::uint8_t, max_frame_size> in{};
+            UdpSocket::Endpoint from;
+            // An error here is a host's ICMP answer (nothing listens): it does not answer.
+            if (auto n = socket_.receive(in, left + std::chrono::milliseconds(1), &from);
+                n && *n > 0)
+                take(Bytes(in.data(), *n), from);
+            receive();
             expire();
         }
     }
@@ -172,45 +169,41 @@ class Sweep {
             static_cast<std::uint8_t>(CpuUnitDataSection::model_and_area)};
         std::array<std::uint8_t, 64> frame{};
         const auto size = encode_request(h, CpuUnitDataRead::code, section, frame);
-        sockaddr_in to{};
-        to.sin_family = AF_INET;
-        to.sin_port = htons(g_.port);
-        to.sin_addr.s_addr = htonl(t.host);
         ++t.attempts;
         t.deadline = std::chrono::steady_clock::now() + wait_;
-        // A host the kernel cannot send to (no route) is one that does not answer.
-        return size && ::sendto(fd_, frame.data(), *size, 0, reinterpret_cast<sockaddr*>(&to),
-                                sizeof to) == static_cast<ssize_t>(*size);
+        // A host the system cannot send to (no route) is one that does not answer.
+        return size && !socket_.send_to(t.host, g_.port, {frame.data(), *size});
     }
 
     void receive() {
-        // Bounded: the socket is drained without waiting, at most one datagram per turn.
+        // Bounded: the socket is drained without waiting, at most max_hosts datagrams.
         for (std::size_t n = 0; n < max_hosts; ++n) {
             std::array<std::uint8_t, max_frame_size> in{};
-            sockaddr_in from{};
-            socklen_t from_size = sizeof from;
-            const auto got = ::recvfrom(fd_, in.data(), in.size(), MSG_DONTWAIT,
-                                        reinterpret_cast<sockaddr*>(&from), &from_size);
-            if (got <= 0) return;
-            auto r = decode_response(Bytes(in.data(), static_cast<std::size_t>(got)));
-            if (!r || r->command != CpuUnitDataRead::code) continue;
-            const auto host = ntohl(from.sin_addr.s_addr);
-            const auto it = std::find_if(in_flight_.begin(), in_flight_.end(), [&](auto i) {
-                return targets_[i].host == host &&
-                       static_cast<std::uint8_t>(i) == r->header.service_id;
-            });
-            if (it == in_flight_.end()) continue;
-            Target& t = targets_[*it];
-            t.found = FoundNode{r->header.source, {}, {}};
-            t.found->address.unit = 0;
-            if (r->code.ok())
-                if (auto data = CpuUnitDataRead{CpuUnitDataSection::model_and_area}.decode_response(
-                        r->data)) {
-                    t.found->model = data->model;
-                    t.version = data->system_version;
-                }
-            in_flight_.erase(it);
+            UdpSocket::Endpoint from;
+            const auto got = socket_.try_receive(in, from);
+            if (!got) return;
+            take(Bytes(in.data(), *got), from);
         }
+    }
+
+    void take(Bytes datagram, const UdpSocket::Endpoint& from) {
+        auto r = decode_response(datagram);
+        if (!r || r->command != CpuUnitDataRead::code || !from.address().is_v4()) return;
+        const auto host = from.address().to_v4().to_uint();
+        const auto it = std::find_if(in_flight_.begin(), in_flight_.end(), [&](auto i) {
+            return targets_[i].host == host && static_cast<std::uint8_t>(i) == r->header.service_id;
+        });
+        if (it == in_flight_.end()) return;
+        Target& t = targets_[*it];
+        t.found = FoundNode{r->header.source, {}, {}};
+        t.found->address.unit = 0;
+        if (r->code.ok())
+            if (auto data =
+                    CpuUnitDataRead{CpuUnitDataSection::model_and_area}.decode_response(r->data)) {
+                t.found->model = data->model;
+                t.version = data->system_version;
+            }
+        in_flight_.erase(it);
     }
 
     void expire() {
@@ -230,7 +223,8 @@ class Sweep {
     const GlobalOptions& g_;
     std::vector<Target>& targets_;
     unsigned parallel_;
-    int fd_ = -1;
+    UdpSocket socket_;
+    std::error_code error_;
     std::chrono::milliseconds wait_{};
     NodeAddress source_{0, discover_source_node, 0};
     std::deque<std::size_t> in_flight_;
@@ -246,7 +240,7 @@ int run_discover(const GlobalOptions& g, const DiscoverArgs& a, Output& out) {
     for (auto h : *hosts)
         targets.push_back(Target{h, 0, {}, std::nullopt, {}});
     Sweep sweep(g, targets, a.parallel);
-    if (!sweep.ok()) return out.failure(std::error_code(errno, std::system_category()), "discover");
+    if (sweep.error()) return out.failure(sweep.error(), "discover");
     sweep.run();
 
     nlohmann::json nodes = nlohmann::json::array();

@@ -5,10 +5,8 @@
 //   --json  one object per line: {"time": "YYYY-MM-DD HH:MM:SS.mmm", "address", "value"}
 // It ends after N polls (--count), after S seconds (--duration), or on Ctrl-C / SIGTERM,
 // each with exit 0; a failed poll ends it with that failure's exit code (3 or 4).
-// SIGINT and SIGTERM are blocked and taken with sigtimedwait between polls, so a signal
-// never interrupts a request half way and the output ends on a whole line.
-#include <signal.h>
-
+// Ctrl-C and SIGTERM are taken between polls (StopRequest), so a signal never interrupts
+// a request half way and the output ends on a whole line.
 #include <chrono>
 #include <cstdio>
 #include <ctime>
@@ -20,6 +18,7 @@
 #include <fmt/core.h>
 
 #include "cli/fins/commands.hpp"
+#include "cli/fins/stop_request.hpp"
 #include "cli/fins/verb_support.hpp"
 #include "fins/address.hpp"
 
@@ -50,23 +49,6 @@ std::string now_text(bool with_date) {
     return fmt::format("{}.{:03}", buf, ms);
 }
 
-// Waits until `until` unless SIGINT or SIGTERM arrives first: true when one did.
-bool interrupted_before(const sigset_t& stop, Clock::time_point until) {
-    // Bounded: each turn either returns or waits out part of the time left.
-    for (;;) {
-        const auto left = until - Clock::now();
-        const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(left).count();
-        timespec wait{};
-        if (ns > 0) {
-            wait.tv_sec = static_cast<std::time_t>(ns / 1'000'000'000);
-            wait.tv_nsec = static_cast<long>(ns % 1'000'000'000);
-        }
-        const int got = ::sigtimedwait(&stop, nullptr, &wait);
-        if (got == SIGINT || got == SIGTERM) return true;
-        if (ns <= 0 || Clock::now() >= until) return false;
-    }
-}
-
 int run_watch(const GlobalOptions& g, const WatchArgs& a, Output& out) {
     std::vector<Address> addresses;
     for (const auto& text : a.addresses) {
@@ -77,12 +59,8 @@ int run_watch(const GlobalOptions& g, const WatchArgs& a, Output& out) {
             return out.usage(fmt::format("{}: {}", text, mem.error().message()));
         addresses.push_back(*addr);
     }
-    // Blocked before the client exists, so every thread it might start inherits the mask.
-    sigset_t stop;
-    ::sigemptyset(&stop);
-    ::sigaddset(&stop, SIGINT);
-    ::sigaddset(&stop, SIGTERM);
-    ::sigprocmask(SIG_BLOCK, &stop, nullptr);
+    // Before the client exists, so every thread it might start inherits the signal mask.
+    StopRequest stop;
 
     int rc = exit_ok;
     auto client = open_client(g, out, rc);
@@ -111,7 +89,7 @@ int run_watch(const GlobalOptions& g, const WatchArgs& a, Output& out) {
         // Fixed rate: a slow poll shortens the next wait instead of shifting the rest.
         auto next = start + interval * (poll + 1);
         if (next > end) next = end;
-        if (interrupted_before(stop, next) || Clock::now() >= end) break;
+        if (stop.requested_before(next) || Clock::now() >= end) break;
     }
     return exit_ok;
 }

@@ -1,7 +1,7 @@
 // [http] and the --http flags (contract in config_http.hpp).
 #include "cli/finsd/config_http.hpp"
 
-#include <arpa/inet.h>
+#include "transport/socket_headers.hpp"
 
 #include <charconv>
 

@@ -9,7 +9,9 @@
 // the server's io_context, so a Plc is touched by one thread only.
 #include "server/control/control.hpp"
 
+#ifndef _WIN32
 #include <sys/stat.h>
+#endif
 
 #include <algorithm>
 #include <chrono>
@@ -228,28 +230,40 @@ Result<std::unique_ptr<ControlServer>> ControlServer::start(asio::io_context& io
                                                             ControlOptions options) {
     if (targets.empty() || options.max_connections == 0)
         return Unexpected(std::make_error_code(std::errc::invalid_argument));
-    // sockaddr_un holds at most 107 characters and a terminating NUL.
-    if (path.empty() || path.native().size() >= sizeof(sockaddr_un{}.sun_path))
+    // sockaddr_un holds at most 107 characters and a terminating NUL (108 on Linux and on
+    // Windows, whose AF_UNIX sockets the channel uses there too: docs/windows.md).
+    constexpr std::size_t max_path = 107;
+    const std::string name = path.string();
+    if (path.empty() || name.size() > max_path)
         return Unexpected(std::make_error_code(std::errc::filename_too_long));
     boost::system::error_code ec;
     const auto st = std::filesystem::symlink_status(path, ec);
     if (std::filesystem::exists(st)) {
         // Replace a stale socket, never a regular file someone pointed us at by mistake,
-        // nor the socket of a finsd that still answers on it.
-        if (!std::filesystem::is_socket(st))
-            return Unexpected(std::make_error_code(std::errc::file_exists));
+        // nor the socket of a finsd that still answers on it. (Windows shows a socket
+        // file as a reparse point, which the standard library does not call a socket.)
+#ifdef _WIN32
+        const bool socket_file =
+            !std::filesystem::is_regular_file(st) && !std::filesystem::is_directory(st);
+#else
+        const bool socket_file = std::filesystem::is_socket(st);
+#endif
+        if (!socket_file) return Unexpected(std::make_error_code(std::errc::file_exists));
         stream::socket probe(io);
-        if (probe.connect(stream::endpoint(path.native()), ec); !ec)
+        if (probe.connect(stream::endpoint(name), ec); !ec)
             return Unexpected(std::make_error_code(std::errc::address_in_use));
         std::filesystem::remove(path, ec);
     }
     auto impl = std::make_unique<Impl>(io, path);
     impl->shared->targets = std::move(targets);
     impl->shared->options = options;
-    const stream::endpoint endpoint(path.native());
+    const stream::endpoint endpoint(name);
     if (impl->acceptor.open(endpoint.protocol(), ec); ec) return Unexpected(ec);
     if (impl->acceptor.bind(endpoint, ec); ec) return Unexpected(ec);
+#ifndef _WIN32
     ::chmod(path.c_str(), 0600);  // the channel changes the PLC: its owner only
+#endif
+    // (Windows: the socket's directory is the user's own, %LOCALAPPDATA%\finskit.)
     if (impl->acceptor.listen(asio::socket_base::max_listen_connections, ec); ec)
         return Unexpected(ec);
     impl->accept();

@@ -17,12 +17,11 @@
 #include <cstdint>
 #include <functional>
 
-#include <sys/socket.h>
-
 #include "fins/byte_io.hpp"
 #include "fins/command_table.hpp"
 #include "fins/error.hpp"
 #include "fins/frame.hpp"
+#include "transport/socket_headers.hpp"
 
 namespace fins::plc {
 class Plc;

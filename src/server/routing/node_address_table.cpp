@@ -1,7 +1,7 @@
 // NodeAddressTable: the per-method rules of node_address_table.hpp.
 #include "server/routing/node_address_table.hpp"
 
-#include <arpa/inet.h>
+#include "transport/socket_headers.hpp"
 
 #include <cstring>
 

@@ -1,7 +1,9 @@
 // Plant: start-up of several CPU Units and their ports, glued by the Router (plant.hpp).
 #include "server/routing/plant.hpp"
 
+#ifndef _WIN32
 #include <sys/resource.h>
+#endif
 
 #include <filesystem>
 #include <map>
@@ -225,6 +227,7 @@ std::size_t plant_descriptors(const PlantConfig& config) noexcept {
 namespace {
 
 // The descriptors this process has open now.
+#ifndef _WIN32
 std::size_t open_descriptors() {
     std::error_code ec;
     std::size_t n = 0;
@@ -233,12 +236,15 @@ std::size_t open_descriptors() {
         ++n;
     return n;
 }
+#endif
 
 }  // namespace
 
 Result<std::unique_ptr<Plant>> Plant::start(asio::io_context& io, const PlantConfig& config) {
     // Refuse up front what would fail at the 9,000th unit: every unit's sockets, with
-    // room left for FINS/TCP connections and the process's own files.
+    // room left for FINS/TCP connections and the process's own files. (Windows has no
+    // such per-process limit on sockets and files: nothing to check there.)
+#ifndef _WIN32
     if (rlimit limit{};
         ::getrlimit(RLIMIT_NOFILE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) {
         const std::size_t sockets = plant_descriptors(config);
@@ -253,6 +259,7 @@ Result<std::unique_ptr<Plant>> Plant::start(asio::io_context& io, const PlantCon
             return Unexpected(std::make_error_code(std::errc::too_many_files_open));
         }
     }
+#endif
     auto impl = std::make_unique<Impl>();
     impl->cpus.reserve(config.cpus.size());
     for (const auto& c : config.cpus) {

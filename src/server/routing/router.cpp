@@ -6,7 +6,7 @@
 #include <array>
 #include <cstring>
 
-#include <netinet/in.h>
+#include "transport/socket_headers.hpp"
 
 #include "plc/plc.hpp"
 #include "plc/routing_tables.hpp"

@@ -1,10 +1,14 @@
 // The scenario compute thread (contract in scenario_worker.hpp).
 #include "server/scenario/scenario_worker.hpp"
 
+#ifdef _WIN32
+#include <windows.h>
+#else
 #include <pthread.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <unistd.h>
+#endif
 
 #include <algorithm>
 #include <atomic>
@@ -93,9 +97,14 @@ void ScenarioWorker::run() {
     // Below the I/O thread (Linux: a thread's own nice value): when both want a core the
     // requests go first, and the ticks take the idle time between them; at nice 10 the
     // thread still gets about a tenth of a contended core, more than ticks need.
+#ifdef _WIN32
+    // Windows: the thread priority below normal, the same rule.
+    ::SetThreadPriority(::GetCurrentThread(), THREAD_PRIORITY_BELOW_NORMAL);
+#else
     setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), worker_nice);
     // Named, so that `top -H` and `ps -L` tell it from the I/O thread.
     pthread_setname_np(pthread_self(), thread_name);
+#endif
     Shared& s = *shared_;
     std::unique_lock lock(s.mutex);
     for (;;) {

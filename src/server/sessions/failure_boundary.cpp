@@ -91,11 +91,11 @@ std::size_t handle_guarded(Dispatcher& dispatcher, Bytes request, MutableBytes o
         const Header header = read_header(reader);
         const CommandCode command{reader.u8(), reader.u8()};
         try {
-            note_failure(FailureChannel::fins,
-                         fmt::format("FINS command {:02X}{:02X} from {}.{}.{}", command.main,
-                                     command.sub, header.source.network, header.source.node,
-                                     header.source.unit),
-                         what);
+            note_failure(
+                FailureChannel::fins,
+                fmt::format("FINS command {:02X}{:02X} from {}.{}.{}", command.main, command.sub,
+                            header.source.network, header.source.node, header.source.unit),
+                what);
         } catch (...) {
             note_failure(FailureChannel::fins, "a FINS request", what);
         }
@@ -104,7 +104,8 @@ std::size_t handle_guarded(Dispatcher& dispatcher, Bytes request, MutableBytes o
             return 0;
         // W342 5-1-3 0301: an error in the unit that serves FINS (finsd itself).
         Header response = response_header(header, dispatcher.self());
-        if (header.destination.node == broadcast_node) response.source.node = dispatcher.self().node;
+        if (header.destination.node == broadcast_node)
+            response.source.node = dispatcher.self().node;
         ByteWriter w(out);
         write_response_prefix(w, response, command,
                               static_cast<std::uint16_t>(EndCode::communications_controller_error));

@@ -4,8 +4,7 @@
 // entry hit last, else a scan of the table, else the oldest entry is replaced.
 #pragma once
 
-#include <netinet/in.h>
-#include <sys/socket.h>
+#include "transport/socket_headers.hpp"
 
 #include <array>
 #include <chrono>

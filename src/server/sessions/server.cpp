@@ -1,6 +1,6 @@
 #include "server/sessions/server.hpp"
 
-#include <arpa/inet.h>
+#include "transport/socket_headers.hpp"
 
 #include <algorithm>
 #include <array>
@@ -8,6 +8,7 @@
 #include <cstring>
 #include <list>
 #include <optional>
+#include <utility>
 
 #include <spdlog/spdlog.h>
 #include <boost/asio/ip/tcp.hpp>
@@ -227,9 +228,12 @@ Result<std::unique_ptr<Server>> Server::start(asio::io_context& io, plc::Plc& pl
         impl->udp->set_response_hook(
             [engine = impl->instructions.get()](Bytes frame, const sockaddr* peer, socklen_t size) {
                 InstructionRoute from;
-                if (size > from.udp.capacity()) return false;
-                std::memcpy(from.udp.data(), peer, size);
-                from.udp.resize(size);
+                // socklen_t: unsigned on Linux, int on Windows.
+                if (std::cmp_less(size, 0) || std::cmp_greater(size, from.udp.capacity()))
+                    return false;
+                const auto bytes = static_cast<std::size_t>(size);
+                std::memcpy(from.udp.data(), peer, bytes);
+                from.udp.resize(bytes);
                 return engine->on_response(frame, from);
             });
     if (options.tcp) impl->accept_tcp();

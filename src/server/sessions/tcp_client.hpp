@@ -109,7 +109,9 @@ class TcpClient {
     // row closes the connection and opens it again.
     void note_unanswered();
     // The connection's socket (tests inspect its options); -1 while down.
-    [[nodiscard]] int native_handle() const noexcept { return transport_.native_handle(); }
+    [[nodiscard]] transport::os::NativeSocket native_handle() const noexcept {
+        return transport_.native_handle();
+    }
 
   private:
     void open();

@@ -1,8 +1,7 @@
 #include "server/sessions/tcp_session.hpp"
 
-#include <netinet/in.h>
-#include <netinet/tcp.h>
-#include <sys/socket.h>
+#include "transport/socket_headers.hpp"
+#include "transport/socket_os.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -27,7 +26,9 @@ namespace {
 constexpr std::size_t source_network_offset = 6;
 constexpr std::size_t source_node_offset = 7;
 
+#ifdef TCP_QUICKACK
 using quick_ack = asio::detail::socket_option::boolean<IPPROTO_TCP, TCP_QUICKACK>;
+#endif
 
 }  // namespace
 
@@ -52,6 +53,7 @@ void TcpSession::start() {
     boost::system::error_code ignored;
     // Never let a response sit behind Nagle waiting for the client's delayed ACK.
     socket_.set_option(asio::ip::tcp::no_delay(true), ignored);
+    transport::os::prepare_nonblocking(socket_.native_handle());
     if (const auto ec = set_keepalive(socket_, limits_.keepalive))
         spdlog::debug("fins/tcp: keep-alive: {}", ec.message());
     set_deadline(Deadline::handshake, limits_.handshake_timeout);
@@ -79,29 +81,31 @@ void TcpSession::wait_readable() {
 }
 
 void TcpSession::on_readable() {
-    const int fd = socket_.native_handle();
+    const auto fd = socket_.native_handle();
     for (unsigned round = 0; round < rounds_per_turn; ++round) {
         if (state_ != State::handshake && state_ != State::established) return;
         // serve_buffered() leaves at most one partial packet, so there is room for one.
         const std::size_t room = in_.size() - in_size_;
-        const ssize_t n = ::recv(fd, in_.data() + in_size_, room, MSG_DONTWAIT);
-        if (n < 0) {
-            if (errno == EINTR) continue;
-            if (errno == EAGAIN || errno == EWOULDBLOCK) break;
-            spdlog::debug("fins/tcp: read failed: {}", std::strerror(errno));
+        const auto got = transport::os::receive_now(fd, in_.data() + in_size_, room);
+        using Kind = transport::os::Moved::Kind;
+        if (got.kind == Kind::interrupted) continue;
+        if (got.kind == Kind::would_block) break;
+        if (got.kind == Kind::failed) {
+            spdlog::debug("fins/tcp: read failed: {}", transport::os::error_text(got.error));
             close();
             return;
         }
+        const std::size_t n = got.bytes;
         if (n == 0) {  // the peer closed its side
             close();
             return;
         }
-        in_size_ += static_cast<std::size_t>(n);
+        in_size_ += n;
         if (!serve_buffered()) return;
         // A lone request is the one-in-flight client: the next cannot come before it has
         // this answer, so reading again would only find nothing. The wait's re-arm
         // (EPOLL_CTL_MOD) reports data that does come meanwhile.
-        if (served_ <= 1 && static_cast<std::size_t>(n) < room) break;
+        if (served_ <= 1 && n < room) break;
         if (round + 1 == rounds_per_turn) {
             // Still busy: let the other sessions' ready handlers run, then go on.
             asio::post(socket_.get_executor(), [self = shared_from_this()] {
@@ -153,14 +157,18 @@ bool TcpSession::serve_buffered() {
         set_deadline(Deadline::idle, limits_.idle_timeout);
     else if (deadline_kind_ != Deadline::frame)
         set_deadline(Deadline::frame, limits_.frame_timeout);
-    // A client that writes the FINS/TCP header and the frame separately without
-    // TCP_NODELAY holds the frame until its header is acknowledged, and a frame that
-    // asks for no response gets no answer to carry the ACK. Linux delays that ACK
-    // (~40 ms); quick-ack mode does not stick, so re-arm it (issue 6 item 13).
+        // A client that writes the FINS/TCP header and the frame separately without
+        // TCP_NODELAY holds the frame until its header is acknowledged, and a frame that
+        // asks for no response gets no answer to carry the ACK. Linux delays that ACK
+        // (~40 ms); quick-ack mode does not stick, so re-arm it (issue 6 item 13).
+#ifdef TCP_QUICKACK
     if (in_size_ > 0 || !answered) {
         boost::system::error_code ignored;
         socket_.set_option(quick_ack(true), ignored);
     }
+#else
+    (void)answered;  // Windows acknowledges by its own rule (no quick-ack option)
+#endif
     return true;
 }
 
@@ -169,19 +177,20 @@ bool TcpSession::send_answer(std::size_t size, bool close_after) {
         send_and_continue(size, close_after);
         return false;
     }
-    ssize_t sent = -1;
-    for (int attempt = 0; attempt < 4 && sent < 0; ++attempt) {
-        sent = ::send(socket_.native_handle(), out_.data(), size, MSG_DONTWAIT | MSG_NOSIGNAL);
-        if (sent < 0 && errno != EINTR) break;
-    }
-    if (sent == static_cast<ssize_t>(size)) return true;
-    if (sent < 0 && errno != EAGAIN && errno != EWOULDBLOCK) {
-        spdlog::debug("fins/tcp: write failed: {}", std::strerror(errno));
+    transport::os::Moved sent;
+    sent.kind = transport::os::Moved::Kind::interrupted;
+    for (int attempt = 0; attempt < 4 && sent.kind == transport::os::Moved::Kind::interrupted;
+         ++attempt)
+        sent = transport::os::send_now(socket_.native_handle(), out_.data(), size);
+    using Kind = transport::os::Moved::Kind;
+    if (sent.kind == Kind::done && sent.bytes == size) return true;
+    if (sent.kind == Kind::failed || sent.kind == Kind::interrupted) {
+        spdlog::debug("fins/tcp: write failed: {}", transport::os::error_text(sent.error));
         close();
         return false;
     }
     // The send buffer is full: the rest goes out asynchronously, reading waits for it.
-    const std::size_t done = sent > 0 ? static_cast<std::size_t>(sent) : 0;
+    const std::size_t done = sent.kind == Kind::done ? sent.bytes : 0;
     std::memmove(out_.data(), out_.data() + done, size - done);
     send_and_continue(size - done, false);
     return false;

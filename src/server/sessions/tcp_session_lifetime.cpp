@@ -1,15 +1,12 @@
 // TcpSession's lifetime: keep-alive, the deadlines and their one timer, and the close
 // after an error notice (drain, then close). The request path is tcp_session.cpp.
-#include <netinet/in.h>
-#include <netinet/tcp.h>
-#include <sys/socket.h>
-
 #include <algorithm>
 #include <cerrno>
 
 #include <spdlog/spdlog.h>
 
 #include "server/sessions/tcp_session.hpp"
+#include "transport/socket_os.hpp"
 
 namespace fins::server {
 
@@ -25,15 +22,11 @@ boost::system::error_code set_keepalive(asio::ip::tcp::socket& socket,
     boost::system::error_code ec;
     socket.set_option(asio::socket_base::keep_alive(idle.count() > 0), ec);
     if (ec || idle.count() <= 0) return ec;
-    const int fd = socket.native_handle();
-    const int idle_s = static_cast<int>(std::min<std::chrono::seconds::rep>(idle.count(), 32767));
-    const int interval_s = std::max(1, idle_s / 3);
-    const int probes = 3;
-    if (::setsockopt(fd, IPPROTO_TCP, TCP_KEEPIDLE, &idle_s, sizeof idle_s) != 0 ||
-        ::setsockopt(fd, IPPROTO_TCP, TCP_KEEPINTVL, &interval_s, sizeof interval_s) != 0 ||
-        ::setsockopt(fd, IPPROTO_TCP, TCP_KEEPCNT, &probes, sizeof probes) != 0)
-        return {errno, boost::system::system_category()};
-    return {};
+    transport::os::KeepAliveTiming timing;
+    timing.idle = idle;
+    timing.interval = std::max(std::chrono::seconds(1), idle / 3);
+    timing.probes = 3;
+    return transport::os::set_keepalive(socket.native_handle(), timing);
 }
 
 void TcpSession::close_after_notice() {

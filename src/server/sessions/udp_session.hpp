@@ -5,6 +5,7 @@
 // Batched and never blocking, on the one I/O thread the whole server shares:
 //   wait until readable -> recvmmsg() up to `batch_size` datagrams (MSG_DONTWAIT) ->
 //   Dispatcher::handle each into its own reply slot -> one sendmmsg() for the replies ->
+//   (udp_batch.hpp; on Windows recvfrom/sendto per datagram, docs/windows.md)
 //   again until recvmmsg finds nothing (at most `rounds_per_turn` batches, then the
 //   turn goes back to the other sessions and continues after them), then wait. A turn
 //   that starts with a lone datagram waits at once (a client with one request in flight
@@ -28,8 +29,7 @@
 #include <functional>
 #include <memory>
 
-#include <netinet/in.h>
-#include <sys/socket.h>
+#include "transport/socket_headers.hpp"
 
 #include <boost/asio/generic/datagram_protocol.hpp>
 
@@ -37,6 +37,7 @@
 #include "server/dispatch/dispatcher.hpp"
 #include "server/sessions/log_summary.hpp"
 #include "server/sessions/recent_peers.hpp"
+#include "server/sessions/udp_batch.hpp"
 #include "transport/asio.hpp"
 
 namespace fins::server {
@@ -45,7 +46,7 @@ namespace fins::server {
 // sendto() to the request's source address; a full send buffer drops it like any reply.
 class UdpSession : public std::enable_shared_from_this<UdpSession>, private ReplyPath {
   public:
-    static constexpr std::size_t batch_size = 32;
+    static constexpr std::size_t batch_size = udp_batch::batch_size;
     static constexpr unsigned rounds_per_turn = 4;
 
     struct Counters {
@@ -93,7 +94,7 @@ class UdpSession : public std::enable_shared_from_this<UdpSession>, private Repl
     bool serve_turn();
     // Receives, answers and sends one batch; returns the datagrams received (-1: none).
     int serve_batch();
-    void send_replies(unsigned count);
+    void send_replies(std::size_t count);
     void note_dropped(std::uint64_t count);
     Completion defer() override;
     void send_late(Bytes frame, const sockaddr_storage& peer, socklen_t size);

@@ -1,0 +1,64 @@
+#!/usr/bin/env bash
+# fins.exe under wine against the host's Linux finsd on 127.0.0.1 (docs/windows.md):
+# FINS/UDP and FINS/TCP reads and writes, probe, discover, watch, and the answer when
+# nothing listens. Usage: windows_round_trip.sh WINDOWS_BIN_DIR HOST_BIN_DIR
+# (WINEPREFIX and WINEDEBUG from ctest's environment). Every wait is for a condition,
+# bounded in time; every process started is ended on exit.
+set -euo pipefail
+bin=$1
+host_bin=$2
+wine=/usr/lib/wine/wine64
+[[ -x "$host_bin/finsd" ]] || { echo "windows round trip: no host finsd in $host_bin" >&2; exit 1; }
+work=$(mktemp -d)
+pids=()
+cleanup() {
+  for pid in "${pids[@]}"; do kill "$pid" 2>/dev/null || true; done
+  for pid in "${pids[@]}"; do wait "$pid" 2>/dev/null || true; done
+  rm -rf "$work"
+}
+trap cleanup EXIT
+fail() { echo "windows round trip: $*" >&2; tail -n 20 "$work/finsd.log" >&2 || true; exit 1; }
+free_port() {
+  /usr/bin/python3 -c 'import socket
+while True:
+    t = socket.socket(); t.bind(("127.0.0.1", 0)); p = t.getsockname()[1]
+    u = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    try:
+        u.bind(("127.0.0.1", p)); print(p); break
+    except OSError: pass
+    finally: u.close(); t.close()'
+}
+wait_for() {
+  local deadline=$((SECONDS + $1)); shift
+  until "$@" >/dev/null 2>&1; do
+    ((SECONDS < deadline)) || return 1
+    sleep 0.1
+  done
+}
+# wine's console output ends lines with CR LF: compare without the CR.
+fins() { "$wine" "$bin/fins.exe" --host 127.0.0.1 --port "$port" "$@" | tr -d '\r'; }
+
+port=$(free_port)
+"$host_bin/finsd" --bind 127.0.0.1 --port "$port" --control "$work/ctl.sock" >"$work/finsd.log" 2>&1 &
+pids+=($!)
+wait_for 60 grep -q "listening $port" "$work/finsd.log" || fail "finsd did not listen"
+passed=0
+check() { if "$@"; then passed=$((passed + 1)); else fail "failed: $*"; fi; }
+values() { fins "$@" --json | grep -o '"values":\[[^]]*\]'; }
+
+check fins write D100 4242 >/dev/null
+check test "$(values read D100 --as int16)" = '"values":[4242]'
+check fins --tcp write D101 -7 --as int16 >/dev/null
+check test "$(values --tcp read D100 2 --as int16)" = '"values":[4242,-7]'
+check test "$(fins probe --json | grep -o '"node":"[^"]*"')" = '"node":"0.1.0"'
+check test "$(fins discover --hosts 127.0.0.1 --json | grep -c '"host":"127.0.0.1"')" = 1
+check test "$(fins watch D100 --count 1 | awk '{print $2, $3}')" = "D100 4242"
+
+# Nothing listening: the same message and exit status as the Linux fins.
+set +e
+out=$("$wine" "$bin/fins.exe" --host 127.0.0.1 --port 1 read D100 --timeout 1 2>&1 | tr -d '\r')
+rc=${PIPESTATUS[0]}
+set -e
+check test "$rc" = 3
+check grep -q "Connection refused" <<<"$out"
+echo "windows round trip: $passed checks passed"
