@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
-# Configures and builds one tree. Usage: scripts/build.sh [release|asan|fuzz|arm64|windows] [TARGET...]
+# Configures and builds one tree. Usage:
+#   scripts/build.sh [release|asan|tsan|fuzz|arm64|windows] [TARGET...]
 # (no targets: everything the tree builds; for fuzz, every fuzzer: fuzz/CMakeLists.txt's
-# fuzz_all; for arm64 and windows, the programs and the unit tests it runs: tests/CMakeLists.txt's
-# fins_cross_all). FINS_BUILD_DIR puts the tree elsewhere; FINS_NINJA_ARGS are extra ninja
-# options (-n: print what would be built, build nothing).
+# fuzz_all; for tsan, the binaries of the multi-threaded tests and what they run:
+# tests/CMakeLists.txt's fins_tsan_all; for arm64 and windows, the programs and the unit
+# tests it runs: tests/CMakeLists.txt's fins_cross_all). FINS_BUILD_DIR puts the tree
+# elsewhere; FINS_NINJA_ARGS are extra ninja options (-n: print what would be built, build
+# nothing).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 kind=${1:-release}
@@ -14,6 +17,10 @@ case "$kind" in
   release) dir=build; args=(-DCMAKE_BUILD_TYPE=Release) ;;
   # What CI tests: ASan+UBSan, warnings as errors, everything (benchmarks compile too).
   asan) dir=build-asan; args=(-DCMAKE_BUILD_TYPE=Debug -DFINS_SANITIZE=ON -DFINS_WERROR=ON) ;;
+  # ThreadSanitizer: only the tests in which our code runs on more than one thread
+  # (tests/CMakeLists.txt's fins_tsan_filters), and the Python module for VirtualPlc's.
+  tsan) dir=build-tsan; args=(-DCMAKE_BUILD_TYPE=Debug -DFINS_SANITIZE=thread -DFINS_WERROR=ON
+    -DFINS_BENCH=OFF -DFINS_EXAMPLES=OFF -DFINS_PYTHON=ON -DPython3_EXECUTABLE=/usr/bin/python3) ;;
   fuzz) dir=build-fuzz; args=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DFINS_FUZZ=ON -DFINS_TESTS=OFF -DCMAKE_CXX_COMPILER=clang++-14) ;;
   # Linux arm64 (docs/platforms.md): Debian's cross compiler and :arm64 libraries, tests
   # under qemu-user; optimised as users get it, our warnings as errors (char is unsigned
@@ -37,7 +44,7 @@ case "$kind" in
       -DCMAKE_BUILD_TYPE=Release -DFINS_WERROR=ON
       "-DCMAKE_CXX_FLAGS=-Wno-error=restrict -Wno-error=array-bounds -Wno-error=stringop-overflow"
       -DFINS_BENCH=OFF -DFINS_EXAMPLES=OFF -DFINS_DOCS=OFF) ;;
-  *) echo "usage: $0 [release|asan|fuzz|arm64|windows]" >&2; exit 2 ;;
+  *) echo "usage: $0 [release|asan|tsan|fuzz|arm64|windows]" >&2; exit 2 ;;
 esac
 # The finskit Python module (release tree) is for Debian's interpreter, whatever python3
 # comes first on PATH (a pyenv one may lack the headers, or be another version).
@@ -51,6 +58,7 @@ cmake -S "$root" -B "$dir" -G Ninja "${args[@]}" >/dev/null
 # The fuzz tree's "everything" would also build the libraries' other programs: its
 # default is the fuzzers alone, which CMake lists (fuzz_all).
 if [[ "$kind" == fuzz && $# -eq 0 ]]; then set -- fuzz_all; fi
+if [[ "$kind" == tsan && $# -eq 0 ]]; then set -- fins_tsan_all; fi
 if [[ ( "$kind" == arm64 || "$kind" == windows ) && $# -eq 0 ]]; then set -- fins_cross_all; fi
 read -r -a ninja_args <<<"${FINS_NINJA_ARGS:-}"
 ninja -C "$dir" -j "$jobs" "${ninja_args[@]}" "$@"

@@ -2,15 +2,18 @@
 # The whole test suite, as CI runs it: installs what is missing, then
 #   1. an ASan+UBSan build with warnings as errors, and every test under it (unit,
 #      loopback integration, CLI, tshark conformance, SIGKILL);
-#   2. a short soak of the ASan+UBSan finsd (scripts/soak.sh: verifying UDP and TCP
+#   2. a ThreadSanitizer build of the tests in which our code runs on more than one
+#      thread (tests/CMakeLists.txt's fins_tsan_filters, the Python module's VirtualPlc)
+#      and those tests under it;
+#   3. a short soak of the ASan+UBSan finsd (scripts/soak.sh: verifying UDP and TCP
 #      clients, garbage datagrams, connection churn; counts as one test);
-#   3. the libFuzzer targets over every decoder, the dispatcher and a whole session,
+#   4. the libFuzzer targets over every decoder, the dispatcher and a whole session,
 #      briefly each, from the committed corpus (fuzz/corpus/);
-#   4. the Linux arm64 cross build: its unit tests and a round trip under qemu-user, and
+#   5. the Linux arm64 cross build: its unit tests and a round trip under qemu-user, and
 #      its .debs (docs/platforms.md);
-#   5. the Windows cross build: its unit tests and fins.exe under wine, and its .zip
+#   6. the Windows cross build: its unit tests and fins.exe under wine, and its .zip
 #      (docs/windows.md);
-#   6. the installable package: Release tree, consumers, Python tests, the .deb.
+#   7. the installable package: Release tree, consumers, Python tests, the .deb.
 # (One instrumented build instead of a Release one and an instrumented one keeps the
 # suite inside its time budget on 2 cores; scripts/run.sh builds Release.)
 set -euo pipefail
@@ -21,10 +24,10 @@ soak_seconds=${FINS_SOAK_SECONDS:-20}
 "$root/scripts/deps.sh"
 
 summary=()
-run_ctest() {
+run_ctest() {  # DIR LABEL [CTEST OPTIONS...]
   local dir=$1 label=$2 log
   log=$(mktemp)
-  if ctest --test-dir "$dir" -j 2 --output-on-failure --timeout 300 | tee "$log"; then :; else
+  if ctest --test-dir "$dir" -j 2 --output-on-failure --timeout 300 "${@:3}" | tee "$log"; then :; else
     summary+=("$label: FAILED"); tail -n 3 "$log"; rm -f "$log"; return 1
   fi
   summary+=("$label: $(grep -E 'tests passed' "$log" | tail -n 1)")
@@ -36,6 +39,27 @@ echo "== ASan+UBSan build"
 echo "== ASan+UBSan tests"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   run_ctest build-asan asan
+
+# ---- issue 27: ThreadSanitizer. Every report (the test binaries', and the finsd and
+# fins-bridge processes they start, which inherit TSAN_OPTIONS) goes to a file under
+# $tsan_logs; any file there fails the stage, even from a process whose exit status no test
+# looks at. Suppressions: third-party code only (tests/tsan.supp says whose and why).
+echo "== TSan build (the multi-threaded tests)"
+"$root/scripts/build.sh" tsan
+echo "== TSan tests"
+tsan_logs=$(mktemp -d)
+tsan_ok=1
+TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$root/tests/tsan.supp:log_path=$tsan_logs/tsan" \
+  run_ctest build-tsan tsan -L tsan || tsan_ok=0
+for report in "$tsan_logs"/tsan.*; do
+  [[ -e "$report" ]] || continue
+  echo "== ThreadSanitizer report $report"; cat "$report"; tsan_ok=0
+done
+rm -rf "$tsan_logs"
+if ((!tsan_ok)); then
+  [[ "${summary[-1]}" == "tsan: FAILED" ]] || summary+=("tsan: FAILED (reports above)")
+  printf '%s\n' "${summary[@]}"; exit 1
+fi
 
 echo "== soak (${soak_seconds}s, ASan+UBSan finsd)"
 soak_log=$(mktemp)
@@ -124,6 +148,7 @@ rm -f "$log"
 echo "== summary"
 printf '%s\n' "${summary[@]}"
 asan_total=$(ctest --test-dir build-asan -N | grep -Eo 'Total Tests: [0-9]+' | grep -Eo '[0-9]+')
+tsan_total=$(ctest --test-dir build-tsan -N -L tsan | grep -Eo 'Total Tests: [0-9]+' | grep -Eo '[0-9]+')
 arm64_total=$(ctest --test-dir build-arm64 -N | grep -Eo 'Total Tests: [0-9]+' | grep -Eo '[0-9]+')
 windows_total=$(ctest --test-dir build-windows -N | grep -Eo 'Total Tests: [0-9]+' | grep -Eo '[0-9]+')
-echo "$((asan_total + soak_ok + fuzz_ok + arm64_total + arm64_packages + windows_total + windows_packages + ${package_passed:-0})) passed, 0 failed"
+echo "$((asan_total + tsan_total + soak_ok + fuzz_ok + arm64_total + arm64_packages + windows_total + windows_packages + ${package_passed:-0})) passed, 0 failed"
