@@ -157,7 +157,8 @@ TEST(Completion, FinsBridgeOptionsAndLogLevelsComplete) {
             << option << ": " << r.out;
     }
     EXPECT_EQ(complete("fins-bridge --log-level w").out, "warn\n");
-    const auto registered = run({"bash", "-c", "source '" + script + "'; complete -p fins-bridge"});
+    const auto registered =
+        run({"/bin/bash", "-c", "source '" + script + "'; complete -p fins-bridge"});
     EXPECT_NE(registered.out.find("_finskit_complete"), std::string::npos) << registered.err;
 }
 

@@ -83,7 +83,8 @@ TEST_F(CliWatch, BadArgumentsAreUsageErrors) {
 // --as shows each value in `fins read`'s formats; a multi-word type reads its words from
 // the address on, and a change in any of them is a change of the value.
 TEST_F(CliWatch, AsShowsValuesInTheirTypeReadingEveryWordOfIt) {
-    auto& c = *finsd_.client();
+    const auto client = finsd_.client();
+    auto& c = *client;
     ASSERT_TRUE(c.write_float(addr("D100"), 1.5F));
     ASSERT_TRUE(c.write_int32(addr("D110"), -70000));
     ASSERT_TRUE(c.write_words(addr("D120"), std::vector<std::uint16_t>{0x4142, 0x4300}));
