@@ -1,7 +1,8 @@
 # What a Debian package carries beside the programs: for each package its DEP-5
-# copyright and gzip'd Debian changelog in /usr/share/doc/PKG/, the man pages fins(1)
-# and finsd(8) (help2man, from the programs' own --help), and the bash completions of
-# fins and finsd. Included by FinsPackage.cmake; the package names come from there.
+# copyright and gzip'd Debian changelog in /usr/share/doc/PKG/, the man pages fins(1),
+# finsd(8) and fins-bridge(8) (help2man, from the programs' own --help and
+# packaging/man/PROGRAM.h2m), and the bash completions of fins, finsd and fins-bridge.
+# Included by FinsPackage.cmake; the package names come from there.
 
 # One version: the changelog's top entry must be the project's.
 file(STRINGS ${PROJECT_SOURCE_DIR}/packaging/changelog fins_changelog_top LIMIT_COUNT 1)
@@ -28,6 +29,9 @@ install(FILES ${PROJECT_SOURCE_DIR}/packaging/completions/finskit.bash
 install(FILES ${PROJECT_SOURCE_DIR}/packaging/completions/finskit.bash
   DESTINATION ${CMAKE_INSTALL_DATAROOTDIR}/bash-completion/completions RENAME finsd
   COMPONENT runtime)
+install(FILES ${PROJECT_SOURCE_DIR}/packaging/completions/finskit.bash
+  DESTINATION ${CMAKE_INSTALL_DATAROOTDIR}/bash-completion/completions RENAME fins-bridge
+  COMPONENT runtime)
 
 # Man pages: on where help2man is (scripts/debian-packages.txt), off in sanitizer and
 # fuzz trees; scripts/package.sh asks for them.
@@ -36,7 +40,8 @@ set(fins_man_default OFF)
 if(FINS_HELP2MAN AND NOT FINS_SANITIZE AND NOT FINS_FUZZ)
   set(fins_man_default ON)
 endif()
-option(FINS_MAN "Man pages fins.1 and finsd.8 from --help (help2man)" ${fins_man_default})
+option(FINS_MAN "Man pages fins.1, finsd.8 and fins-bridge.8 from --help (help2man)"
+  ${fins_man_default})
 if(FINS_MAN)
   if(NOT FINS_HELP2MAN)
     message(FATAL_ERROR "FINS_MAN needs help2man (apt install help2man)")
@@ -55,7 +60,7 @@ if(FINS_MAN)
                          WORLD_READ WORLD_EXECUTE)
     endforeach()
   endif()
-  foreach(page fins:1 finsd:8)
+  foreach(page fins:1 finsd:8 fins-bridge:8)
     string(REPLACE ":" ";" page ${page})
     list(GET page 0 program)
     list(GET page 1 section)

@@ -43,7 +43,8 @@ done
 ls "$work"/root/usr/lib/aarch64-linux-gnu/libfins.so.* >/dev/null 2>&1 ||
   fail "libfins.so is not in /usr/lib/aarch64-linux-gnu"
 check "libfins.so in the arm64 multiarch directory"
-for page in usr/share/man/man1/fins.1.gz usr/share/man/man8/finsd.8.gz; do
+for page in usr/share/man/man1/fins.1.gz usr/share/man/man8/finsd.8.gz \
+    usr/share/man/man8/fins-bridge.8.gz; do
   zcat "$work/root/$page" | grep -q "^\.SH" || fail "$page is empty"
 done
 check "man pages made by the arm64 programs"

@@ -90,11 +90,15 @@ if command -v lintian >/dev/null; then
 else
   echo "  skipped: lintian (not installed: scripts/deps.sh installs it)"
 fi
-for page in man1/fins.1.gz man8/finsd.8.gz; do
-  zcat "/usr/share/man/$page" | grep -q '^\.SH' || fail "man page $page"
+for page in man1/fins.1.gz man8/finsd.8.gz man8/fins-bridge.8.gz; do
+  for section in OPTIONS '"EXIT STATUS"' EXAMPLES '"SEE ALSO"'; do
+    zcat "/usr/share/man/$page" | grep -qx "\.SH $section" || fail "man page $page has no $section"
+  done
 done
-if command -v man >/dev/null; then man -w fins finsd >/dev/null || fail "man finds fins and finsd"; fi
-check "man pages fins(1) and finsd(8)"
+if command -v man >/dev/null; then
+  man -w fins finsd fins-bridge >/dev/null || fail "man finds fins, finsd and fins-bridge"
+fi
+check "man pages fins(1), finsd(8) and fins-bridge(8) with EXIT STATUS and EXAMPLES"
 # Bash completion: every verb `fins --help` lists (and every `finsd ctl` verb) completes.
 completion_test() {
   local program=$1 verbs
@@ -114,6 +118,16 @@ completion_test fins
 completion_test fins files
 completion_test finsd ctl
 check "bash completion offers every verb of fins, fins files and finsd ctl"
+# fins-bridge has options only: each one `fins-bridge --help` lists completes.
+# shellcheck disable=SC1091
+source /usr/share/bash-completion/completions/fins-bridge
+for option in $(fins-bridge --help | awk '/^  -/ { n = split($1, o, ","); for (i = 1; i <= n; i++) { sub(/\{.*/, "", o[i]); print o[i] } }'); do
+  COMP_WORDS=(fins-bridge "${option:0:4}")
+  COMP_CWORD=1
+  _finskit_complete
+  printf '%s\n' "${COMPREPLY[@]}" | grep -qxF -- "$option" || fail "bash completion of 'fins-bridge ${option:0:4}' lacks $option"
+done
+check "bash completion offers every option of fins-bridge"
 
 # The unit's command line, run as systemd would (it creates the State- and
 # RuntimeDirectory).

@@ -77,7 +77,7 @@ struct ClientOptions {
     std::string host = "127.0.0.1";
     std::uint16_t port = 9600;
     enum class Protocol { udp, tcp, serial } protocol = Protocol::udp;
-    // Protocol::serial: FINS over Host Link (README "Host Link (serial)") on this device,
+    // Protocol::serial: FINS over Host Link (docs/serial.md "Host Link (serial)") on this device,
     // to the PLC with this Host Link unit number (0-31). Half duplex: one request on the
     // line at a time, the others wait (their timeout starts when they are sent). The
     // direct form is used while destination and source network and node are 0 (the

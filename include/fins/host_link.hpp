@@ -9,7 +9,7 @@
 //     "@" UU "FA" W  ICF RSV GCT DNA DA1 DA2 SNA SA1 SA2 SID  MRC SRC  text  FCS "*" CR
 //   response (direct: ICF "40" DA2 SA2 SID; network: ICF "C0" and the whole header):
 //     "@" UU "FA" EC  [header]  MRC SRC  MRES SRES  data  FCS "*" CR
-//   error response (EC not "00"; our choice, see README "Host Link (serial)"):
+//   error response (EC not "00"; our choice, see docs/serial.md "Host Link end codes"):
 //     "@" UU "FA" EC  FCS "*" CR
 // UU: Host Link unit number, two decimal digits 00-31. W: response wait time, one hex
 // digit, in 10 ms. EC: Host Link end code. FCS: XOR of every character from "@" through
@@ -55,7 +55,7 @@ inline constexpr std::uint8_t host_link_max_unit = 31;
 inline constexpr std::uint8_t host_link_terminator[2] = {'*', '\r'};
 
 // Host Link end codes (W342 4-2, C-mode codes of the CS/CJ CPU Units). Which of them an
-// "FA" frame can get is not in the sources; finsd answers 13, 14, 16 and 18 (README).
+// "FA" frame can get is not in the sources; finsd answers 13, 14, 16 and 18 (docs/serial.md).
 enum class HostLinkEndCode : std::uint8_t {
     normal = 0x00,
     not_executable_in_run = 0x01,
@@ -128,7 +128,7 @@ inline constexpr std::size_t host_link_error_size = 11;
 // Decodes one whole frame ("@" through CR). `response` says which kind the caller
 // expects (a slave decodes commands, a host responses). The FINS frame goes to
 // `fins_out` (host_link_max_fins_response bytes are always enough).
-// Errors, checked in this order (what a slave answers, README): frame too short, no
+// Errors, checked in this order (what a slave answers, docs/serial.md): frame too short, no
 // "*" CR, unit not 2 decimal digits -> format (a slave ignores those: it cannot tell the
 // unit); FCS mismatch -> bad_fcs; frame over the length limit -> too_long; a header
 // code other than FA/OF -> format with `not_fins` set (C-mode "16"); odd or non-hex

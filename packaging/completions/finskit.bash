@@ -1,5 +1,5 @@
-# bash completion for fins and finsd (finskit), installed as
-# /usr/share/bash-completion/completions/fins and .../finsd.
+# bash completion for fins, finsd and fins-bridge (finskit), installed as
+# /usr/share/bash-completion/completions/fins, .../finsd and .../fins-bridge.
 # CLI11 has no completion generator: the verbs and options are read from the program's
 # own --help at each Tab (`fins --help`, `fins files --help`, `finsd ctl --help` ...), so
 # the completion always matches the installed program, verb for verb.
@@ -34,6 +34,10 @@ _finskit_complete() {
             mapfile -t COMPREPLY < <(compgen -f -- "$cur")
             return
             ;;
+        --log-level)
+            mapfile -t COMPREPLY < <(compgen -W "trace debug info warn error off" -- "$cur")
+            return
+            ;;
     esac
     # The command chain so far: the program and each word naming a subcommand of it.
     local chain=("${COMP_WORDS[0]}") i verbs
@@ -49,4 +53,4 @@ _finskit_complete() {
     fi
     mapfile -t COMPREPLY < <(compgen -W "$words" -- "$cur")
 }
-complete -F _finskit_complete fins finsd
+complete -F _finskit_complete fins finsd fins-bridge

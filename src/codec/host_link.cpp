@@ -291,7 +291,8 @@ tl::expected<HostLinkFrame, HostLinkDecodeError> decode_host_link(Bytes frame, b
         f.end_code = static_cast<HostLinkEndCode>(end_code);
         pos += 2;
         if (f.end_code != HostLinkEndCode::normal) {
-            // An error answer carries no FINS part (our choice, README).
+            // An error answer carries no FINS part (our choice, docs/serial.md "Host Link end
+            // codes").
             if (pos != text_end) return Error(e);
             return f;
         }

@@ -136,7 +136,7 @@ class FileMemory {
 
     struct Device;
 
-    // Descriptors kept open between the chunks of a transfer (for tests and the README).
+    // Descriptors kept open between the chunks of a transfer (for tests and docs/file-memory.md).
     static constexpr std::size_t max_open_files = 4;
     // An open file unused for longer (CPU clock seconds, either way) is closed at the
     // next 22 03.

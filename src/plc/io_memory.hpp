@@ -12,7 +12,7 @@
 //   index_register / data_register      IR0-15 (32-bit) / DR0-15
 //   clock_pulse, condition_flag,        derived or constant, read-only
 //   access_error_flag
-// Retention (W342 / CS/CJ operation manuals "status at power ON"; README (profiles and
+// Retention (W342 / CS/CJ operation manuals "status at power ON"; docs/finsd.md (profiles and
 // configuration)): every region lives in a plc::Storage section. Retained (battery-backed, kept
 // across restarts when finsd has a data directory): H, D, every EM bank, counter PVs and counter
 // completion flags, and the Auxiliary Area words of retained_auxiliary_words(). Cleared at every

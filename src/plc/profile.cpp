@@ -22,7 +22,7 @@
 //            1.x (CJ2H) / 2.x (CJ2M).
 //   [W421]   CS1W-ETN21/CJ1W-ETN21 Ethernet Units manual 7-3-2: a CPU Bus Unit's own
 //            05 01 answer (model, version "V1.20" in its example).
-// Figures no source above gives are choices, marked "choice" (README, PLC profiles).
+// Figures no source above gives are choices, marked "choice" (docs/finsd.md, Profiles).
 #include "plc/profile.hpp"
 
 #include <array>

@@ -7,7 +7,7 @@
 // (1103 start / 1104 end). An area the model does not have at all answers 1101.
 //
 // The registry (profiles(), find_profile()) holds the models finsd can be: see
-// README (profiles and configuration) for the table and where each figure comes from.
+// docs/finsd.md (Profiles) for the table and where each figure comes from.
 #pragma once
 
 #include <cstdint>

@@ -1,7 +1,7 @@
 // The routing tables of a CPU Unit (W596 2-4, frames-networks 1.2) and their layout in
 // parameter area 8013 (W342 5-3-7..5-3-9: 512 words, 0000-01FF, read and written in
 // parts). No public source gives the real word layout (frames-networks 1.3), so finskit
-// defines one; README "A plant of several networks" documents it:
+// defines one; docs/networks.md "The 8013 routing-table layout" documents it:
 //
 //   word 0000         options: bits 0-7 the GCT a frame this CPU Unit starts gets
 //                     (00 = 02, 02 or 07 as CX-Net offers); bits 8-15 reserved (00)

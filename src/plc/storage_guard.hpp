@@ -24,7 +24,7 @@
 
 namespace fins::plc {
 
-// finsd's exit code when a state file shrank under it (README "Exit codes").
+// finsd's exit code when a state file shrank under it (docs/finsd.md, "finsd").
 inline constexpr int state_file_lost_exit_code = 4;
 
 // The exact line the guard writes (tests compare with it).

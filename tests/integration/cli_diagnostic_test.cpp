@@ -137,11 +137,24 @@ TEST_F(CliDiagnostic, AccessRightAcrossTwoSourceNodes) {
     EXPECT_EQ(refused.exit_code, 4);
     const auto doc = Json::parse(refused.out);
     EXPECT_EQ(doc["error"]["end_code"], "3001");
+    // The refusal names the holder (its 3 bytes, W342 5-3-24) and what helps.
+    const std::string held =
+        "node 0.10.0 holds the access right (0C 01): `fins access force` takes it over (0C 02), "
+        "or the holder gives it back (`fins --source 0.10.0 access release` sends its 0C 03)";
+    EXPECT_EQ(doc["error"]["holder"], "0.10.0");
+    EXPECT_EQ(doc["error"]["hint"], held);
+    EXPECT_EQ(fins({"--source", "0.11.0", "access", "acquire"}).err,
+              "fins: access right held by 0.10.0 (network.node.unit): 3001\nfins: " + held + "\n");
     // 21 03: refused while another node holds the access right (5-3-29 and the 0C 01 /
-    // 0C 02 pages decide against 5-1-2's OK).
+    // 0C 02 pages decide against 5-1-2's OK). The 3001 carries no holder: fins asks with
+    // an 0C 01, whose refusal names it.
     auto clear = fins({"--source", "0.11.0", "error-log", "--clear", "--json"});
     EXPECT_EQ(clear.exit_code, 4) << clear.err;
     EXPECT_EQ(Json::parse(clear.out)["error"]["end_code"], "3001");
+    EXPECT_EQ(Json::parse(clear.out)["error"]["hint"], held);
+    const auto clear_text = fins({"--source", "0.11.0", "error-log", "--clear"});
+    EXPECT_EQ(clear_text.err.substr(clear_text.err.find('\n') + 1), "fins: " + held + "\n")
+        << clear_text.err;
     EXPECT_EQ(fins({"--source", "0.11.0", "access-log", "--clear"}).exit_code, 4);  // 21 41
     EXPECT_EQ(fins({"--source", "0.11.0", "access", "force"}).exit_code, 0);
     EXPECT_EQ(fins({"--source", "0.10.0", "access", "acquire"}).exit_code, 4);

@@ -153,6 +153,16 @@ TEST(CliFirstUse, WriteProtection2102NamesTheSourceNodePer5_1_2) {
     EXPECT_TRUE(has(tcp.err, "--source NET.NODE")) << tcp.err;
     auto chosen = fins(d, {"--tcp", "--source", "0.254", "write", "D0", "1"});
     EXPECT_EQ(chosen.exit_code, 0) << chosen.err;
+    // What helps: the node, --source, and where the protection is set.
+    auto udp = fins(d, {"--source", "0.20", "write", "D0", "1"});
+    EXPECT_EQ(udp.exit_code, 4) << udp.err;
+    EXPECT_EQ(udp.err.substr(udp.err.find('\n') + 1),
+              "fins: fins sent as source node 0.20.0; network write protection lets only the "
+              "nodes it lists write (--source NET.NODE sends as another node, `fins probe` "
+              "shows the node in use). It is set in the PLC Setup (finsd: "
+              "--network-write-protection and --protect-node, [protection] network_write and "
+              "nodes, or `finsd ctl write-protect off`)\n")
+        << udp.err;
 
     auto probe = fins(d, {"probe"});
     EXPECT_EQ(probe.exit_code, 0) << probe.err;
@@ -191,7 +201,11 @@ TEST(CliFirstUse, ReadOnly2101SaysWhetherTheDipSwitchProtectsPer5_1_3) {
     auto clear = fins(dip, {"program-clear"});
     EXPECT_EQ(clear.exit_code, 4) << clear.err;
     EXPECT_TRUE(has(clear.err, "(0x2101)")) << clear.err;
-    EXPECT_TRUE(has(clear.err, "DIP switch pin 1 is ON")) << clear.err;
+    EXPECT_TRUE(has(clear.err,
+                    "\nfins: the CPU Unit's DIP switch pin 1 is ON: user memory is "
+                    "write-protected (W342 5-1-2); turn pin 1 OFF to write (finsd: started with "
+                    "--dip-write-protection or [protection] dip_write = true)\n"))
+        << clear.err;
 
     Finsd plain({});
     ASSERT_TRUE(plain.started()) << plain.result().err;

@@ -112,7 +112,7 @@ class Output {
     void print(const nlohmann::json& doc, const std::string& text);
     // Records the CPU error flags (bits 7 and 6, W342 5-1-3) of an answer.
     void note_flags(ResponseCode code);
-    // A relay error (end code bit 15, README "A plant of several networks"): failure()
+    // A relay error (end code bit 15, docs/networks.md "Seeing relay errors in the CLI"): failure()
     // names the relay node that answered, in the text and in the JSON "relay_error".
     void note_relay(const std::optional<RelayErrorSource>& relay) { relay_ = relay; }
     // The connection settings failures are explained against (set by open_client).
@@ -166,6 +166,13 @@ Result<FoundNode> discover_node(const GlobalOptions& g);
 // The DIP switch byte of 05 01 (pin k is bit k-1) of the PLC the options address;
 // nothing when it cannot be read.
 std::optional<std::uint8_t> read_dip_switch(const GlobalOptions& g);
+// The node holding the access right of the PLC the options address, asked with 0C 01
+// ACCESS RIGHT ACQUIRE: its 3001 refusal carries the holder (W342 5-3-24). Nothing when
+// it cannot be asked or nobody holds it; should the 0C 01 find the right free, it is
+// released again at once (0C 03).
+std::optional<NodeAddress> access_right_holder(const GlobalOptions& g);
+// What helps against a 3001: who holds the right, how to take it over or give it back.
+std::string access_right_hint(const NodeAddress& holder);
 // NET.NODE.UNIT: each part decimal, or hex with 0x or with a letter A-F (E1 = 225).
 // NET.NODE is unit 0 (the CPU Unit), as the protection node lists write it.
 std::optional<NodeAddress> parse_node_address(const std::string& s);

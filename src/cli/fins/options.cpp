@@ -20,7 +20,7 @@ namespace fins::cli {
 namespace {
 
 // One part of NET.NODE.UNIT: decimal, 0x-prefixed hex, or hex when it has a letter A-F
-// (the README and the manuals write unit addresses such as E1 in hex).
+// (docs/cli.md and the manuals write unit addresses such as E1 in hex).
 std::optional<unsigned> parse_node_part(std::string_view s) {
     int base = 10;
     if (s.size() > 2 && s[0] == '0' && (s[1] == 'x' || s[1] == 'X')) {

@@ -99,11 +99,13 @@ int Output::failure(std::error_code ec, const std::string& context) {
     } else if (ec == make_error_code(EndCode::read_only) && target_ != nullptr) {
         // W342 5-1-3 2101: read-only, "or protected using a switch setting": DIP switch
         // pin 1 (UM write protection, 5-1-2), which 05 01 reports as bit 0.
+        // finsd sets the pin with --dip-write-protection or [protection] dip_write.
         const auto dip = read_dip_switch(*target_);
         if (dip && (*dip & 0x01) != 0)
             hint =
                 "the CPU Unit's DIP switch pin 1 is ON: user memory is write-protected "
-                "(W342 5-1-2); turn pin 1 OFF to write";
+                "(W342 5-1-2); turn pin 1 OFF to write (finsd: started with "
+                "--dip-write-protection or [protection] dip_write = true)";
         else if (dip)
             hint = "DIP switch pin 1 is OFF: the area or file itself is read-only";
     } else if (ec == make_error_code(EndCode::write_protected) && local_) {
@@ -112,8 +114,18 @@ int Output::failure(std::error_code ec, const std::string& context) {
         hint = fmt::format(
             "fins sent as source node {}; network write protection lets only the nodes it "
             "lists write (--source NET.NODE sends as another node, `fins probe` shows the "
-            "node in use)",
+            "node in use). It is set in the PLC Setup (finsd: --network-write-protection "
+            "and --protect-node, [protection] network_write and nodes, or `finsd ctl "
+            "write-protect off`)",
             node_text(*local_));
+    } else if (ec == make_error_code(EndCode::no_access_right) && target_ != nullptr) {
+        // W342 5-1-3 3001: another device holds the access right; its 0C 01 refusal names it.
+        if (const auto holder = access_right_holder(*target_))
+            hint = access_right_hint(*holder);
+        else
+            hint =
+                "no node holds the access right any more: run the command again "
+                "(`fins access acquire` takes it first)";
     }
     std::string meaning = ec.message();
     if (explained_ && kind == ErrorKind::end_code && ec == make_error_code(explained_->first))

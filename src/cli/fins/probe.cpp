@@ -13,6 +13,7 @@
 
 #include "cli/fins/commands.hpp"
 #include "cli/fins/udp_socket.hpp"
+#include "fins/commands/access_right.hpp"
 #include "fins/commands/configuration.hpp"
 #include "fins/frame.hpp"
 
@@ -138,6 +139,35 @@ std::optional<std::uint8_t> read_dip_switch(const GlobalOptions& g) {
     return data->dip_switch;
 }
 
+std::optional<NodeAddress> access_right_holder(const GlobalOptions& g) {
+    int rc = 0;
+    Output quiet{false};
+    auto client = open_client(g, quiet, rc);
+    if (!client) return std::nullopt;
+    std::array<std::uint8_t, 2> buffer{};
+    ByteWriter w(buffer);
+    AccessRightAcquire{}.encode(w);
+    auto r = client->send_raw(AccessRightAcquire::code, w.written());
+    if (!r) return std::nullopt;
+    // Free again since the refusal: give it back at once, as found.
+    if (r->code.ok()) {
+        (void)client->send(AccessRightRelease{});
+        return std::nullopt;
+    }
+    if (r->code.end_code() != EndCode::no_access_right) return std::nullopt;
+    auto holder = AccessRightHolder::decode(r->data);
+    if (!holder) return std::nullopt;
+    return holder->holder;
+}
+
+std::string access_right_hint(const NodeAddress& holder) {
+    const auto node = node_text(holder);
+    return fmt::format(
+        "node {} holds the access right (0C 01): `fins access force` takes it over (0C 02), "
+        "or the holder gives it back (`fins --source {} access release` sends its 0C 03)",
+        node, node);
+}
+
 Result<FoundNode> discover_node(const GlobalOptions& g) {
     if (!g.serial.empty()) return discover_serial(g);
     return g.tcp ? discover_tcp(g) : discover_udp(g);
@@ -176,7 +206,7 @@ int run_probe(const GlobalOptions& g, Output& out) {
                             derived->node, node_text(found->address));
     // What a network write protection list must name to let this client write (W342
     // 5-1-2): over UDP the local address's node (254 on loopback), over TCP the node the
-    // handshake allocated for this connection (README "Which source node fins uses").
+    // handshake allocated for this connection (docs/cli.md, "Which source node fins uses").
     if (g.serial.empty())
         text += fmt::format("fins sends as node {}{}\n", node_text(found->local),
                             !g.source.empty() ? " (--source)"

@@ -1,5 +1,5 @@
 // `fins files cassette` for 22 20 MEMORY CASSETTE TRANSFER (W342 5-3-43; the CP1H's
-// Memory Cassette, disk 8003; README "File memory (22 xx)", Memory Cassette):
+// Memory Cassette, disk 8003; docs/file-memory.md "Memory Cassette (22 20, CP1H)"):
 //   files cassette save   [AREA...]   0000 CPU Unit -> cassette
 //   files cassette load   [AREA...]   0001 cassette -> CPU Unit (PROGRAM mode)
 //   files cassette verify [AREA...]   0002 compare (exit 4 with 2007 on a difference)

@@ -261,15 +261,18 @@ int run_access(const GlobalOptions& g, Output& out, const std::string& action) {
         return out.failure(make_error_code(r->code.end_code()),
                            std::string(AccessRightAcquire::name));
     const std::string who = node_text(holder->holder);
+    const std::string hint = access_right_hint(holder->holder);
     if (out.json())
         std::printf("%s\n", Json{{"error",
                                   {{"kind", "end_code"},
                                    {"end_code", "3001"},
                                    {"name", "no access right"},
-                                   {"holder", who}}}}
+                                   {"holder", who},
+                                   {"hint", hint}}}}
                                 .dump()
                                 .c_str());
-    std::fprintf(stderr, "fins: access right held by %s (network.node.unit): 3001\n", who.c_str());
+    std::fprintf(stderr, "fins: access right held by %s (network.node.unit): 3001\nfins: %s\n",
+                 who.c_str(), hint.c_str());
     return exit_end_code;
 }
 

@@ -1,4 +1,4 @@
-// `fins files` verbs for 22 xx file memory (README "File memory (22 xx)"):
+// `fins files` verbs for 22 xx file memory (docs/file-memory.md):
 //   files ls [DIR]                      22 01 over as many requests as needed
 //   files get PLCFILE [LOCAL|-]         22 02 in pipelined chunks (LOCAL default: the name)
 //   files put LOCAL PLCFILE [--force]   22 03: create (0000), --force replaces (0001)

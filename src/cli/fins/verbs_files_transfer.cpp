@@ -1,5 +1,5 @@
 // `fins files save / load / compare` helpers (22 0A / 0B / 0C, W342 5-3-39 .. 5-3-41):
-// - the argument list, in the orders the README gives;
+// - the argument list, in the orders docs/file-memory.md gives;
 // - after the PLC answered a compare with 2007: the answer only counts what matched
 //   before the first difference, so the file is fetched (22 02) and the area read
 //   (01 01, 02 01, 03 06) to say where they first differ, both values, and how many

@@ -18,7 +18,7 @@ struct TransferArguments {
     unsigned count = 0;
     std::string problem;  // the usage message when the list does not fit
 };
-// `save WHAT PLCFILE [COUNT]`, `save WHAT COUNT PLCFILE` (README's "D100 10"),
+// `save WHAT PLCFILE [COUNT]`, `save WHAT COUNT PLCFILE` (docs/file-memory.md's "D100 10"),
 // `load|compare PLCFILE WHAT [COUNT]`; anything else: a usage message naming the form.
 TransferArguments transfer_arguments(FileTransferMode mode, const std::vector<std::string>& v);
 

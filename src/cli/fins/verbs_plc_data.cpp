@@ -1,5 +1,5 @@
 // `fins` verbs for 02 xx parameter areas and 02 40 loop control (03 xx program area:
-// verbs_program_area.cpp) (README (parameter and program areas)):
+// verbs_program_area.cpp) (docs/commands.md, parameter and program areas):
 //   param-read AREA [START] [COUNT]       02 01 in blocks of 498 words
 //   param-write AREA START WORD...        02 02; whole areas are read, patched and
 //                                         rewritten from word 0 (5-3-7), bit 15 on the

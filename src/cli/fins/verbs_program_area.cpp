@@ -1,4 +1,4 @@
-// `fins` verbs for the 03 xx program area (README (parameter and program areas)):
+// `fins` verbs for the 03 xx program area (docs/commands.md, parameter and program areas):
 //   program-read [START] [BYTES]          03 06 in blocks of 992 bytes, to bit 15
 //   program-write FILE                    03 07 in blocks of 996 bytes, bit 15 on the last
 //   program-clear [--with-interrupt-tasks] 03 08

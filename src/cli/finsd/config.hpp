@@ -5,7 +5,8 @@
 // Every error is one line naming the key and, for file keys, the file, line and column:
 //   "finsd.toml:12:1: protection.network_write: 'some' is not off, all, listed or
 //    all-except-listed"
-// finsd prints it and exits with code 2. README (profiles and configuration) lists every key.
+// finsd prints it and exits with code 2. docs/finsd.md ("Configuration file reference") lists every
+// key.
 #pragma once
 
 #include <cstdint>

@@ -1,8 +1,8 @@
 // finsd's plant configuration: [[plc]] tables, each a CPU Unit with its [[plc.ethernet]]
 // Communications Units, [[plc.relay]] relay-table entries and, read by the single node's
 // loaders, its own [plc.memory], [plc.protection], [plc.inject], [plc.storage],
-// [plc.files], [plc.serial], [[plc.remote]] and [[plc.schedule]] (README "A plant of several
-// networks"). With at least one [[plc]], finsd runs the plant instead of the one node
+// [plc.files], [plc.serial], [[plc.remote]] and [[plc.schedule]] (docs/networks.md "A plant
+// of several networks"). With at least one [[plc]], finsd runs the plant instead of the one node
 // the top-level keys describe; the [network] TCP limits apply to every unit.
 #pragma once
 

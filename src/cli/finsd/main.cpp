@@ -1,5 +1,5 @@
-// finsd: a virtual Omron CPU Unit answering FINS over UDP and TCP (README: profiles and
-// configuration).
+// finsd: a virtual Omron CPU Unit answering FINS over UDP and TCP (docs/finsd.md:
+// profiles and configuration).
 //
 //   finsd [--config FILE] [flags]   serve; flags override the file (config.hpp)
 //   finsd ctl ...                   the control channel's client (ctl.hpp)
@@ -111,7 +111,7 @@ int configure(int argc, char** argv, Settings& settings) {
     std::size_t max_connections = 0;
     std::string durability;
     bool udp = true, tcp = true, um_read = false, dip_write = false, list = false;
-    app.add_option("--config", config, "TOML configuration file (keys: see README)");
+    app.add_option("--config", config, "TOML configuration file (every key: docs/finsd.md)");
     auto* o_profile = app.add_option("--profile", profile, "PLC profile (--list-profiles)");
     app.add_flag("--list-profiles", list, "Print the known profiles and exit");
     auto* o_mode =
@@ -181,7 +181,7 @@ int configure(int argc, char** argv, Settings& settings) {
             ->check(CLI::IsMember({"process", "power"}));
     app.add_option("--serial", o.serial,
                    "Serial port NAME=DEVICE[,baud=9600,parity=even,data=7,stop=2,unit=0,mode=..."
-                   ",timeout=1]; NAME cpu, scuN.P or board.P (repeatable; README Host Link)");
+                   ",timeout=1]; NAME cpu, scuN.P or board.P (repeatable; docs/serial.md)");
     fins::cli::finsd::HttpFlags http;
     fins::cli::finsd::add_http_flags(app, http);
 

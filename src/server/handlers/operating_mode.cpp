@@ -9,7 +9,8 @@
 // The scan cycle follows the mode: leaving PROGRAM starts operation (statistics
 // restart, 5-3-18 "Comments"); entering PROGRAM stops it. RUN <-> MONITOR keeps the
 // program running. A fatal CPU error is not modelled here (the error model decides
-// whether operation may start; see the README section on the operating mode).
+// whether operation may start; see docs/commands.md "Operating mode, CPU Unit
+// data, cycle time and clock").
 #include "fins/commands/operating_mode.hpp"
 #include "plc/plc.hpp"
 #include "server/handlers/handlers.hpp"

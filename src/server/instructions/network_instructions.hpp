@@ -27,7 +27,7 @@
 // instructions are already running (the 33rd), 0501 no IP address for that network or
 // node, 0101 the node has no FINS/UDP port or its FINS/TCP connection is not
 // established (W596 3 Send error g, Rcv j, SendCmd h), 0103 the frame could not be sent.
-// README "PLC-initiated messages" lists them.
+// docs/networks.md "PLC-initiated messages" lists them.
 //
 // CS/CJ profiles also show the instruction ports in the Auxiliary Area as their CPU
 // Units do: A202 bits 0-7 Communications Port Enabled Flags (ON = port free), A203-A210

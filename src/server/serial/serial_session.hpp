@@ -8,7 +8,7 @@
 // - Frames for another Host Link unit number are ignored (multi-drop line).
 // - Frames with a bad FCS, a format error, a non-FINS header code or over 1,114
 //   characters get the Host Link error answer "@UUFA" EC FCS "*" CR (13, 14, 16, 18;
-//   README "Host Link (serial)"); their unit number must be readable and ours.
+//   docs/serial.md "Host Link (serial)"); their unit number must be readable and ours.
 // - Garbage between frames is skipped; a line with no CR within max_line characters is
 //   dropped unanswered (C-mode rule: over-long frames get no response). The receive
 //   buffer is fixed: nothing the line sends grows memory.

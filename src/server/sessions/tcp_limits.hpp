@@ -1,6 +1,6 @@
 // Limits of finsd's FINS/TCP side (ServerOptions::tcp_limits, finsd [network] keys):
 // deadlines, idle timeout, keep-alive and the cap on connections still in the
-// handshake. README "FINS/TCP identity and limits" gives the defaults and why.
+// handshake. docs/finsd.md "FINS/TCP identity and limits" gives the defaults and why.
 #pragma once
 
 #include <chrono>

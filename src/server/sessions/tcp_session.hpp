@@ -8,7 +8,7 @@
 // Identity: the node of step 2 is the connection's identity. A frame whose source
 // (SNA, SA1) is not this node on the local network is neither executed nor answered
 // (W421 pairs each node with one connection and sends a node's answers on its own
-// connection only; see README "FINS/TCP identity and limits").
+// connection only; see docs/finsd.md "FINS/TCP identity and limits").
 //
 // Closing after an error notice: shut down our sending side, read and discard what
 // the peer still sends (bounded in bytes and time), then close; closing with unread
