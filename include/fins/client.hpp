@@ -4,18 +4,28 @@
 // (an NX CPU runs at most 32 Send/Rcv/SendCmd at once; this client allows 256, one per
 // service ID, and the PLC's own limits still apply).
 //
-// Threading: a Client owns one asio::io_context and runs it only inside its own calls
-// (send*, run, the helpers, connect). It is NOT thread-safe: use it from one thread.
-// Completion callbacks of async_send*() run on that thread, inside send*()/run()/a
-// helper; a callback may call async_send*() again, but must not destroy the Client. A
-// synchronous call (send, send_raw, send_no_response, the helpers) made inside a callback
-// fails at once with ClientError::called_from_callback, and run() returns at once there.
+// Threading, two ways to run (one engine: docs/client.md "One engine"):
+// - Client::connect(): the Client owns one asio::io_context and runs it only inside its
+//   own calls (send*, run, the helpers, connect). Completion callbacks of async_send*()
+//   run inside send*()/run()/a helper; a callback may call async_send*() again, but must
+//   not destroy the Client. A synchronous call (send, send_raw, send_no_response, the
+//   helpers) made inside a callback fails at once with ClientError::called_from_callback,
+//   and run() returns at once there.
+// - Client::create(io, options): embedded in the caller's io_context, which the caller
+//   runs; many clients (and servers) share it. Name resolution, connect and handshake
+//   are asynchronous (async_open(), or the first request); every completion runs on
+//   `io`. Only async_open(), async_send*() and the state calls are for this client: the
+//   synchronous calls fail with ClientError::called_from_callback and run() is a no-op.
+//   Destroying it drops the requests in flight without callbacks.
+// Either way a Client is NOT thread-safe: use it from the thread that runs its io_context.
 //
 // Requests: up to 256 accepted at once; one more fails with
 // ClientError::too_many_in_flight. Each attempt waits `timeout`; after `retries`
-// retransmissions the request fails with ClientError::timeout. A response is matched by
-// service ID (SID), command code and addresses; stale or duplicate answers are dropped
-// and counted in stats().
+// retransmissions the request fails with ClientError::timeout. A retry resends the
+// identical frame, same SID (W596 p. 3-16: "try to resend the message"), so an answer to
+// any attempt completes the request and a late answer to an earlier one is a duplicate. A response
+// is matched by service ID (SID), command code and addresses; stale or duplicate answers are
+// dropped and counted in stats().
 //
 // No late answer completes the wrong request: a read answer carries no address, only
 // the SID. A SID whose request was retransmitted, timed out or failed after it was sent
@@ -70,6 +80,10 @@
 #include "fins/error.hpp"
 #include "fins/frame.hpp"
 #include "fins/serial.hpp"
+
+namespace boost::asio {
+class io_context;
+}
 
 namespace fins {
 
@@ -131,6 +145,14 @@ class Client {
     // ClientError::invalid_argument (retries > 15), a resolve/connect error, a TcpError
     // from the handshake, or ClientError::timeout.
     static Result<std::unique_ptr<Client>> connect(ClientOptions options);
+    // A client on the caller's io_context (see Threading). Only checks the options
+    // (ClientError::invalid_argument as connect()); nothing is opened yet.
+    static Result<std::unique_ptr<Client>> create(boost::asio::io_context& io,
+                                                  ClientOptions options);
+    // Resolves (asynchronously), connects and, over TCP, does the handshake, unless open
+    // already; `done` runs on the io_context with the outcome of that open ({} when the
+    // link is up). Requests submitted meanwhile wait for the link.
+    void async_open(std::function<void(std::error_code)> done);
     // Closes the connection; requests still in flight are dropped without callbacks.
     ~Client();
     Client(const Client&) = delete;
