@@ -134,9 +134,12 @@ struct ClientStats {
     std::uint64_t failed = 0;             // requests failed by connection loss or close
     std::uint64_t stale_discarded = 0;    // answers to no request in flight / wrong command
     std::uint64_t invalid_discarded = 0;  // undecodable frames, wrong addresses
-    std::uint64_t reconnects = 0;         // successful opens after the first
-    std::uint64_t quarantined = 0;        // SIDs put into quarantine (see above)
-    std::uint64_t waited_for_id = 0;      // requests that waited for a usable SID
+    // Of those: answers with the SID and command of a request in flight from another
+    // node than the one it was sent to (the peer is not the node it is addressed as).
+    std::uint64_t other_node_answers = 0;
+    std::uint64_t reconnects = 0;     // successful opens after the first
+    std::uint64_t quarantined = 0;    // SIDs put into quarantine (see above)
+    std::uint64_t waited_for_id = 0;  // requests that waited for a usable SID
 };
 
 class Client {
@@ -227,6 +230,9 @@ class Client {
     // The addresses put in request headers (after derivation).
     [[nodiscard]] NodeAddress destination() const noexcept;
     [[nodiscard]] NodeAddress source() const noexcept;
+    // The node that answered a request sent to destination() instead, since the last
+    // answer that matched: configure it as the destination (or fix the peer's node).
+    [[nodiscard]] std::optional<NodeAddress> other_node() const noexcept;
     // The most parameter bytes (after MRC SRC) a request may carry and response data
     // bytes an answer may carry: 2,000 / 1,998 over Ethernet (2,012-byte frames), 540 /
     // 538 over Host Link (W342 3-5). The helpers split by them.

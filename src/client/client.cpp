@@ -196,6 +196,7 @@ ClientStats Client::stats() const noexcept {
     out.failed = s.failed;
     out.stale_discarded = s.stale_discarded;
     out.invalid_discarded = s.invalid_discarded;
+    out.other_node_answers = s.other_node_answers;
     out.reconnects = impl_->opens > 0 ? impl_->opens - 1 : 0;
     out.quarantined = s.quarantined;
     out.waited_for_id = s.waited_for_id;
@@ -249,6 +250,9 @@ NodeAddress Client::destination() const noexcept {
 }
 NodeAddress Client::source() const noexcept {
     return impl_->tracker.source();
+}
+std::optional<NodeAddress> Client::other_node() const noexcept {
+    return impl_->tracker.other_node();
 }
 
 void Client::close() {
