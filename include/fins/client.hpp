@@ -175,6 +175,10 @@ class Client {
     Result<RawResponse> send_raw(CommandCode code, Bytes parameters);
     void async_send_raw(CommandCode code, Bytes parameters,
                         std::function<void(Result<RawResponse>)> done);
+    // As async_send_raw() without copying the answer: `done` sees views into the receive
+    // buffer, valid only during the call (a hot path such as a poller decoding in place).
+    void async_send_view(CommandCode code, Bytes parameters,
+                         std::function<void(Result<ResponseView>)> done);
     // ICF bit 0 (frames 1.2): nothing is awaited; returns once the frame has been handed
     // to the kernel (or after `timeout` if it could not be). Reconnects first if needed.
     Result<void> send_no_response(CommandCode code, Bytes parameters);

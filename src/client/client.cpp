@@ -172,6 +172,11 @@ Result<RawResponse> Client::send_raw(CommandCode code, Bytes parameters) {
     return std::move(*out);
 }
 
+void Client::async_send_view(CommandCode code, Bytes parameters,
+                             std::function<void(Result<ResponseView>)> done) {
+    submit(code, parameters, std::move(done));
+}
+
 void Client::async_send_raw(CommandCode code, Bytes parameters,
                             std::function<void(Result<RawResponse>)> done) {
     submit(code, parameters, [done = std::move(done)](Result<ResponseView> r) {

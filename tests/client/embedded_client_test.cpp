@@ -103,6 +103,29 @@ TEST(EmbeddedClient, TwoClientsOnTheCallersIoContextTalkToFinsdConcurrently) {
     EXPECT_NE(a.client->source().node, b.client->source().node);
 }
 
+TEST(EmbeddedClient, AsyncSendViewHandsTheAnswerWithoutACopy) {
+    server::ServerOptions so;
+    so.tcp = false;
+    ServerThread finsd(so);
+    asio::io_context io{1};
+    ClientOptions options;
+    options.port = finsd.port();
+    auto client = embedded(io, options);
+    ASSERT_TRUE(client);
+    const std::array<std::uint8_t, 8> write{0x82, 0x00, 0x0A, 0x00, 0x00, 0x01, 0x12, 0x34};
+    const std::array<std::uint8_t, 6> read{0x82, 0x00, 0x0A, 0x00, 0x00, 0x01};
+    std::optional<std::vector<std::uint8_t>> got;
+    client->async_send_view(MemoryAreaWrite::code, write,
+                            [](Result<ResponseView> r) { EXPECT_TRUE(r && r->code.ok()); });
+    client->async_send_view(MemoryAreaRead::code, read, [&got](Result<ResponseView> r) {
+        ASSERT_TRUE(r) << r.error().message();
+        EXPECT_TRUE(r->code.ok());
+        got.emplace(r->data.begin(), r->data.end());
+    });
+    ASSERT_TRUE(run_until(io, [&] { return got.has_value(); }));
+    EXPECT_EQ(*got, (std::vector<std::uint8_t>{0x12, 0x34}));
+}
+
 TEST(EmbeddedClient, SynchronousCallsRefuseAndRunIsANoOp) {
     asio::io_context io{1};
     auto client = embedded(io, {});
