@@ -4,18 +4,28 @@
 // (an NX CPU runs at most 32 Send/Rcv/SendCmd at once; this client allows 256, one per
 // service ID, and the PLC's own limits still apply).
 //
-// Threading: a Client owns one asio::io_context and runs it only inside its own calls
-// (send*, run, the helpers, connect). It is NOT thread-safe: use it from one thread.
-// Completion callbacks of async_send*() run on that thread, inside send*()/run()/a
-// helper; a callback may call async_send*() again, but must not destroy the Client. A
-// synchronous call (send, send_raw, send_no_response, the helpers) made inside a callback
-// fails at once with ClientError::called_from_callback, and run() returns at once there.
+// Threading, two ways to run (one engine: docs/client.md "One engine"):
+// - Client::connect(): the Client owns one asio::io_context and runs it only inside its
+//   own calls (send*, run, the helpers, connect). Completion callbacks of async_send*()
+//   run inside send*()/run()/a helper; a callback may call async_send*() again, but must
+//   not destroy the Client. A synchronous call (send, send_raw, send_no_response, the
+//   helpers) made inside a callback fails at once with ClientError::called_from_callback,
+//   and run() returns at once there.
+// - Client::create(io, options): embedded in the caller's io_context, which the caller
+//   runs; many clients (and servers) share it. Name resolution, connect and handshake
+//   are asynchronous (async_open(), or the first request); every completion runs on
+//   `io`. Only async_open(), async_send*() and the state calls are for this client: the
+//   synchronous calls fail with ClientError::called_from_callback and run() is a no-op.
+//   Destroying it drops the requests in flight without callbacks.
+// Either way a Client is NOT thread-safe: use it from the thread that runs its io_context.
 //
 // Requests: up to 256 accepted at once; one more fails with
 // ClientError::too_many_in_flight. Each attempt waits `timeout`; after `retries`
-// retransmissions the request fails with ClientError::timeout. A response is matched by
-// service ID (SID), command code and addresses; stale or duplicate answers are dropped
-// and counted in stats().
+// retransmissions the request fails with ClientError::timeout. A retry resends the
+// identical frame, same SID (W596 p. 3-16: "try to resend the message"), so an answer to
+// any attempt completes the request and a late answer to an earlier one is a duplicate. A response
+// is matched by service ID (SID), command code and addresses; stale or duplicate answers are
+// dropped and counted in stats().
 //
 // No late answer completes the wrong request: a read answer carries no address, only
 // the SID. A SID whose request was retransmitted, timed out or failed after it was sent
@@ -71,6 +81,10 @@
 #include "fins/frame.hpp"
 #include "fins/serial.hpp"
 
+namespace boost::asio {
+class io_context;
+}
+
 namespace fins {
 
 struct ClientOptions {
@@ -120,9 +134,12 @@ struct ClientStats {
     std::uint64_t failed = 0;             // requests failed by connection loss or close
     std::uint64_t stale_discarded = 0;    // answers to no request in flight / wrong command
     std::uint64_t invalid_discarded = 0;  // undecodable frames, wrong addresses
-    std::uint64_t reconnects = 0;         // successful opens after the first
-    std::uint64_t quarantined = 0;        // SIDs put into quarantine (see above)
-    std::uint64_t waited_for_id = 0;      // requests that waited for a usable SID
+    // Of those: answers with the SID and command of a request in flight from another
+    // node than the one it was sent to (the peer is not the node it is addressed as).
+    std::uint64_t other_node_answers = 0;
+    std::uint64_t reconnects = 0;     // successful opens after the first
+    std::uint64_t quarantined = 0;    // SIDs put into quarantine (see above)
+    std::uint64_t waited_for_id = 0;  // requests that waited for a usable SID
 };
 
 class Client {
@@ -131,6 +148,14 @@ class Client {
     // ClientError::invalid_argument (retries > 15), a resolve/connect error, a TcpError
     // from the handshake, or ClientError::timeout.
     static Result<std::unique_ptr<Client>> connect(ClientOptions options);
+    // A client on the caller's io_context (see Threading). Only checks the options
+    // (ClientError::invalid_argument as connect()); nothing is opened yet.
+    static Result<std::unique_ptr<Client>> create(boost::asio::io_context& io,
+                                                  ClientOptions options);
+    // Resolves (asynchronously), connects and, over TCP, does the handshake, unless open
+    // already; `done` runs on the io_context with the outcome of that open ({} when the
+    // link is up). Requests submitted meanwhile wait for the link.
+    void async_open(std::function<void(std::error_code)> done);
     // Closes the connection; requests still in flight are dropped without callbacks.
     ~Client();
     Client(const Client&) = delete;
@@ -150,6 +175,10 @@ class Client {
     Result<RawResponse> send_raw(CommandCode code, Bytes parameters);
     void async_send_raw(CommandCode code, Bytes parameters,
                         std::function<void(Result<RawResponse>)> done);
+    // As async_send_raw() without copying the answer: `done` sees views into the receive
+    // buffer, valid only during the call (a hot path such as a poller decoding in place).
+    void async_send_view(CommandCode code, Bytes parameters,
+                         std::function<void(Result<ResponseView>)> done);
     // ICF bit 0 (frames 1.2): nothing is awaited; returns once the frame has been handed
     // to the kernel (or after `timeout` if it could not be). Reconnects first if needed.
     Result<void> send_no_response(CommandCode code, Bytes parameters);
@@ -205,6 +234,9 @@ class Client {
     // The addresses put in request headers (after derivation).
     [[nodiscard]] NodeAddress destination() const noexcept;
     [[nodiscard]] NodeAddress source() const noexcept;
+    // The node that answered a request sent to destination() instead, since the last
+    // answer that matched: configure it as the destination (or fix the peer's node).
+    [[nodiscard]] std::optional<NodeAddress> other_node() const noexcept;
     // The most parameter bytes (after MRC SRC) a request may carry and response data
     // bytes an answer may carry: 2,000 / 1,998 over Ethernet (2,012-byte frames), 540 /
     // 538 over Host Link (W342 3-5). The helpers split by them.

@@ -19,12 +19,42 @@ Client::~Client() {
     if (impl_) impl_->transport->close();
 }
 
-Result<std::unique_ptr<Client>> Client::connect(ClientOptions options) {
+namespace {
+
+// The checks and defaults both ways of making a client share.
+Result<ClientOptions> checked(ClientOptions options) {
     if (options.retries > max_retries || (options.protocol == ClientOptions::Protocol::serial &&
                                           options.host_link_unit > host_link_max_unit))
         return Unexpected(make_error_code(ClientError::invalid_argument));
     if (options.timeout.count() <= 0) options.timeout = default_timeout;
-    std::unique_ptr<Client> client(new Client(std::make_unique<Impl>(std::move(options))));
+    return options;
+}
+
+}  // namespace
+
+Result<std::unique_ptr<Client>> Client::create(asio::io_context& io, ClientOptions options) {
+    auto o = checked(std::move(options));
+    if (!o) return Unexpected(o.error());
+    return std::unique_ptr<Client>(new Client(std::make_unique<Impl>(std::move(*o), &io)));
+}
+
+void Client::async_open(std::function<void(std::error_code)> done) {
+    auto& i = *impl_;
+    i.check_idle_link();
+    if (i.tracker.is_link_up()) {
+        std::weak_ptr<int> life = i.life;
+        asio::post(i.io, [life, done = std::move(done)] {
+            if (!life.expired()) done({});
+        });
+        return;
+    }
+    i.ensure_open(std::move(done));
+}
+
+Result<std::unique_ptr<Client>> Client::connect(ClientOptions options) {
+    auto o = checked(std::move(options));
+    if (!o) return Unexpected(o.error());
+    std::unique_ptr<Client> client(new Client(std::make_unique<Impl>(std::move(*o), nullptr)));
     std::optional<std::error_code> opened;
     client->impl_->ensure_open([&opened](std::error_code ec) { opened = ec; });
     client->run_until([&opened] { return opened.has_value(); });
@@ -48,13 +78,15 @@ void Client::submit(CommandCode code, Bytes parameters, ViewCompletion done) {
 }
 
 bool Client::in_callback() const noexcept {
-    return impl_->running > 0;
+    return impl_->embedded || impl_->running > 0;
 }
 
 void Client::fail_later(ViewCompletion done, std::error_code ec) {
     auto* impl = impl_.get();
     ++impl->posted;
-    asio::post(impl->io, [impl, done = std::move(done), ec] {
+    std::weak_ptr<int> life = impl->life;
+    asio::post(impl->io, [impl, life, done = std::move(done), ec] {
+        if (life.expired()) return;  // the client is gone (embedded): no callback
         --impl->posted;
         done(Unexpected(ec));
     });
@@ -140,6 +172,11 @@ Result<RawResponse> Client::send_raw(CommandCode code, Bytes parameters) {
     return std::move(*out);
 }
 
+void Client::async_send_view(CommandCode code, Bytes parameters,
+                             std::function<void(Result<ResponseView>)> done) {
+    submit(code, parameters, std::move(done));
+}
+
 void Client::async_send_raw(CommandCode code, Bytes parameters,
                             std::function<void(Result<RawResponse>)> done) {
     submit(code, parameters, [done = std::move(done)](Result<ResponseView> r) {
@@ -164,6 +201,7 @@ ClientStats Client::stats() const noexcept {
     out.failed = s.failed;
     out.stale_discarded = s.stale_discarded;
     out.invalid_discarded = s.invalid_discarded;
+    out.other_node_answers = s.other_node_answers;
     out.reconnects = impl_->opens > 0 ? impl_->opens - 1 : 0;
     out.quarantined = s.quarantined;
     out.waited_for_id = s.waited_for_id;
@@ -217,6 +255,9 @@ NodeAddress Client::destination() const noexcept {
 }
 NodeAddress Client::source() const noexcept {
     return impl_->tracker.source();
+}
+std::optional<NodeAddress> Client::other_node() const noexcept {
+    return impl_->tracker.other_node();
 }
 
 void Client::close() {

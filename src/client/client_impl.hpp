@@ -2,9 +2,11 @@
 // timer that covers the tracker's next deadline. Private to src/client.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <utility>
+#include <vector>
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/steady_timer.hpp>
@@ -28,8 +30,14 @@ inline SteadyTime now() {
 inline constexpr std::uint8_t fallback_source_node = 254;
 
 struct Client::Impl final : FrameSink {
-    explicit Impl(ClientOptions o)
-        : io(1), options(std::move(o)), tracker(*this, options.gateway_count), timer(io) {
+    // `external`: the caller's io_context (Client::create); null: an own one (connect).
+    Impl(ClientOptions o, asio::io_context* external)
+        : own_io(external ? nullptr : std::make_unique<asio::io_context>(1)),
+          io(external ? *external : *own_io),
+          embedded(external != nullptr),
+          options(std::move(o)),
+          tracker(*this, options.gateway_count),
+          timer(io) {
         tracker.set_quarantine(quarantine());
         transport::TransportOptions t;
         t.host = options.host;
@@ -83,10 +91,12 @@ struct Client::Impl final : FrameSink {
 
     void send_frame(Bytes frame) override { transport->send(frame); }
 
-    // Starts opening unless already open or opening; `notify` hears how this open ends.
+    // Starts opening unless already open or opening; `notify` hears how the open under
+    // way (this one or one started earlier) ends.
     void ensure_open(std::function<void(std::error_code)> notify = nullptr) {
+        if (notify) open_waiters.push_back(std::move(notify));
         if (transport->state() != transport::Transport::State::closed) return;
-        transport->async_open([this, notify = std::move(notify)](Result<transport::LinkInfo> r) {
+        transport->async_open([this](Result<transport::LinkInfo> r) {
             if (!r) {
                 last_open_error = r.error();
                 tracker.link_down(r.error());
@@ -96,7 +106,10 @@ struct Client::Impl final : FrameSink {
                 tracker.link_up(derive_destination(*r), derive_source(*r), now());
             }
             rearm();
-            if (notify) notify(r ? std::error_code{} : r.error());
+            auto waiters = std::move(open_waiters);
+            open_waiters.clear();
+            for (auto& w : waiters)
+                w(r ? std::error_code{} : r.error());
         });
     }
 
@@ -144,9 +157,15 @@ struct Client::Impl final : FrameSink {
 
     [[nodiscard]] RequestTiming timing() const { return {options.timeout, options.retries}; }
 
-    // Declaration order is destruction order in reverse: the io_context goes last, so
-    // no handler that refers to the members below can run after they are gone.
-    asio::io_context io;
+    // Declaration order is destruction order in reverse: an own io_context goes last, so
+    // no handler that refers to the members below can run after they are gone. On the
+    // caller's io_context, handlers outlive the Impl: the transport's and the timer's
+    // check a generation or an error, posted ones `life`.
+    std::unique_ptr<asio::io_context> own_io;
+    asio::io_context& io;
+    bool embedded = false;
+    std::shared_ptr<int> life = std::make_shared<int>(0);
+    std::vector<std::function<void(std::error_code)>> open_waiters;
     ClientOptions options;
     std::unique_ptr<transport::Transport> transport;
     RequestTracker tracker;

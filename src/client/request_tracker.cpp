@@ -192,8 +192,15 @@ RequestTracker::Disposition RequestTracker::on_frame(Bytes frame, SteadyTime now
     }
     if (!addresses_match(requests_[index].header, response->header)) {
         ++stats_.invalid_discarded;
+        auto only_node = response->header;
+        only_node.source.node = requests_[index].header.destination.node;
+        if (addresses_match(requests_[index].header, only_node)) {
+            ++stats_.other_node_answers;
+            other_node_ = response->header.source;
+        }
         return Disposition::invalid;
     }
+    other_node_.reset();
     if (requests_[index].transmissions == 1) {
         // Smoothed like TCP's SRTT (RFC 6298, gain 1/8); sets how long clean SIDs rest.
         const auto rtt = now - requests_[index].sent_at;

@@ -23,7 +23,10 @@
 //   example the second answer to a retransmitted frame); discarded, counted in
 //   stats().stale_discarded. Undecodable frames, frames without the response bit and
 //   address mismatches are discarded and counted in stats().invalid_discarded; the
-//   request stays in flight.
+//   request stays in flight. A mismatch that is only the responder's node (SID and
+//   command of a request in flight, from another node than the one asked) is counted in
+//   stats().other_node_answers as well, and other_node() names that node until an answer
+//   matches: the peer is not the node it is addressed as (fins-bridge says so).
 // - On timeout the identical frame (same SID) is sent again, up to `retries` times; after
 //   the last attempt the request fails with ClientError::timeout. A request's clock
 //   starts at submit() while the link is down, and again when it is first sent.
@@ -71,15 +74,16 @@ struct RequestTiming {
 };
 
 struct TrackerStats {
-    std::uint64_t sent = 0;               // frames handed to the sink for the first time
-    std::uint64_t retransmitted = 0;      // frames sent again after a timeout
-    std::uint64_t completed = 0;          // responses matched to a request
-    std::uint64_t timed_out = 0;          // requests failed with ClientError::timeout
-    std::uint64_t failed = 0;             // requests failed by link_down() / cancel_all()
-    std::uint64_t stale_discarded = 0;    // SID not in flight, or wrong command code
-    std::uint64_t invalid_discarded = 0;  // undecodable, not a response, wrong addresses
-    std::uint64_t quarantined = 0;        // SIDs put into quarantine
-    std::uint64_t waited_for_id = 0;      // requests that had to wait for a usable SID
+    std::uint64_t sent = 0;                // frames handed to the sink for the first time
+    std::uint64_t retransmitted = 0;       // frames sent again after a timeout
+    std::uint64_t completed = 0;           // responses matched to a request
+    std::uint64_t timed_out = 0;           // requests failed with ClientError::timeout
+    std::uint64_t failed = 0;              // requests failed by link_down() / cancel_all()
+    std::uint64_t stale_discarded = 0;     // SID not in flight, or wrong command code
+    std::uint64_t invalid_discarded = 0;   // undecodable, not a response, wrong addresses
+    std::uint64_t other_node_answers = 0;  // of those: a request's answer from another node
+    std::uint64_t quarantined = 0;         // SIDs put into quarantine
+    std::uint64_t waited_for_id = 0;       // requests that had to wait for a usable SID
 };
 
 // Where frames go. send_frame() must copy the bytes (the slot buffer is reused) and
@@ -144,6 +148,11 @@ class RequestTracker {
     [[nodiscard]] std::size_t waiting() const noexcept { return queue_.size(); }
     [[nodiscard]] const TrackerStats& stats() const noexcept { return stats_; }
     [[nodiscard]] const NodeAddress& destination() const noexcept { return destination_; }
+    // The node that last answered a request addressed to another node, since the last
+    // answer that matched (see the contract above).
+    [[nodiscard]] const std::optional<NodeAddress>& other_node() const noexcept {
+        return other_node_;
+    }
     [[nodiscard]] const NodeAddress& source() const noexcept { return source_; }
     void set_gateway_count(std::uint8_t count) noexcept { gateway_count_ = count; }
     void set_quarantine(std::chrono::nanoseconds q) noexcept { sids_.set_quarantine(q); }
@@ -196,6 +205,7 @@ class RequestTracker {
     NodeAddress destination_;
     NodeAddress source_;
     TrackerStats stats_;
+    std::optional<NodeAddress> other_node_;
 };
 
 }  // namespace fins

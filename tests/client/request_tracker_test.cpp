@@ -170,6 +170,26 @@ TEST_F(TrackerTest, MalformedFramesAreDiscardedAndCounted) {
     EXPECT_EQ(tracker.on_frame(good, t0), RequestTracker::Disposition::matched);
 }
 
+TEST_F(TrackerTest, AnAnswerFromAnotherNodeIsDroppedAndNamesThatNode) {
+    Outcome o;
+    submit(o);
+    EXPECT_FALSE(tracker.other_node());
+    auto from_11 = answer(wire.frames[0]);
+    from_11[7] = 11;  // SA1: answered by node 11, asked node 10
+    EXPECT_EQ(tracker.on_frame(from_11, t0), RequestTracker::Disposition::invalid);
+    EXPECT_FALSE(o.result) << "node 10 was asked: node 11's answer completes nothing";
+    EXPECT_EQ(tracker.stats().other_node_answers, 1u);
+    EXPECT_EQ(tracker.stats().invalid_discarded, 1u);
+    ASSERT_TRUE(tracker.other_node());
+    EXPECT_EQ(tracker.other_node()->node, 11);
+    auto wrong_unit = answer(wire.frames[0]);
+    wrong_unit[5] = 0x10;  // another unit: not a node mix-up
+    EXPECT_EQ(tracker.on_frame(wrong_unit, t0), RequestTracker::Disposition::invalid);
+    EXPECT_EQ(tracker.stats().other_node_answers, 1u);
+    EXPECT_EQ(tracker.on_frame(answer(wire.frames[0]), t0), RequestTracker::Disposition::matched);
+    EXPECT_FALSE(tracker.other_node()) << "a matching answer clears it";
+}
+
 TEST(TrackerAddresses, LocalNodeZeroAcceptsTheRespondersRealAddress) {
     FakeWire wire;
     RequestTracker tracker{wire};
