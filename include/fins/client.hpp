@@ -55,10 +55,11 @@
 //
 // Address defaults (node 0 in ClientOptions means "derive"):
 //   destination: TCP -> the server node from the handshake; UDP -> the last octet of
-//                the host's IPv4 address (1 for loopback, last byte for other IPv6).
+//                the host's IPv4 address, on loopback too (127.0.0.2 -> node 2; ::1 -> 1;
+//                the last byte for other IPv6), as W420 5-2's automatic generation does.
 //   source:      TCP -> the node the server allocated (or the one requested);
 //                UDP -> the last octet of the local address; if that equals the
-//                destination node (loopback), 254 instead, so the two ends differ.
+//                destination node (both on 127.0.0.1), 254 instead, so the two ends differ.
 #pragma once
 
 #include <array>

@@ -25,7 +25,7 @@ inline SteadyTime now() {
     return std::chrono::steady_clock::now();
 }
 
-// UDP on loopback derives node 1 for both ends; a source equal to the destination would
+// UDP to 127.0.0.1 derives node 1 for both ends; a source equal to the destination would
 // look like the PLC talking to itself (W421 7-4 refuses it on TCP with error 0x24).
 inline constexpr std::uint8_t fallback_source_node = 254;
 

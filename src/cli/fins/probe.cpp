@@ -1,6 +1,6 @@
 // `fins probe`: which FINS node answers at HOST:PORT, and the --dest that reaches it.
 //
-// Over UDP the client addresses node "host's last octet" (1 on loopback), so a PLC set to
+// Over UDP the client addresses node "host's last octet" (1 at 127.0.0.1), so a PLC set to
 // another node answers 0201. A request to node 00 means "the local node" (W342 5-1-1
 // DA1), which a PLC answers with its own address in the response's source field: one
 // 05 01 CPU UNIT DATA READ sent that way tells the node and the model. Over TCP the

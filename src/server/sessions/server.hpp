@@ -44,7 +44,7 @@ struct ServerOptions {
     std::uint16_t port = 9600;  // 0 picks a free port (tests)
     bool udp = true;
     bool tcp = true;
-    // 0 = derive: last octet of the bound IPv4 address, 1 on loopback or a wildcard.
+    // 0 = derive: last octet of the bound IPv4 address (loopback too), 1 on a wildcard.
     std::uint8_t node = 0;
     std::uint8_t network = 0;  // this node's FINS network address (00 = local network)
     // W596 1-2: up to 16 FINS/TCP connections.
