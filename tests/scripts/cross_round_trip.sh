@@ -39,7 +39,9 @@ wait_for() {
 run() { "${emu[@]}" "$bin/$1" "${@:2}"; }
 
 fins_port=$(free_port)
-XDG_RUNTIME_DIR=$work run finsd --bind 127.0.0.1 --port "$fins_port" >"$work/finsd.log" 2>&1 &
+# Started without the run function: $! must be the program's own PID (a function in the
+# background is a subshell, and killing it left the emulated program running).
+XDG_RUNTIME_DIR=$work "${emu[@]}" "$bin/finsd" --bind 127.0.0.1 --port "$fins_port" >"$work/finsd.log" 2>&1 &
 pids+=($!)
 wait_for 60 grep -q "listening $fins_port" "$work/finsd.log" || fail "finsd did not listen"
 passed=0
@@ -78,7 +80,8 @@ tags = [ { name = "speed", address = "D100", type = "int16" },
 CONF
 mosquitto_sub -p "$mqtt_port" -t 'cross/#' -v >"$work/sub.log" 2>&1 &
 pids+=($!)
-run fins-bridge --config "$work/bridge.toml" --instance cross --log-level warn >"$work/bridge.log" 2>&1 &
+"${emu[@]}" "$bin/fins-bridge" --config "$work/bridge.toml" --instance cross --log-level warn \
+  >"$work/bridge.log" 2>&1 &
 pids+=($!)
 check wait_for 60 grep -q 'cross/press1/fast .*"speed":4242' "$work/sub.log"
 wait_for 30 grep -q 'cross/press1/status .*"online"' "$work/sub.log" || fail "PLC not online"
