@@ -144,11 +144,10 @@ TEST(FinsdCtl, Newcomer6_FinsdAndCtlShareTheDefaultSocket) {
     EXPECT_EQ(cli::default_control_sockets(), std::vector<std::filesystem::path>{"/tmp/x.sock"});
     ::unsetenv("FINSD_SOCKET");
     const char* xdg = std::getenv("XDG_RUNTIME_DIR");
-    const std::filesystem::path own = ::geteuid() == 0
-                                          ? std::filesystem::path("/run/finsd/finsd.sock")
-                                          : std::filesystem::path("/tmp/finsd-" +
-                                                                  std::to_string(::geteuid())) /
-                                                "finsd.sock";
+    const std::filesystem::path own =
+        ::geteuid() == 0
+            ? std::filesystem::path("/run/finsd/finsd.sock")
+            : std::filesystem::path("/tmp/finsd-" + std::to_string(::geteuid())) / "finsd.sock";
     if (xdg == nullptr || *xdg == '\0') {
         EXPECT_EQ(cli::default_control_socket(), own);
         EXPECT_EQ(cli::default_control_sockets(), std::vector<std::filesystem::path>{own});
@@ -186,15 +185,15 @@ TEST(FinsdCtl, Issue26_8_FinsdAndCtlMeetAtTheDefaultSocketWithoutFlags) {
 // no default place holds a socket.
 TEST(FinsdCtl, Issue26_8_CtlErrorSaysHowToStartFinsdWithAChannel) {
     ScratchDir dir("ctlnone");
-    std::vector<std::string> command{"/usr/bin/env", "-u", "FINSD_SOCKET",
-                                     "XDG_RUNTIME_DIR=" + dir.path().string(), finsd_path,
-                                     "ctl", "status"};
+    std::vector<std::string> command{
+        "/usr/bin/env", "-u",  "FINSD_SOCKET", "XDG_RUNTIME_DIR=" + dir.path().string(),
+        finsd_path,     "ctl", "status"};
     if (::geteuid() == 0 && ::access("/usr/bin/unshare", X_OK) == 0) {
         std::string line = "mount -t tmpfs none /run && mount -t tmpfs none /tmp && exec";
         for (const auto& word : command)
             line += " '" + word + "'";
-        command = {"/usr/bin/unshare", "--mount", "--propagation", "private", "/bin/sh", "-c",
-                   line};
+        command = {
+            "/usr/bin/unshare", "--mount", "--propagation", "private", "/bin/sh", "-c", line};
     }
     const auto r = run(command);
     EXPECT_NE(r.exit_code, 0);
@@ -238,8 +237,8 @@ TEST(FinsdCtl, Issue26_8_SocketDirectoryIsCreatedAndCheckedBeforeUse) {
         const auto theirs = dir.path() / "finsd-theirs";
         ASSERT_EQ(::mkdir(theirs.c_str(), 0700), 0);
         ASSERT_EQ(::chown(theirs.c_str(), 65534, 65534), 0);
-        EXPECT_TRUE(has(cli::prepare_socket_directory(theirs, 0700, 0),
-                        "is owned by uid 65534, not 0"));
+        EXPECT_TRUE(
+            has(cli::prepare_socket_directory(theirs, 0700, 0), "is owned by uid 65534, not 0"));
     }
 }
 
