@@ -17,25 +17,7 @@ cleanup() {
 }
 trap cleanup EXIT
 fail() { echo "cross round trip: $*" >&2; for f in "$work"/*.log; do echo "== $f"; tail -n 20 "$f"; done >&2; exit 1; }
-# A free loopback port (UDP and TCP both free: finsd takes both).
-free_port() {
-  /usr/bin/python3 -c 'import socket
-while True:
-    t = socket.socket(); t.bind(("127.0.0.1", 0)); p = t.getsockname()[1]
-    u = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    try:
-        u.bind(("127.0.0.1", p)); print(p); break
-    except OSError: pass
-    finally: u.close(); t.close()'
-}
-# wait_for SECONDS COMMAND...: until COMMAND succeeds, at most SECONDS (tenths polled).
-wait_for() {
-  local deadline=$((SECONDS + $1)); shift
-  until "$@" >/dev/null 2>&1; do
-    ((SECONDS < deadline)) || return 1
-    sleep 0.1
-  done
-}
+source "$(dirname "$0")/round_trip_lib.sh"  # free_port, wait_for
 run() { "${emu[@]}" "$bin/$1" "${@:2}"; }
 
 fins_port=$(free_port)

@@ -18,23 +18,7 @@ cleanup() {
 }
 trap cleanup EXIT
 fail() { echo "windows round trip: $*" >&2; tail -n 20 "$work/finsd.log" >&2 || true; exit 1; }
-free_port() {
-  /usr/bin/python3 -c 'import socket
-while True:
-    t = socket.socket(); t.bind(("127.0.0.1", 0)); p = t.getsockname()[1]
-    u = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    try:
-        u.bind(("127.0.0.1", p)); print(p); break
-    except OSError: pass
-    finally: u.close(); t.close()'
-}
-wait_for() {
-  local deadline=$((SECONDS + $1)); shift
-  until "$@" >/dev/null 2>&1; do
-    ((SECONDS < deadline)) || return 1
-    sleep 0.1
-  done
-}
+source "$(dirname "$0")/round_trip_lib.sh"  # free_port, wait_for
 # wine's console output ends lines with CR LF: compare without the CR.
 fins() { "$wine" "$bin/fins.exe" --host 127.0.0.1 --port "$port" "$@" | tr -d '\r'; }
 
