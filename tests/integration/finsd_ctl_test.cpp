@@ -29,12 +29,6 @@ bool has(const std::string& text, const std::string& part) {
     return text.find(part) != std::string::npos;
 }
 
-RunResult ctl(const std::string& socket, std::vector<std::string> args) {
-    std::vector<std::string> argv{finsd_path, "ctl", "--socket", socket};
-    argv.insert(argv.end(), args.begin(), args.end());
-    return run(argv);
-}
-
 // Plant item: `finsd ctl` reached only the first [[plc]]. --plc NAME or NET.NODE picks
 // any CPU Unit; without it, the first.
 TEST(FinsdCtl, PlcSelectsACpuUnitOfAPlantOfTwo) {

@@ -137,4 +137,14 @@ inline unsigned end_code(Client& c, CommandCode code, const std::vector<std::uin
     return r ? static_cast<unsigned>(r->code.end_code()) : 0xFFFFU;
 }
 
+// `finsd ctl --socket SOCKET ARGS...`, run to its end.
+inline RunResult ctl(const std::string& socket, const std::vector<std::string>& args) {
+    std::vector<std::string> argv{finsd_path, "ctl", "--socket", socket};
+    argv.insert(argv.end(), args.begin(), args.end());
+    return run(argv);
+}
+
+// The shipped example scenarios, with a trailing slash.
+inline const std::string scenario_examples = std::string(FINS_SOURCE_DIR) + "/examples/scenarios/";
+
 }  // namespace fins::test

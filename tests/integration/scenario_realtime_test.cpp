@@ -19,13 +19,7 @@ namespace {
 
 using Json = nlohmann::json;
 
-const std::string examples = std::string(FINS_SOURCE_DIR) + "/examples/scenarios/";
-
-RunResult ctl(const std::string& socket, std::vector<std::string> args) {
-    std::vector<std::string> argv{finsd_path, "ctl", "--socket", socket};
-    argv.insert(argv.end(), args.begin(), args.end());
-    return run(argv);
-}
+const std::string& examples = scenario_examples;
 
 // Reads `address` until it differs from its first value: true when it did within 10 s
 // (bounded in time and in reads; no sleep, each read is a FINS round trip).

@@ -17,13 +17,7 @@ namespace {
 
 using Json = nlohmann::json;
 
-const std::string examples = std::string(FINS_SOURCE_DIR) + "/examples/scenarios/";
-
-RunResult ctl(const std::string& socket, std::vector<std::string> args) {
-    std::vector<std::string> argv{finsd_path, "ctl", "--socket", socket};
-    argv.insert(argv.end(), args.begin(), args.end());
-    return run(argv);
-}
+const std::string& examples = scenario_examples;
 
 Json scenario_status(const std::string& socket) {
     const auto r = ctl(socket, {"scenario", "status"});
