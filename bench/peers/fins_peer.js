@@ -9,7 +9,8 @@
 // whatever the earlier ones cost; a timer that fires after the next grid point skips the
 // points it missed, and a cycle due while the PLC's previous read is still in flight is
 // skipped; both count as overruns. Counters go out every --stats-s on
-// `{prefix}/$peer/node/stats` with fins-bridge's names (values, overruns, timeouts ...).
+// `{prefix}/$peer/node/stats` with fins-bridge's names (values, overruns, timeouts ...),
+// overruns split into `late` and `busy`; the totals are printed on SIGTERM.
 //
 //   node fins_peer.js --plcs 1000 --fins-port 9650 --net 127.0.60 --mqtt-port 1883
 'use strict';
@@ -48,7 +49,9 @@ const third = Number(o.net.split('.')[2]);
 const ipOf = (i) => `${a}.${b}.${third + Math.floor(i / 250)}.${1 + (i % 250)}`;
 const nodeOf = (i) => 1 + (i % 250);
 
-const stats = { values: 0, frames: 0, overruns: 0, timeouts: 0, errors: 0, published: 0 };
+// overruns = late (grid points the timer fired too late for) + busy (a cycle due while the
+// previous read was in flight).
+const stats = { values: 0, frames: 0, overruns: 0, late: 0, busy: 0, timeouts: 0, errors: 0, published: 0 };
 const broker = mqtt.connect(`mqtt://127.0.0.1:${o['mqtt-port']}`, {
     clientId: `fins-peer-node-${process.pid}`,
     clean: true,
@@ -103,10 +106,12 @@ function startPlc(i, start) {
             const missed = Math.floor((now - plc.next) / interval) + 1;
             plc.next += missed * interval;
             stats.overruns += missed;
+            stats.late += missed;
         }
         setTimeout(tick, plc.next - performance.now());
         if (plc.busy) {
             ++stats.overruns;
+            ++stats.busy;
             return;
         }
         plc.busy = true;
@@ -125,6 +130,7 @@ broker.once('connect', () => {
 });
 
 const stop = () => {
+    console.error(`fins_peer.js: totals ${JSON.stringify(stats)}`);
     broker.end(true, () => process.exit(0));
     setTimeout(() => process.exit(0), 2000).unref();
 };
