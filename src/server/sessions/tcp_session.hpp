@@ -55,7 +55,7 @@ boost::system::error_code set_keepalive(asio::ip::tcp::socket& socket,
 
 // Deferred answers (a Serial Gateway port's) wait in a small queue of their own and are
 // written whole between the in-order responses, never interleaved with one.
-class TcpSession : public std::enable_shared_from_this<TcpSession>, private ReplyPath {
+class TcpSession final : public std::enable_shared_from_this<TcpSession>, private ReplyPath {
   public:
     TcpSession(asio::ip::tcp::socket socket, Dispatcher& dispatcher, TcpNodeTable& nodes,
                const TcpLimits& limits);

@@ -1,6 +1,7 @@
 #include "server/sessions/udp_batch.hpp"
 
 #ifndef _WIN32
+#include <netinet/in.h>
 #include <sys/uio.h>
 #endif
 
@@ -107,11 +108,24 @@ SendOne send_one(transport::os::NativeSocket s, const std::uint8_t* data, std::s
 
 // recvmmsg/sendmmsg take arrays of message headers that point at the buffers; they are
 // wired once here and only the lengths and reply addresses change per batch.
+//
+// A socket bound to a wildcard address (0.0.0.0, ::) gets each datagram's own destination
+// address with it (IP_PKTINFO, IPV6_PKTINFO), and the reply leaves from that address: a
+// request sent to 127.0.0.3 is answered from 127.0.0.3, not from the address the route
+// would pick (127.0.0.1), which a connected client socket would drop, as it would on a host
+// with several addresses. A PLC has one address, so it never answers from another.
+constexpr std::size_t control_size = CMSG_SPACE(sizeof(in6_pktinfo));
+static_assert(CMSG_SPACE(sizeof(in_pktinfo)) <= control_size);
+
 struct SystemHeaders {
     std::array<iovec, batch_size> in_iov{};
     std::array<iovec, batch_size> out_iov{};
     std::array<mmsghdr, batch_size> in_msgs{};
     std::array<mmsghdr, batch_size> out_msgs{};
+    // Received with each datagram, and the same bytes put on its reply (alignas: cmsghdr).
+    alignas(cmsghdr) std::array<std::array<std::uint8_t, control_size>, batch_size> in_control{};
+    alignas(cmsghdr) std::array<std::array<std::uint8_t, control_size>, batch_size> out_control{};
+    std::array<std::size_t, batch_size> in_control_size{};
 };
 
 Batch::Batch() : headers(std::make_unique<SystemHeaders>()) {
@@ -126,9 +140,71 @@ Batch::Batch() : headers(std::make_unique<SystemHeaders>()) {
     }
 }
 
+namespace {
+
+// The destination address of a received datagram as the control message a reply carries
+// to leave from it (interface 0 unless IPv6 needs it for a link-local address): its
+// length, 0 when the datagram came without one.
+std::size_t reply_control(const msghdr& received, std::uint8_t* out) noexcept {
+    for (cmsghdr* c = CMSG_FIRSTHDR(&received); c != nullptr;
+         c = CMSG_NXTHDR(const_cast<msghdr*>(&received), c)) {
+        if (c->cmsg_level == IPPROTO_IP && c->cmsg_type == IP_PKTINFO) {
+            in_pktinfo got{};
+            std::memcpy(&got, CMSG_DATA(c), sizeof got);
+            // ipi_spec_dst: the datagram's destination, or for a broadcast the
+            // interface's own address (never 255.255.255.255).
+            in_pktinfo reply{};
+            reply.ipi_spec_dst = got.ipi_spec_dst;
+            auto* r = reinterpret_cast<cmsghdr*>(out);
+            r->cmsg_level = IPPROTO_IP;
+            r->cmsg_type = IP_PKTINFO;
+            r->cmsg_len = CMSG_LEN(sizeof reply);
+            std::memcpy(CMSG_DATA(r), &reply, sizeof reply);
+            return CMSG_SPACE(sizeof reply);
+        }
+        if (c->cmsg_level == IPPROTO_IPV6 && c->cmsg_type == IPV6_PKTINFO) {
+            in6_pktinfo reply{};
+            std::memcpy(&reply, CMSG_DATA(c), sizeof reply);
+            if (IN6_IS_ADDR_MULTICAST(&reply.ipi6_addr)) return 0;  // the route's choice
+            if (!IN6_IS_ADDR_LINKLOCAL(&reply.ipi6_addr)) reply.ipi6_ifindex = 0;
+            auto* r = reinterpret_cast<cmsghdr*>(out);
+            r->cmsg_level = IPPROTO_IPV6;
+            r->cmsg_type = IPV6_PKTINFO;
+            r->cmsg_len = CMSG_LEN(sizeof reply);
+            std::memcpy(CMSG_DATA(r), &reply, sizeof reply);
+            return CMSG_SPACE(sizeof reply);
+        }
+    }
+    return 0;
+}
+
+bool is_wildcard(const sockaddr_storage& a) noexcept {
+    if (a.ss_family == AF_INET)
+        return reinterpret_cast<const sockaddr_in&>(a).sin_addr.s_addr == htonl(INADDR_ANY);
+    if (a.ss_family == AF_INET6)
+        return IN6_IS_ADDR_UNSPECIFIED(&reinterpret_cast<const sockaddr_in6&>(a).sin6_addr);
+    return false;
+}
+
+}  // namespace
+
 Batch::~Batch() = default;
 
-void prepare(transport::os::NativeSocket) noexcept {}  // MSG_DONTWAIT on every call
+// MSG_DONTWAIT on every call; the destination address of each datagram on a wildcard
+// socket (a dual-stack IPv6 socket reports IPv4 datagrams' with IP_PKTINFO).
+void prepare(transport::os::NativeSocket s) noexcept {
+    sockaddr_storage local{};
+    socklen_t size = sizeof local;
+    if (::getsockname(s, reinterpret_cast<sockaddr*>(&local), &size) != 0 || !is_wildcard(local))
+        return;
+    const int on = 1;
+    if (local.ss_family == AF_INET6 &&
+        ::setsockopt(s, IPPROTO_IPV6, IPV6_RECVPKTINFO, &on, sizeof on) != 0)
+        spdlog::debug("fins/udp: IPV6_RECVPKTINFO: {}", std::strerror(errno));
+    // Also on an IPv6 socket: its IPv4-mapped peers' datagrams (fails harmlessly if v6 only).
+    if (::setsockopt(s, IPPROTO_IP, IP_PKTINFO, &on, sizeof on) != 0 && local.ss_family == AF_INET)
+        spdlog::debug("fins/udp: IP_PKTINFO: {}", std::strerror(errno));
+}
 
 namespace {
 
@@ -140,8 +216,11 @@ bool would_block(int error) noexcept {
 
 std::size_t receive(transport::os::NativeSocket s, Batch& b) noexcept {
     SystemHeaders& h = *b.headers;
-    for (auto& m : h.in_msgs)
-        m.msg_hdr.msg_namelen = sizeof(sockaddr_storage);
+    for (std::size_t i = 0; i < batch_size; ++i) {
+        h.in_msgs[i].msg_hdr.msg_namelen = sizeof(sockaddr_storage);
+        h.in_msgs[i].msg_hdr.msg_control = h.in_control[i].data();
+        h.in_msgs[i].msg_hdr.msg_controllen = control_size;
+    }
     const int received = ::recvmmsg(s, h.in_msgs.data(), batch_size, MSG_DONTWAIT, nullptr);
     if (received <= 0) {
         // EAGAIN: drained. Anything else (an error queued on the socket, which reading
@@ -155,6 +234,7 @@ std::size_t receive(transport::os::NativeSocket s, Batch& b) noexcept {
         // A longer datagram was cut to receive_size (MSG_TRUNC), still more than a frame.
         b.in_size[i] = std::min<std::size_t>(h.in_msgs[i].msg_len, receive_size);
         b.peer_size[i] = h.in_msgs[i].msg_hdr.msg_namelen;
+        h.in_control_size[i] = reply_control(h.in_msgs[i].msg_hdr, h.out_control[i].data());
     }
     return n;
 }
@@ -165,6 +245,10 @@ Sent send(transport::os::NativeSocket s, Batch& b, std::size_t count) noexcept {
         h.out_iov[i].iov_len = b.out_size[i];
         h.out_msgs[i].msg_hdr.msg_name = &b.peer[b.out_peer[i]];
         h.out_msgs[i].msg_hdr.msg_namelen = reply_size(b, b.out_peer[i]);
+        // The reply control bytes were built at receive time, by the peer's index.
+        const std::size_t control = h.in_control_size[b.out_peer[i]];
+        h.out_msgs[i].msg_hdr.msg_control = control ? h.out_control[b.out_peer[i]].data() : nullptr;
+        h.out_msgs[i].msg_hdr.msg_controllen = control;
     }
     Sent r;
     std::size_t done = 0;

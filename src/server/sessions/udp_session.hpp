@@ -44,7 +44,7 @@ namespace fins::server {
 
 // A deferred answer (a Serial Gateway port's) goes out later with one non-blocking
 // sendto() to the request's source address; a full send buffer drops it like any reply.
-class UdpSession : public std::enable_shared_from_this<UdpSession>, private ReplyPath {
+class UdpSession final : public std::enable_shared_from_this<UdpSession>, private ReplyPath {
   public:
     static constexpr std::size_t batch_size = udp_batch::batch_size;
     static constexpr unsigned rounds_per_turn = 4;
