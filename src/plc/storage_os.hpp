@@ -7,8 +7,8 @@
 //   cannot be locked there): a second finsd gets "in use", as with flock;
 // - files are opened without FILE_SHARE_WRITE, so nothing else can write or truncate
 //   the state file while finsd maps it (and Windows refuses to shrink a mapped file);
-// - a reservation extends the file (SetFileInformationByHandle: allocation, then end of
-//   file), a full disk is no_space at start as with posix_fallocate;
+// - a reservation extends the file (SetEndOfFile: NTFS allocates the clusters of a file
+//   that is not sparse), a full disk is no_space at start as with posix_fallocate;
 // - views come from CreateFileMapping/MapViewOfFile at 64 KiB-aligned offsets (the
 //   allocation granularity; sections are 4 KiB-aligned in the file);
 // - a view of a file lives in the system cache: a write to it survives the end of the

@@ -126,13 +126,11 @@ std::error_code reserve(Handle file, std::uint64_t offset, std::uint64_t length)
     auto current = size(file);
     if (!current) return current.error();
     if (*current >= end) return {};
-    FILE_ALLOCATION_INFO allocation{};
-    allocation.AllocationSize.QuadPart = static_cast<LONGLONG>(end);
-    if (!::SetFileInformationByHandle(h(file), FileAllocationInfo, &allocation, sizeof allocation))
-        return last_error();
-    FILE_END_OF_FILE_INFO eof{};
-    eof.EndOfFile.QuadPart = static_cast<LONGLONG>(end);
-    if (!::SetFileInformationByHandle(h(file), FileEndOfFileInfo, &eof, sizeof eof))
+    // Growing a file that is not sparse allocates its clusters on NTFS: a full disk is
+    // ERROR_DISK_FULL here, never a failed write through a view later.
+    LARGE_INTEGER at{};
+    at.QuadPart = static_cast<LONGLONG>(end);
+    if (!::SetFilePointerEx(h(file), at, nullptr, FILE_BEGIN) || !::SetEndOfFile(h(file)))
         return last_error();
     return {};
 }
