@@ -34,7 +34,7 @@ check() { if "$@"; then passed=$((passed + 1)); else fail "failed: $*"; fi; }
 data="Z:${work}/data"
 control="Z:${work}/ctl.sock"  # finsd ctl's --socket: nothing listens there under wine
 start_finsd() {  # LOG: finsd.exe in the background, its wine process's PID in $finsd_pid
-  LOCALAPPDATA="Z:${work}/appdata" "$wine" "$bin/finsd.exe" --bind 127.0.0.1 --port "$port" \
+  "$wine" "$bin/finsd.exe" --bind 127.0.0.1 --port "$port" \
     --data-dir "$data" >"$work/$1" 2>&1 &
   finsd_pid=$!
   pids+=("$finsd_pid")
