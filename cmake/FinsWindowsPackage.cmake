@@ -1,9 +1,12 @@
 # The Windows release artifact (scripts/package.sh windows, docs/windows.md):
-# finskit-VERSION-windows-x86_64.zip with bin/ (fins.exe, libfins.dll and the MinGW-w64
+# finskit-VERSION-windows-x86_64.zip with bin/ (fins.exe, finsd.exe with the web page's
+# assets compiled in, libfins.dll and the MinGW-w64
 # runtime DLLs it uses), include/ (with
 # tl/expected.hpp),
 # lib/ (libfins.a, the import library libfins.dll.a, the CMake package and pkg-config
 # files), the documentation and README-windows.txt.
+# finsd.exe (cmake/FinsPackage.cmake installs fins.exe): linked statically, like fins.exe.
+install(TARGETS finsd RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
 install(FILES ${PROJECT_SOURCE_DIR}/packaging/windows/README-windows.txt
   DESTINATION . COMPONENT runtime)
 # fins::Result is a tl::expected: its one header (CC0) ships beside ours, as no Windows

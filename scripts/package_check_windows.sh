@@ -25,7 +25,7 @@ fail() { echo "FAILED: $1" >&2; exit 1; }
 unzip -q "$zip" -d "$work"
 top=$(find "$work" -mindepth 1 -maxdepth 1 -type d -name 'finskit-*-windows-x86_64')
 [[ -n "$top" ]] || fail "no finskit-VERSION-windows-x86_64/ in $zip"
-for f in bin/fins.exe bin/libfins.dll bin/libstdc++-6.dll bin/libgcc_s_seh-1.dll \
+for f in bin/fins.exe bin/finsd.exe bin/libfins.dll bin/libstdc++-6.dll bin/libgcc_s_seh-1.dll \
     bin/libwinpthread-1.dll lib/libfins.a lib/libfins.dll.a include/fins/client.hpp \
     include/tl/expected.hpp lib/cmake/fins/finsConfig.cmake lib/pkgconfig/fins.pc \
     README-windows.txt share/doc/finskit/docs/windows.md; do
@@ -36,6 +36,24 @@ version=$("$wine" "$top/bin/fins.exe" --version | tr -d '\r')
 [[ "$version" == "fins $(sed -n 's/^project(finskit VERSION \([0-9.]*\).*/\1/p' "$root/CMakeLists.txt")" ]] ||
   fail "fins.exe --version says '$version'"
 check "fins.exe runs under wine: $version"
+# finsd.exe from the zip starts once: "listening P", the page's assets inside it (GET /
+# answers the page with no file beside the program), then it is ended.
+source "$root/tests/scripts/round_trip_lib.sh"  # free_port, wait_for
+exe_port=$(free_port)
+http_port=$(free_port)
+# (No control channel under wine: it has no AF_UNIX sockets, docs/windows.md.)
+"$wine" "$top/bin/finsd.exe" --bind 127.0.0.1 --port "$exe_port" \
+  --http "127.0.0.1:$http_port" >"$work/finsd-exe.log" 2>&1 &
+exe_pid=$!
+if ! wait_for 120 grep -q "^listening $exe_port" "$work/finsd-exe.log"; then
+  kill -9 "$exe_pid" 2>/dev/null || true
+  cat "$work/finsd-exe.log"; fail "finsd.exe from the zip did not listen"
+fi
+page=$(curl -sS --max-time 10 "http://127.0.0.1:$http_port/" || true)
+kill "$exe_pid" 2>/dev/null || true
+wait "$exe_pid" 2>/dev/null || true
+grep -qi "<html" <<<"$page" || fail "finsd.exe from the zip did not serve its page"
+check "finsd.exe runs under wine and serves the page from its own assets"
 
 source "$root/scripts/finsd_start.sh"
 finsd_start "$host_bin/finsd" --bind 127.0.0.1 --control "$work/ctl.sock"

@@ -1,4 +1,6 @@
 // plc::FileMemory: the 22 xx file devices (see file_memory.hpp for the rules).
+// Linux (POSIX *at calls); Windows: file_memory_win.cpp.
+#ifndef _WIN32
 #include "plc/file_memory.hpp"
 
 #include <fcntl.h>
@@ -410,3 +412,4 @@ EndCode FileMemory::create(std::uint16_t disk, const FileName& file, const std::
 }
 
 }  // namespace fins::plc
+#endif

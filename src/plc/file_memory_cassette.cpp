@@ -1,6 +1,8 @@
 // plc::FileMemory: the Memory Cassette of a CP1H (disk 8003, W342 5-3-43). Items are
 // host files in <root>/cassette, reached like the file devices: one directory fd opened
 // with O_NOFOLLOW, names that are single components chosen by finsd (never by a request).
+// Linux (POSIX *at calls); Windows: file_memory_win.cpp.
+#ifndef _WIN32
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -58,3 +60,4 @@ EndCode FileMemory::initialize_cassette() {
 }
 
 }  // namespace fins::plc
+#endif

@@ -1,4 +1,6 @@
 // Host file-system helpers of plc::FileMemory (see file_memory_host.hpp).
+// Linux (POSIX *at calls); Windows: file_memory_win.cpp.
+#ifndef _WIN32
 #include "plc/file_memory_host.hpp"
 
 #include <dirent.h>
@@ -223,3 +225,4 @@ bool extend_at(int dir, const std::string& name, std::uint64_t old_size, Bytes d
 }
 
 }  // namespace fins::plc::host
+#endif

@@ -1,5 +1,7 @@
 // plc::FileMemory: descriptors kept open between the chunks of one 22 03 transfer (see
 // FileMemory::OpenFile in file_memory.hpp).
+// Linux (POSIX *at calls); Windows: file_memory_win.cpp.
+#ifndef _WIN32
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -87,3 +89,4 @@ void FileMemory::close_idle_files(CivilSeconds now) noexcept {
 }
 
 }  // namespace fins::plc
+#endif

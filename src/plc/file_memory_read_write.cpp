@@ -1,6 +1,8 @@
 // plc::FileMemory: 22 02 SINGLE FILE READ and 22 03 SINGLE FILE WRITE (see
 // file_memory.hpp for the rules; the descriptors kept open between 22 03 chunks are in
 // file_memory_open_files.cpp).
+// Linux (POSIX *at calls); Windows: file_memory_win.cpp.
+#ifndef _WIN32
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -180,3 +182,4 @@ EndCode FileMemory::write(const SingleFileWrite& c, CivilSeconds now) {
 }
 
 }  // namespace fins::plc
+#endif

@@ -1,13 +1,6 @@
 #include "plc/storage.hpp"
 
-#include <fcntl.h>
-#include <sys/file.h>
-#include <sys/mman.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <cstring>
 #include <ctime>
 #include <vector>
@@ -16,8 +9,11 @@
 #include "plc/storage_chunks.hpp"
 #include "plc/storage_format.hpp"
 #include "plc/storage_guard.hpp"
+#include "plc/storage_os.hpp"
 
 namespace fins::plc {
+
+namespace os = state_file::os;
 
 namespace {
 
@@ -37,13 +33,19 @@ void step(const char* name) {
 std::error_code make(Error e) {
     return sf::make_error(e);
 }
-std::error_code last_error() {
-    return {errno, std::system_category()};
+using os::last_error;
+// A reservation's result: one that does not fit is no_space.
+std::error_code reserve_error(std::error_code e) {
+    if (os::is_no_space(e)) return make(Error::no_space);
+    return e;
 }
-// posix_fallocate's result: a reservation that does not fit is no_space.
-std::error_code reserve_error(int e) {
-    if (e == ENOSPC || e == EDQUOT || e == EFBIG) return make(Error::no_space);
-    return {e, std::system_category()};
+// The UTC time `now` as YYYYMMDDTHHMMSSZ.
+std::string utc_stamp(std::time_t now) {
+    std::tm utc{};
+    ::gmtime_r(&now, &utc);
+    char stamp[32];
+    std::strftime(stamp, sizeof stamp, "%Y%m%dT%H%M%SZ", &utc);
+    return stamp;
 }
 
 std::string_view entry_name(const sf::Entry& e) {
@@ -59,9 +61,10 @@ Unexpected fail(std::error_code e) {
 struct Storage::Impl {
     // Sections not in the file, and those it could not map.
     SectionChunks unmapped;
-    int dir_fd = -1;  // the data directory, locked (flock) for the Storage's life
-    int fd = -1;
+    os::Directory dir;  // the data directory, locked for the Storage's life
+    os::Handle fd = os::none;
     sf::Header* header = nullptr;
+    std::size_t header_span = 0;
     std::vector<std::pair<void*, std::size_t>> maps;
     std::vector<std::span<std::byte>> sections;  // by entry index
     std::vector<bool> claimed;                   // per existing entry
@@ -80,20 +83,20 @@ struct Storage::Impl {
 
     std::span<std::byte> map(std::uint64_t offset, std::size_t bytes) {
         const std::size_t length = round_up_to_page(bytes);
-        void* p = ::mmap(nullptr, length, PROT_READ | PROT_WRITE, MAP_SHARED, fd,
-                         static_cast<off_t>(offset));
-        if (p == MAP_FAILED) {
-            if (!problem) problem = last_error();
+        auto view = os::map(fd, offset, length, true);
+        if (!view) {
+            if (!problem) problem = view.error();
             return unmapped.allocate(bytes);
         }
-        maps.emplace_back(p, length);
-        return {static_cast<std::byte*>(p), bytes};
+        maps.emplace_back(view->base, view->span);
+        return {view->data, bytes};
     }
 
     Result<void> map_header() {
-        void* h = ::mmap(nullptr, page, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
-        if (h == MAP_FAILED) return fail(last_error());
-        header = static_cast<sf::Header*>(h);
+        auto view = os::map(fd, 0, page, true);
+        if (!view) return fail(view.error());
+        header = reinterpret_cast<sf::Header*>(view->data);
+        header_span = view->span;
         return {};
     }
 
@@ -109,18 +112,21 @@ struct Storage::Impl {
         seal.crc = sf::crc_without(seal, seal.crc);
     }
 
+    // The file's data on disk, its views included (fdatasync; FlushViewOfFile and
+    // FlushFileBuffers on Windows).
+    bool sync_data() noexcept { return os::sync_data(fd, maps, {header, header_span}); }
+
     Result<void> create(std::string_view profile_id);
     Result<void> restore(std::string_view profile_id);
 
     ~Impl() {
         guard.reset();  // before the mappings go
         for (auto [p, n] : maps)
-            ::munmap(p, n);
-        if (header != nullptr) ::munmap(header, page);
-        if (fd >= 0) ::close(fd);
+            os::unmap(p, n);
+        if (header != nullptr) os::unmap(header, header_span);
+        os::close(fd);
         // An unfinished build is ours (the lock): nothing else ever reads it.
-        if (creating) ::unlinkat(dir_fd, temp_name, 0);
-        if (dir_fd >= 0) ::close(dir_fd);
+        if (creating) os::remove(dir, temp_name);
     }
 };
 
@@ -128,11 +134,12 @@ struct Storage::Impl {
 // completes it and renames it into place.
 Result<void> Storage::Impl::create(std::string_view profile_id) {
     step("locked");
-    fd = ::openat(dir_fd, temp_name, O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd < 0) return fail(last_error());
+    auto created = os::create_file(dir, temp_name);
+    if (!created) return fail(created.error());
+    fd = *created;
     creating = true;
     step("temporary file created");
-    if (const int e = ::posix_fallocate(fd, 0, page); e != 0) return fail(reserve_error(e));
+    if (const auto e = os::reserve(fd, 0, page)) return fail(reserve_error(e));
     if (auto r = map_header(); !r) return r;
     sf::Descriptor& d = header->descriptor;
     d.magic = sf::magic;
@@ -145,9 +152,9 @@ Result<void> Storage::Impl::create(std::string_view profile_id) {
 
 // An existing finsd.state: every check before the first byte is written to it.
 Result<void> Storage::Impl::restore(std::string_view profile_id) {
-    struct stat st {};
-    if (::fstat(fd, &st) != 0) return fail(last_error());
-    const auto size = static_cast<std::uint64_t>(st.st_size);
+    const auto file_size = os::size(fd);
+    if (!file_size) return fail(file_size.error());
+    const std::uint64_t size = *file_size;
     if (size == 0) return fail(make(Error::empty));
     if (size < page) return fail(make(Error::not_a_state_file));
     if (auto r = map_header(); !r) return r;
@@ -156,11 +163,11 @@ Result<void> Storage::Impl::restore(std::string_view profile_id) {
     if (d.version == 1 && !upgraded) {
         // Converted into a new file (the old one kept as finsd.state.version1), then
         // checked as any other.
-        auto converted = sf::convert_version1(dir_fd, fd, size);
+        auto converted = sf::convert_version1(dir, fd, size);
         if (!converted) return fail(converted.error());
-        ::munmap(header, page);
+        os::unmap(header, header_span);
         header = nullptr;
-        ::close(fd);
+        os::close(fd);
         fd = *converted;
         upgraded = true;
         return restore(profile_id);
@@ -190,8 +197,7 @@ Result<void> Storage::Impl::restore(std::string_view profile_id) {
     }
     // A sparse file (an older finsd, a copy) gets its holes reserved now: a write to a
     // page never needs disk space later, so a full disk cannot SIGBUS finsd.
-    if (const int e = ::posix_fallocate(fd, 0, static_cast<off_t>(size)); e != 0)
-        return fail(reserve_error(e));
+    if (const auto e = os::reserve(fd, 0, size)) return fail(reserve_error(e));
     existing = true;
     claimed.assign(d.count, false);
     sections.assign(d.count, {});
@@ -214,13 +220,12 @@ Result<std::unique_ptr<Storage>> Storage::open(const std::filesystem::path& dir,
     if (ec) return fail(ec);
     auto impl = std::make_unique<Impl>();
     impl->path = dir / file_name;
-    impl->dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    if (impl->dir_fd < 0) return fail(last_error());
-    if (::flock(impl->dir_fd, LOCK_EX | LOCK_NB) != 0)
-        return fail(errno == EWOULDBLOCK ? make(Error::in_use) : last_error());
-    impl->fd = ::openat(impl->dir_fd, file_name, O_RDWR | O_CLOEXEC);
-    if (impl->fd < 0 && errno != ENOENT) return fail(last_error());
-    const auto opened = impl->fd >= 0 ? impl->restore(profile_id) : impl->create(profile_id);
+    if (auto locked = os::lock_directory(dir, impl->dir); !locked)
+        return fail(os::is_lock_conflict(locked.error()) ? make(Error::in_use) : locked.error());
+    auto existing = os::open_file(impl->dir, file_name);
+    if (!existing && !os::is_missing(existing.error())) return fail(existing.error());
+    if (existing) impl->fd = *existing;
+    const auto opened = existing ? impl->restore(profile_id) : impl->create(profile_id);
     if (!opened) return fail(opened.error());
     std::unique_ptr<Storage> storage(new Storage(std::move(impl)));
     storage->sync_on_commit_ = options.durability == Durability::power;
@@ -233,25 +238,17 @@ bool Storage::is_refusal(const std::error_code& error) noexcept {
 
 Result<std::filesystem::path> Storage::set_aside(const std::filesystem::path& dir) {
     Impl lock;  // closes the directory (and so releases the lock) on every return
-    lock.dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    if (lock.dir_fd < 0) return fail(last_error());
-    if (::flock(lock.dir_fd, LOCK_EX | LOCK_NB) != 0)
-        return fail(errno == EWOULDBLOCK ? make(Error::in_use) : last_error());
-    const std::time_t now = std::time(nullptr);
-    std::tm utc{};
-    ::gmtime_r(&now, &utc);
-    char stamp[32];
-    std::strftime(stamp, sizeof stamp, "%Y%m%dT%H%M%SZ", &utc);
-    const std::string base = std::string(file_name) + ".replaced-" + stamp;
+    if (auto locked = os::lock_directory(dir, lock.dir); !locked)
+        return fail(os::is_lock_conflict(locked.error()) ? make(Error::in_use) : locked.error());
+    const std::string base = std::string(file_name) + ".replaced-" + utc_stamp(std::time(nullptr));
     for (int n = 1; n <= 100; ++n) {
         const std::string name = n == 1 ? base : base + "-" + std::to_string(n);
-        struct stat st {};
-        if (::fstatat(lock.dir_fd, name.c_str(), &st, AT_SYMLINK_NOFOLLOW) == 0) continue;
-        if (errno != ENOENT) return fail(last_error());
+        const auto taken = os::exists(lock.dir, name.c_str());
+        if (!taken) return fail(taken.error());
+        if (*taken) continue;
         // Under the lock nothing else creates names here: the free name stays free.
-        if (::renameat(lock.dir_fd, file_name, lock.dir_fd, name.c_str()) != 0)
-            return fail(last_error());
-        if (::fsync(lock.dir_fd) != 0) return fail(last_error());
+        if (auto r = os::rename(lock.dir, file_name, name.c_str()); !r) return fail(r.error());
+        if (auto r = os::sync(lock.dir); !r) return fail(r.error());
         return dir / name;
     }
     return fail(std::make_error_code(std::errc::file_exists));
@@ -260,7 +257,7 @@ Result<std::filesystem::path> Storage::set_aside(const std::filesystem::path& di
 std::span<std::byte> Storage::section(std::string_view name, std::size_t bytes, std::size_t,
                                       Retention retention) {
     Impl& s = *impl_;
-    if (retention == Retention::cleared || s.fd < 0) return s.unmapped.allocate(bytes);
+    if (retention == Retention::cleared || s.fd == os::none) return s.unmapped.allocate(bytes);
     sf::Descriptor& d = s.header->descriptor;
     if (s.existing) {
         for (std::uint32_t i = 0; i < d.count; ++i) {
@@ -287,9 +284,7 @@ std::span<std::byte> Storage::section(std::string_view name, std::size_t bytes, 
         }
     const std::uint64_t offset = d.file_size;
     const std::uint64_t length = round_up_to_page(bytes);
-    if (const int e =
-            ::posix_fallocate(s.fd, static_cast<off_t>(offset), static_cast<off_t>(length));
-        e != 0) {
+    if (const auto e = os::reserve(s.fd, offset, length)) {
         if (!s.problem) s.problem = reserve_error(e);
         return s.unmapped.allocate(bytes);
     }
@@ -319,19 +314,19 @@ Result<void> Storage::seal() {
         d.complete = sf::complete_mark;
         d.crc = sf::crc_without(d, d.crc);
     }
-    if (::fdatasync(s.fd) != 0) return fail(last_error());
+    if (!s.sync_data()) return fail(last_error());
     if (s.creating) {
         step("synced");
-        if (::renameat(s.dir_fd, temp_name, s.dir_fd, file_name) != 0) return fail(last_error());
+        if (auto r = os::rename(s.dir, temp_name, file_name); !r) return r;
         s.creating = false;
         step("renamed");
-        if (::fsync(s.dir_fd) != 0) return fail(last_error());
+        if (auto r = os::sync(s.dir); !r) return r;
         step("directory synced");
     }
     s.sealed = true;
     s.sealed_size = s.header->descriptor.file_size;
     s.guarded = s.maps;
-    s.guarded.emplace_back(s.header, page);
+    s.guarded.emplace_back(s.header, s.header_span);
     s.guard = std::make_unique<StateFileGuard>(s.guarded, s.path.string());
     return {};
 }
@@ -350,15 +345,15 @@ std::filesystem::path Storage::path() const {
 
 bool Storage::intact() const noexcept {
     const Impl& s = *impl_;
-    if (!s.sealed || s.fd < 0) return true;
-    struct stat st {};
-    return ::fstat(s.fd, &st) == 0 && static_cast<std::uint64_t>(st.st_size) >= s.sealed_size;
+    if (!s.sealed || s.fd == os::none) return true;
+    const auto size = os::size(s.fd);
+    return size && *size >= s.sealed_size;
 }
 
 void Storage::flush() noexcept {
     for (auto [p, n] : impl_->maps)
-        ::msync(p, n, MS_SYNC);
-    if (impl_->header != nullptr) ::msync(impl_->header, page, MS_SYNC);
+        os::flush(p, n);
+    if (impl_->header != nullptr) os::flush(impl_->header, impl_->header_span);
 }
 
 void Storage::close() noexcept {
@@ -370,14 +365,14 @@ void Storage::close() noexcept {
     if (!intact()) return;
     // Sections first: checksums never describe data that is not on disk. When a sync
     // fails the file stays "running" and is checked as after a SIGKILL.
-    if (::fdatasync(s.fd) != 0) return;
+    if (!s.sync_data()) return;
     s.write_seal(true);
-    ::fdatasync(s.fd);
+    s.sync_data();
 }
 
 bool Storage::sync() noexcept {
     ++syncs_;
-    return impl_->fd >= 0 && ::fdatasync(impl_->fd) == 0;
+    return impl_->fd != os::none && impl_->sync_data();
 }
 
 void Storage::set_creation_probe(void (*probe)(const char* step)) noexcept {

@@ -1,11 +1,10 @@
 // SectionChunks (contract in storage_chunks.hpp).
 #include "plc/storage_chunks.hpp"
 
-#include <sys/mman.h>
-
 #include <algorithm>
 
 #include "plc/storage_format.hpp"
+#include "plc/storage_os.hpp"
 
 namespace fins::plc {
 
@@ -16,13 +15,12 @@ std::uint64_t round_up_to_page(std::uint64_t n) noexcept {
 
 SectionChunks::~SectionChunks() {
     for (auto [p, n] : mappings_)
-        ::munmap(p, n);
+        state_file::os::release_zeroed(p, n);
 }
 
 void* SectionChunks::reserve(std::size_t length) {
-    void* p = ::mmap(nullptr, length, PROT_READ | PROT_WRITE,
-                     MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
-    if (p == MAP_FAILED) return nullptr;
+    void* p = state_file::os::reserve_zeroed(length);
+    if (p == nullptr) return nullptr;
     mappings_.emplace_back(p, length);
     return p;
 }

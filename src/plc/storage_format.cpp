@@ -3,8 +3,6 @@
 // check of a cleanly stopped file's section checksums.
 #include "plc/storage_format.hpp"
 
-#include <sys/mman.h>
-
 #include <cerrno>
 #include <string>
 
@@ -79,17 +77,17 @@ bool is_refusal(const std::error_code& e) noexcept {
     }
 }
 
-Result<void> verify_section_checksums(int fd, std::uint64_t size, const Header& header) {
-    void* p = ::mmap(nullptr, size, PROT_READ, MAP_SHARED, fd, 0);
-    if (p == MAP_FAILED) return Unexpected(std::error_code(errno, std::system_category()));
-    const auto* file = static_cast<const std::byte*>(p);
+Result<void> verify_section_checksums(os::Handle fd, std::uint64_t size, const Header& header) {
+    auto view = os::map(fd, 0, static_cast<std::size_t>(size), false);
+    if (!view) return Unexpected(view.error());
+    const std::byte* file = view->data;
     const Descriptor& d = header.descriptor;
     bool intact = true;
     for (std::uint32_t i = 0; i < d.count && intact; ++i) {
         const auto& e = d.entries[i];
         intact = crc32c({file + e.offset, e.size}) == header.seal.section_crc[i];
     }
-    ::munmap(p, size);
+    os::unmap(view->base, view->span);
     if (!intact) return Unexpected(make_error(Error::section_checksum));
     return {};
 }

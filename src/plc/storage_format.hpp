@@ -25,6 +25,7 @@
 
 #include "fins/error.hpp"
 #include "plc/crc32c.hpp"
+#include "plc/storage_os.hpp"
 
 namespace fins::plc::state_file {
 
@@ -104,15 +105,15 @@ std::uint32_t crc_without(const Block& block, const std::uint32_t& field) {
 }
 
 // A complete version 1 `finsd.state` (open as `fd`, `size` bytes, in the locked
-// directory `dir_fd`) copied to a version 2 file: built as finsd.state.new (reserved,
+// directory `dir`) copied to a version 2 file: built as finsd.state.new (reserved,
 // header given version 2, its checksum and a "not stopped cleanly" seal), synced, the
 // old file kept as finsd.state.version1 (a hard link), renamed into place, directory
 // synced. Returns the new file's descriptor. An incomplete version 1 file, or one with
 // more sections than version 2 holds, is refused (incomplete, unsupported_version).
-Result<int> convert_version1(int dir_fd, int fd, std::uint64_t size);
+Result<os::Handle> convert_version1(const os::Directory& dir, os::Handle fd, std::uint64_t size);
 // A cleanly stopped file's sections (open as `fd`, `size` bytes, `header` its header)
 // against the seal's checksums: section_checksum when one differs.
-Result<void> verify_section_checksums(int fd, std::uint64_t size, const Header& header);
+Result<void> verify_section_checksums(os::Handle fd, std::uint64_t size, const Header& header);
 // True for the errors about an existing file's content (Storage::is_refusal).
 bool is_refusal(const std::error_code& e) noexcept;
 

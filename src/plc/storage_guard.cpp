@@ -1,4 +1,6 @@
 // StateFileGuard (contract in storage_guard.hpp).
+// Linux (SIGBUS); Windows: storage_guard_win.cpp.
+#ifndef _WIN32
 #include "plc/storage_guard.hpp"
 
 #include <signal.h>
@@ -107,3 +109,4 @@ StateFileGuard::~StateFileGuard() {
 }
 
 }  // namespace fins::plc
+#endif

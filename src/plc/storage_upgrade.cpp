@@ -1,9 +1,5 @@
 // Version 1 state files (no checksums, created in place) become version 2 files with
 // their data intact: an upgrade of finsd keeps retained memory (storage_format.hpp).
-#include <fcntl.h>
-#include <unistd.h>
-
-#include <cerrno>
 #include <cstring>
 #include <vector>
 
@@ -17,29 +13,28 @@ constexpr const char* file_name = "finsd.state";
 constexpr const char* temp_name = "finsd.state.new";
 constexpr const char* kept_name = "finsd.state.version1";
 
-std::error_code last_error() {
-    return {errno, std::system_category()};
-}
+using os::last_error;
 
 // Removes the unfinished copy unless released.
 struct TempFile {
-    int dir_fd;
-    int fd = -1;
+    const os::Directory& dir;
+    os::Handle fd = os::none;
     ~TempFile() {
-        if (fd < 0) return;
-        ::close(fd);
-        ::unlinkat(dir_fd, temp_name, 0);
+        if (fd == os::none) return;
+        os::close(fd);
+        os::remove(dir, temp_name);
     }
 };
 
-bool copy(int from, int to, std::uint64_t size) {
+bool copy(os::Handle from, os::Handle to, std::uint64_t size) {
     std::vector<char> buffer(1 << 20);
     for (std::uint64_t at = 0; at < size;) {
-        const auto n = ::pread(from, buffer.data(), buffer.size(), static_cast<off_t>(at));
+        const auto n = os::read_at(from, buffer.data(), buffer.size(), at);
         if (n <= 0) return false;
-        for (ssize_t done = 0; done < n;) {
-            const auto w = ::pwrite(to, buffer.data() + done, static_cast<std::size_t>(n - done),
-                                    static_cast<off_t>(at) + done);
+        for (long long done = 0; done < n;) {
+            const auto w =
+                os::write_at(to, buffer.data() + done, static_cast<std::size_t>(n - done),
+                             at + static_cast<std::uint64_t>(done));
             if (w <= 0) return false;
             done += w;
         }
@@ -50,20 +45,19 @@ bool copy(int from, int to, std::uint64_t size) {
 
 }  // namespace
 
-Result<int> convert_version1(int dir_fd, int fd, std::uint64_t size) {
+Result<os::Handle> convert_version1(const os::Directory& dir, os::Handle fd, std::uint64_t size) {
     Header h{};
-    if (::pread(fd, &h, sizeof h, 0) != static_cast<ssize_t>(sizeof h))
+    if (os::read_at(fd, &h, sizeof h, 0) != static_cast<long long>(sizeof h))
         return Unexpected(make_error(Error::not_a_state_file));
     Descriptor& d = h.descriptor;
     if (d.complete != complete_mark) return Unexpected(make_error(Error::incomplete));
     if (d.count > max_entries) return Unexpected(make_error(Error::unsupported_version));
-    TempFile temp{dir_fd};
-    temp.fd = ::openat(dir_fd, temp_name, O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (temp.fd < 0) return Unexpected(last_error());
-    if (const int e = ::posix_fallocate(temp.fd, 0, static_cast<off_t>(size)); e != 0)
-        return Unexpected(e == ENOSPC || e == EDQUOT || e == EFBIG
-                              ? make_error(Error::no_space)
-                              : std::error_code(e, std::system_category()));
+    TempFile temp{dir};
+    auto created = os::create_file(dir, temp_name);
+    if (!created) return Unexpected(created.error());
+    temp.fd = *created;
+    if (const auto e = os::reserve(temp.fd, 0, size))
+        return Unexpected(os::is_no_space(e) ? make_error(Error::no_space) : e);
     if (!copy(fd, temp.fd, size)) return Unexpected(last_error());
     // Version 1 kept 62 entries' room; version 2 uses the tail for the seal block.
     std::memset(reinterpret_cast<std::byte*>(&h) + sizeof(Descriptor), 0,
@@ -71,15 +65,15 @@ Result<int> convert_version1(int dir_fd, int fd, std::uint64_t size) {
     d.version = version;
     d.crc = crc_without(d, d.crc);
     h.seal.crc = crc_without(h.seal, h.seal.crc);
-    if (::pwrite(temp.fd, &h, sizeof h, 0) != static_cast<ssize_t>(sizeof h) ||
-        ::fdatasync(temp.fd) != 0)
+    if (os::write_at(temp.fd, &h, sizeof h, 0) != static_cast<long long>(sizeof h) ||
+        !os::sync_data(temp.fd, {}, {nullptr, 0}))
         return Unexpected(last_error());
     // An existing finsd.state.version1 is never overwritten: the conversion stops.
-    if (::linkat(dir_fd, file_name, dir_fd, kept_name, 0) != 0) return Unexpected(last_error());
-    if (::renameat(dir_fd, temp_name, dir_fd, file_name) != 0 || ::fsync(dir_fd) != 0)
-        return Unexpected(last_error());
-    const int converted = temp.fd;
-    temp.fd = -1;
+    if (auto r = os::link(dir, file_name, kept_name); !r) return Unexpected(r.error());
+    if (auto r = os::rename(dir, temp_name, file_name); !r) return Unexpected(r.error());
+    if (auto r = os::sync(dir); !r) return Unexpected(r.error());
+    const os::Handle converted = temp.fd;
+    temp.fd = os::none;
     return converted;
 }
 

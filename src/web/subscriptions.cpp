@@ -1,7 +1,13 @@
 // WebSocket subscriptions (contract in subscriptions.hpp).
 #include "web/subscriptions.hpp"
 
+#ifdef _WIN32
+#include <windows.h>
+
+#include <bcrypt.h>  // after windows.h, which it needs
+#else
 #include <sys/random.h>
+#endif
 
 #include <algorithm>
 #include <array>
@@ -282,10 +288,17 @@ std::unique_ptr<Subscriptions> ResumeStore::take(std::string_view session, Stead
     return nullptr;
 }
 
-// 128 bits from the kernel's CSPRNG (getrandom(2)): a session name is a capability (it
-// takes over another page's subscriptions), so it must not be guessable from others.
+// 128 bits from the kernel's CSPRNG (getrandom(2); BCryptGenRandom on Windows): a session
+// name is a capability (it takes over another page's subscriptions), so it must not be
+// guessable from others.
 std::string new_session_id() {
     std::array<unsigned char, 16> bits{};
+#ifdef _WIN32
+    // Windows' CSPRNG (the system-preferred RNG).
+    if (::BCryptGenRandom(nullptr, bits.data(), static_cast<ULONG>(bits.size()),
+                          BCRYPT_USE_SYSTEM_PREFERRED_RNG) != 0)
+        throw std::system_error(EIO, std::generic_category(), "BCryptGenRandom");
+#else
     std::size_t got = 0;
     while (got < bits.size()) {
         const auto n = ::getrandom(bits.data() + got, bits.size() - got, 0);
@@ -293,6 +306,7 @@ std::string new_session_id() {
         if (n < 0) throw std::system_error(errno, std::generic_category(), "getrandom");
         got += static_cast<std::size_t>(n);
     }
+#endif
     std::string hex;
     hex.reserve(2 * bits.size());
     for (const auto b : bits)

@@ -2,7 +2,9 @@
 #include "cli/finsd/control_setup.hpp"
 
 #include <sys/stat.h>
+#ifndef _WIN32
 #include <unistd.h>
+#endif
 
 #include <cerrno>
 #include <cstdlib>
@@ -22,6 +24,17 @@ std::optional<std::filesystem::path> from_environment(const char* name) {
     return std::filesystem::path(value);
 }
 
+#ifdef _WIN32
+// Windows: the user's own %LOCALAPPDATA%\finskit (its ACL admits the user alone), the
+// socket there as on Linux's /tmp/finsd-UID.
+std::pair<std::filesystem::path, mode_t> own_directory() {
+    const auto local = from_environment("LOCALAPPDATA");
+    return {(local ? *local : std::filesystem::temp_directory_path()) / "finskit", 0700};
+}
+uid_t effective_user() {
+    return 0;
+}
+#else
 const std::filesystem::path root_directory = "/run/finsd";
 
 std::filesystem::path user_directory() {
@@ -33,6 +46,10 @@ std::pair<std::filesystem::path, mode_t> own_directory() {
     if (::geteuid() == 0) return {root_directory, 0755};
     return {user_directory(), 0700};
 }
+uid_t effective_user() {
+    return ::geteuid();
+}
+#endif
 
 }  // namespace
 
@@ -50,6 +67,21 @@ std::vector<std::filesystem::path> default_control_sockets() {
     return out;
 }
 
+#ifdef _WIN32
+// No owner or mode bits to check: the directory's ACL (inherited from the user's profile)
+// is what protects the socket. A link or junction in its place is refused.
+std::string prepare_socket_directory(const std::filesystem::path& dir, mode_t, uid_t) {
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec) return fmt::format("cannot create {}: {}", dir.string(), ec.message());
+    const auto st = std::filesystem::symlink_status(dir, ec);
+    if (ec) return fmt::format("{}: {}", dir.string(), ec.message());
+    if (std::filesystem::is_symlink(st)) return fmt::format("{} is a symbolic link", dir.string());
+    if (!std::filesystem::is_directory(st))
+        return fmt::format("{} is not a directory", dir.string());
+    return {};
+}
+#else
 std::string prepare_socket_directory(const std::filesystem::path& dir, mode_t mode, uid_t owner) {
     if (::mkdir(dir.c_str(), mode) != 0 && errno != EEXIST)
         return fmt::format("cannot create {}: {}", dir.string(), std::strerror(errno));
@@ -66,6 +98,7 @@ std::string prepare_socket_directory(const std::filesystem::path& dir, mode_t mo
                            mode);
     return {};
 }
+#endif
 
 std::string control_channel_hint() {
     return "start finsd with a control channel: `finsd --control PATH`, then "
@@ -81,7 +114,7 @@ ControlStart start_control(asio::io_context& io, std::vector<server::ControlTarg
     out.path = configured ? *configured : default_control_socket();
     if (!chosen && !from_environment("XDG_RUNTIME_DIR")) {
         const auto [dir, mode] = own_directory();
-        if (const auto why = prepare_socket_directory(dir, mode, ::geteuid()); !why.empty()) {
+        if (const auto why = prepare_socket_directory(dir, mode, effective_user()); !why.empty()) {
             spdlog::warn(
                 "finsd: no control channel: {} (give one with --control PATH or "
                 "FINSD_SOCKET)",

@@ -30,6 +30,10 @@
 
 namespace fins::cli {
 
+#ifdef _WIN32
+using uid_t = unsigned;  // Windows has no user ids: the directory's ACL protects it
+#endif
+
 // The socket path finsd listens on by rules 2-5 (the environment is read at each call).
 std::filesystem::path default_control_socket();
 

@@ -32,10 +32,19 @@
 #include "cli/finsd/ctl_instructions.hpp"
 #include "cli/finsd/ctl_scenario.hpp"
 
+#ifdef _WIN32
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/local/stream_protocol.hpp>
+#include <boost/asio/read_until.hpp>
+#include <boost/asio/write.hpp>
+
+#include "transport/asio.hpp"
+#else
 #include <poll.h>
 #include <sys/socket.h>
 #include <sys/un.h>
 #include <unistd.h>
+#endif
 
 #include <algorithm>
 #include <cerrno>
@@ -59,6 +68,41 @@ constexpr int exit_io = 3;
 constexpr int answer_timeout_ms = 5000;
 constexpr std::size_t max_answer_size = 1 << 20;
 
+#ifdef _WIN32
+// Windows 10's AF_UNIX sockets through Asio (the same JSON lines as on Linux): the
+// connection is made, the request written, then the answer read on an io_context run
+// for at most the wait (no bound: until the answer or the end of the connection).
+std::optional<std::string> send_request(const std::string& path, const std::string& request,
+                                        std::optional<std::chrono::milliseconds> wait) {
+    using stream = asio::local::stream_protocol;
+    asio::io_context io;
+    stream::socket s(io);
+    boost::system::error_code ec;
+    if (s.connect(stream::endpoint(path), ec); ec) {
+        std::fprintf(stderr, "finsd ctl: cannot connect to %s: %s\n%s\n", path.c_str(),
+                     ec.message().c_str(), control_channel_hint().c_str());
+        return std::nullopt;
+    }
+    if (asio::write(s, asio::buffer(request + "\n"), ec); ec) {
+        std::fprintf(stderr, "finsd ctl: send: %s\n", ec.message().c_str());
+        return std::nullopt;
+    }
+    std::string answer;
+    bool done = false;
+    asio::async_read_until(s, asio::dynamic_buffer(answer, max_answer_size), '\n',
+                           [&](const boost::system::error_code& e, std::size_t n) {
+                               done = !e;
+                               if (done) answer.resize(n - 1);
+                           });
+    if (wait)
+        io.run_for(std::max(*wait, std::chrono::milliseconds(answer_timeout_ms)));
+    else
+        io.run();
+    if (done) return answer;
+    std::fprintf(stderr, "finsd ctl: no answer from %s\n", path.c_str());
+    return std::nullopt;
+}
+#else
 struct Fd {
     int fd = -1;
     ~Fd() {
@@ -121,6 +165,7 @@ std::optional<std::string> send_request(const std::string& path, const std::stri
     std::fprintf(stderr, "finsd ctl: no answer from %s\n", path.c_str());
     return std::nullopt;
 }
+#endif
 
 }  // namespace
 

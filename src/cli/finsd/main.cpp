@@ -35,6 +35,7 @@
 #include "cli/finsd/config_plant.hpp"
 #include "cli/finsd/control_setup.hpp"
 #include "cli/finsd/ctl.hpp"
+#include "cli/finsd/process_os.hpp"
 #include "cli/finsd/scenario_setup.hpp"
 #include "cli/finsd/serial_gateway_setup.hpp"
 #include "cli/finsd/serial_ports.hpp"
@@ -292,16 +293,15 @@ int open_plc(const Settings& s, const fins::plc::Profile& profile,
         std::fprintf(stderr,
                      "finsd: warning: %s: %s; --reset-state moved it to %s: retained memory "
                      "starts empty\n",
-                     file.c_str(), opened->refusal.message().c_str(), opened->moved_aside->c_str());
+                     file.c_str(), opened->refusal.message().c_str(),
+                     opened->moved_aside->string().c_str());
     plc = std::move(opened->plc);
     return -1;
 }
 
 int serve(const Settings& s) {
     spdlog::set_level(spdlog::level::from_str(s.log_level));
-    // A file size limit (RLIMIT_FSIZE) then fails the state file's reservation with
-    // EFBIG, a clear exit 3, instead of killing finsd with SIGXFSZ.
-    std::signal(SIGXFSZ, SIG_IGN);
+    fins::cli::finsd::ignore_file_size_signal();
     fins::plc::Profile profile = *fins::plc::find_profile(s.profile);
     if (s.dip_write_protection) profile.dip_switch |= fins::plc::dip_pin1;
     if (auto r = fins::cli::finsd::mount_serial_units(s.serial, profile); !r)
@@ -316,7 +316,7 @@ int serve(const Settings& s) {
                      "finsd: warning: %s was not stopped cleanly (SIGKILL, crash or power "
                      "loss; or it was just converted from an earlier format): its header and "
                      "section table are intact; its data has no valid checksums to check\n",
-                     plc.storage().path().c_str());
+                     plc.storage().path().string().c_str());
     if (s.data_dir)
         spdlog::info("finsd: {} state file {}", restored ? "restored" : "new",
                      plc.storage().path().string());

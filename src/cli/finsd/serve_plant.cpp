@@ -1,7 +1,9 @@
 // finsd with [[plc]] tables: the plant (server/routing/plant.hpp) on one I/O thread, and
 // what each CPU Unit has beyond its units: memory table, protections, injections, serial
 // ports and scheduled network instructions, set up as finsd sets them up for one node.
+#ifndef _WIN32
 #include <sys/resource.h>
+#endif
 
 #include <algorithm>
 #include <chrono>
@@ -17,6 +19,7 @@
 
 #include "cli/finsd/config_plant.hpp"
 #include "cli/finsd/control_setup.hpp"
+#include "cli/finsd/process_os.hpp"
 #include "cli/finsd/scenario_setup.hpp"
 #include "cli/finsd/serial_gateway_setup.hpp"
 #include "cli/finsd/serial_ports.hpp"
@@ -46,6 +49,10 @@ constexpr std::size_t units_logged_at_info = 64;
 // The plant keeps a socket or two per unit open (server::plant_descriptors): the soft
 // limit on open files goes up to the hard one when the plant needs more than it allows
 // (a shell's 1,024 is a plant of ~480 units). Plant::start refuses what still does not fit.
+#ifdef _WIN32
+// Windows has no limit on open sockets to raise (a SOCKET is a kernel handle).
+void raise_descriptor_limit(std::size_t) {}
+#else
 void raise_descriptor_limit(std::size_t needed) {
     rlimit limit{};
     if (::getrlimit(RLIMIT_NOFILE, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return;
@@ -57,6 +64,7 @@ void raise_descriptor_limit(std::size_t needed) {
         spdlog::info("finsd: open files limit raised from {} to {} for the plant's sockets", was,
                      limit.rlim_cur);
 }
+#endif
 
 std::string plc_path(std::size_t cpu) {
     return "plc[" + std::to_string(cpu) + "]";
@@ -213,7 +221,7 @@ int set_up_cpu(asio::io_context& io, const Settings& s, server::Plant& plant, st
 
 int serve_plant(const Settings& s) {
     spdlog::set_level(spdlog::level::from_str(s.log_level));
-    std::signal(SIGXFSZ, SIG_IGN);
+    ignore_file_size_signal();
     server::PlantConfig config;
     if (const auto problem = plant_config(s, config); !problem.empty()) return fail(2, problem);
     warn_single_node_keys(s);
