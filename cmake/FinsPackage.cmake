@@ -72,7 +72,7 @@ foreach(pc fins fins-static)
 endforeach()
 
 if(WIN32)
-  # finsd is not ported to Windows yet (docs/windows.md); fins.dll beside the programs.
+  # fins.exe; finsd.exe is installed by cmake/FinsWindowsPackage.cmake (docs/windows.md).
   install(TARGETS fins RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
 else()
   install(TARGETS finsd fins RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
