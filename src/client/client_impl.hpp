@@ -115,7 +115,7 @@ struct Client::Impl final : FrameSink {
 
     NodeAddress derive_destination(const transport::LinkInfo& info) const {
         NodeAddress d = options.destination;
-        if (d.node == 0) d.node = info.remote_node;
+        if (d.node == 0 && !options.destination_as_given) d.node = info.remote_node;
         return d;
     }
 
