@@ -103,8 +103,8 @@ struct ClientOptions {
     SerialSettings serial;
     std::uint8_t host_link_unit = 0;
     NodeAddress destination;  // node 0: derive (see above), unless destination_as_given
-    // Send `destination` exactly as written, node 0 included: W342's DA1 00 addresses "the
-    // local PLC" (internal communications), which a user may mean. Off: node 0 derives.
+    // Sent as written, node 0 too (W342: DA1 00 is "the local PLC"), and answered only from
+    // exactly that node (another node's answer: other_node(), a timeout). Off: 00 derives.
     bool destination_as_given = false;
     NodeAddress source;       // node 0: derive (see above); TCP: sent in the handshake
     // Per attempt; also bounds connecting and the TCP handshake. W596 p. 3-16: 0 means 2.0 s.

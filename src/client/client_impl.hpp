@@ -39,6 +39,7 @@ struct Client::Impl final : FrameSink {
           tracker(*this, options.gateway_count),
           timer(io) {
         tracker.set_quarantine(quarantine());
+        tracker.set_exact_destination(options.destination_as_given);
         transport::TransportOptions t;
         t.host = options.host;
         t.port = options.port;

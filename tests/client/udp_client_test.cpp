@@ -64,7 +64,7 @@ TEST(UdpClient, W342DestinationNode00IsSentAsWrittenWhenGivenAsIs) {
     auto frames = server.requests();
     ASSERT_GE(frames.size(), 1u);
     EXPECT_EQ(frames[0][4], 0) << "DA1 as written";
-    EXPECT_EQ(frames[0][7], 254) << "the source is still derived";
+    EXPECT_EQ(frames[0][7], 1) << "the source is still derived (127.0.0.1, not node 0)";
 }
 
 // Without destination_as_given, node 0 still means "derive" (existing users).
