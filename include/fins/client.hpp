@@ -53,7 +53,8 @@
 // that closed while the client was idle (finsd restarted) is noticed before the next
 // request is sent, so that request goes out on the new connection.
 //
-// Address defaults (node 0 in ClientOptions means "derive"):
+// Address defaults (node 0 in ClientOptions means "derive", unless
+// ClientOptions::destination_as_given: then the destination is sent as written):
 //   destination: TCP -> the server node from the handshake; UDP -> the last octet of
 //                the host's IPv4 address, on loopback too (127.0.0.2 -> node 2; ::1 -> 1;
 //                the last byte for other IPv6), as W420 5-2's automatic generation does.
@@ -101,7 +102,10 @@ struct ClientOptions {
     // HostLinkError::bad_fcs (fins/host_link.hpp). host/port are not used.
     SerialSettings serial;
     std::uint8_t host_link_unit = 0;
-    NodeAddress destination;  // node 0: derive (see above)
+    NodeAddress destination;  // node 0: derive (see above), unless destination_as_given
+    // Sent as written, node 0 too (W342: DA1 00 is "the local PLC"), and answered only from
+    // exactly that node (another node's answer: other_node(), a timeout). Off: 00 derives.
+    bool destination_as_given = false;
     NodeAddress source;       // node 0: derive (see above); TCP: sent in the handshake
     // Per attempt; also bounds connecting and the TCP handshake. W596 p. 3-16: 0 means 2.0 s.
     std::chrono::milliseconds timeout{2000};

@@ -11,6 +11,8 @@
 
 namespace fins::bridge {
 
+using PollClock = std::chrono::steady_clock;
+
 // Tick k of a group is at start + phase x interval + k x interval, whatever the ticks
 // before it cost: lateness never accumulates. A tick that comes when the grid point
 // after it has already passed skips the missed points and counts them.

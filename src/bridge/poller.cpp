@@ -1,23 +1,33 @@
-// PlcPoller: lifecycle, the groups' tick grids, the in-flight window (send, timeouts,
-// answers) and the end of a cycle. Sockets are in poller_io.cpp, writes in
-// poller_write.cpp, online/offline and back-off in poller_offline.cpp; the pure parts in
-// poll_schedule, request_window and tag_decode.
+// PlcPoller: lifecycle, the groups' tick grids, the window of frames handed to the PLC's
+// fins::Client, their answers and the end of a cycle. Writes are in poller_write.cpp,
+// online/offline and back-off in poller_offline.cpp; the pure parts in poll_schedule and
+// tag_decode. SIDs, retries, timeouts, sockets and the FINS/TCP handshake are the client's.
 #include <algorithm>
+#include <stdexcept>
 
 #include "bridge/poller_parts.hpp"
 #include "bridge/tag_decode.hpp"
 #include "fins/commands/memory_area.hpp"
-#include "fins/tcp.hpp"
 
 namespace fins::bridge {
 
 namespace {
 
-// A SID is not reused for this long after its frame was answered or given up: longer
-// than any answer arrives late in practice, shorter than 256 frames take at the rates
-// the bridge polls.
-PollClock::duration quarantine_of(const Plc& plc) {
-    return 2 * std::chrono::duration_cast<PollClock::duration>(plc.timeout);
+// The client of one PLC: its transport, address, timeout and retries. A configured
+// dest is sent as written (node 0 too: W342's "local PLC"); none: the client derives it.
+ClientOptions client_options(const Plc& plc) {
+    ClientOptions o;
+    o.host = plc.host;
+    o.port = plc.port;
+    o.protocol =
+        plc.transport == Transport::tcp ? ClientOptions::Protocol::tcp : ClientOptions::Protocol::udp;
+    if (plc.dest) {
+        o.destination = *plc.dest;
+        o.destination_as_given = true;
+    }
+    o.timeout = plc.timeout;
+    o.retries = plc.retries;
+    return o;
 }
 
 }  // namespace
@@ -28,12 +38,13 @@ PlcPoller::PlcPoller(asio::io_context& io, const Plc& plc, double phase, PollerE
       plc_(plc),
       phase_(phase),
       events_(events),
-      udp_(io),
-      tcp_(io),
-      window_(plc.window, quarantine_of(plc)),
-      timeout_timer_(io),
       backoff_timer_(io),
       backoff_(plc.backoff_min, plc.backoff_max, seed) {
+    // The configuration checked timeout and retries (config.cpp): create() only fails on
+    // options out of range, which would be a bug here.
+    auto client = Client::create(io, client_options(plc));
+    if (!client) throw std::logic_error("fins-bridge: " + client.error().message());
+    client_ = std::move(*client);
     for (const auto& g : plc.groups) {
         auto gs = std::make_unique<GroupState>(io, g);
         gs->plan = plan_group(g.tags, g.gap_words);
@@ -65,7 +76,7 @@ PlcPoller::PlcPoller(asio::io_context& io, const Plc& plc, double phase, PollerE
         gs->have_published.assign(g.tags.size(), false);
         groups_.push_back(std::move(gs));
     }
-    expired_.reserve(plc.window + 1);
+    in_flight_.reserve(plc.window);
 }
 
 PlcPoller::~PlcPoller() = default;
@@ -109,13 +120,9 @@ void PlcPoller::stop() {
         gs->outstanding = 0;
         gs->have_published.assign(gs->have_published.size(), false);
     }
-    timeout_timer_.cancel();
-    armed_.reset();
     backoff_timer_.cancel();
     ready_.clear();
-    expired_.clear();
-    window_.take_all(PollClock::now(), expired_);
-    expired_.clear();
+    in_flight_.clear();
     auto writes = std::move(writes_);
     writes_.clear();
     for (auto& op : writes) {
@@ -124,8 +131,35 @@ void PlcPoller::stop() {
         r.error = "this instance no longer polls the PLC";
         events_.write_done(plc_, r);
     }
-    close_socket();
+    // Requests still with the client fail with `canceled`: their completions belong to
+    // the old generation and return early.
+    client_->close();
     state_ = State::stopped;
+}
+
+NodeAddress PlcPoller::destination() const noexcept {
+    return client_->destination();
+}
+
+PollerStats PlcPoller::stats() const noexcept {
+    PollerStats s = stats_;
+    const auto c = client_->stats();
+    s.resends = c.retransmitted;
+    s.other_node_answers = c.other_node_answers;
+    return s;
+}
+
+// UDP: resolves and opens the socket, then polls (the first answer puts the PLC online);
+// TCP: connects and does the handshake, then the PLC is online.
+void PlcPoller::open() {
+    client_->async_open([this, gen = generation_](std::error_code ec) {
+        if (gen != generation_) return;
+        if (ec) {
+            go_offline(ec);
+            return;
+        }
+        if (plc_.transport == Transport::tcp) go_online();
+    });
 }
 
 void PlcPoller::schedule(std::size_t g) {
@@ -168,113 +202,63 @@ void PlcPoller::enqueue(Request r) {
 }
 
 void PlcPoller::pump() {
-    while (!window_.full() && !ready_.empty()) {
+    while (in_flight_.size() < plc_.window && !ready_.empty()) {
         Request r = ready_.front();
         ready_.pop_front();
-        if (!send(r)) continue;
-        window_.add(r);
+        send(r);
     }
-    arm_timeout();
 }
 
-bool PlcPoller::send(Request& r) {
-    const auto now = PollClock::now();
-    Header h;
-    h.destination = destination_;
-    h.source = source_;
-    h.service_id = window_.allocate(now);
-    r.service_id = h.service_id;
+void PlcPoller::send(Request r) {
     Bytes parameters;
     switch (r.kind) {
         case Request::Kind::group_frame:
         case Request::Kind::probe:
             parameters = groups_[r.group]->parameters[r.frame];
             break;
-        case Request::Kind::handshake:
-            return false;
         case Request::Kind::write:
         case Request::Kind::read_back:
             parameters = r.op->parameters;
             break;
     }
-    const std::size_t offset = plc_.transport == Transport::tcp ? tcp_header_size : 0;
-    auto n = encode_request(h, r.command, parameters, MutableBytes(scratch_).subspan(offset));
-    if (!n) {
-        complete(r, nullptr, n.error());
-        return false;
-    }
-    r.deadline = now + plc_.timeout;
-    if (plc_.transport == Transport::udp) {
-        boost::system::error_code ec;
-        udp_.send(asio::buffer(scratch_.data(), *n), 0, ec);
-        // A refused or full send is a lost datagram: the timeout handles it.
-    } else {
-        ByteWriter w(MutableBytes(scratch_).first(tcp_header_size));
-        write_tcp_header(w, TcpCommand::frame, *n);
-        tx_.insert(tx_.end(), scratch_.begin(),
-                   scratch_.begin() + static_cast<std::ptrdiff_t>(offset + *n));
-        tcp_flush();
-    }
-    return true;
+    r.token = ++next_token_;
+    in_flight_.push_back(r);
+    // The client copies the frame before returning; its answer comes as a view into the
+    // receive buffer, decoded in place (no copy).
+    client_->async_send_view(r.command, parameters,
+                             [this, gen = generation_, token = r.token](Result<ResponseView> a) {
+                                 if (gen != generation_) return;
+                                 on_answer(token, a);
+                             });
 }
 
-void PlcPoller::arm_timeout() {
-    const auto earliest = window_.earliest_deadline();
-    if (!earliest) return;
-    // An earlier wait fires first and arms again for the rest.
-    if (armed_ && *armed_ <= *earliest) return;
-    armed_ = *earliest;
-    timeout_timer_.expires_at(*earliest);
-    timeout_timer_.async_wait([this, gen = generation_](boost::system::error_code ec) {
-        if (gen != generation_ || ec) return;
-        armed_.reset();
-        on_timeout();
-    });
-}
-
-void PlcPoller::on_timeout() {
-    expired_.clear();
-    window_.take_expired(PollClock::now(), expired_);
-    for (std::size_t k = 0; k < expired_.size(); ++k) {
-        Request& r = expired_[k];
-        if (r.attempts < plc_.retries) {
-            ++r.attempts;
-            ++stats_.resends;
-            // A new SID (the old one is in quarantine): a late answer to the old one
-            // finds nothing in flight.
-            if (send(r)) window_.add(r);
-            continue;
-        }
-        ++stats_.timeouts;
-        // The PLC is offline: this frame and every other one waiting fail with it.
-        for (std::size_t j = k; j < expired_.size(); ++j)
-            ready_.push_front(expired_[j]);
-        go_offline(make_error_code(ClientError::timeout));
+void PlcPoller::on_answer(std::uint64_t token, const Result<ResponseView>& answer) {
+    const auto it = std::find_if(in_flight_.begin(), in_flight_.end(),
+                                 [token](const Request& q) { return q.token == token; });
+    if (it == in_flight_.end()) return;
+    Request r = *it;
+    *it = in_flight_.back();
+    in_flight_.pop_back();
+    if (!answer) {
+        // Every attempt went unanswered (the client resent the same frame Plc::retries
+        // times), the link failed or the PLC's port refused: the PLC is offline, and this
+        // frame and every other one waiting fail with it.
+        auto why = answer.error();
+        // UDP: an ICMP port unreachable (nothing listens at the PLC's port) is a frame
+        // that got no response, as the bridge has always reported it; the client only
+        // says so sooner than the timeout would.
+        if (plc_.transport == Transport::udp && why == std::errc::connection_refused)
+            why = make_error_code(ClientError::timeout);
+        if (why == make_error_code(ClientError::timeout)) ++stats_.timeouts;
+        ready_.push_front(r);
+        go_offline(why);
         return;
     }
-    arm_timeout();
-}
-
-void PlcPoller::on_frame(Bytes frame) {
-    auto v = decode_response(frame);
-    if (!v) return;
-    auto r = window_.take_answer(v->header, v->command, destination_.node, PollClock::now());
-    if (!r) {
-        // Late (after a resend), duplicated or not ours: dropped. But an answer to a frame
-        // in flight from another node means the PLC is not the node it is addressed as
-        // (dest, or its IP's last number): its frames then time out, and the status says
-        // why (go_offline).
-        if (window_.from_other_node(v->header, v->command, destination_.node)) {
-            ++stats_.other_node_answers;
-            answered_by_ = v->header.source;
-        }
-        return;
-    }
-    answered_by_.reset();
     ++stats_.frames;
     if (state_ != State::online) go_online();
-    complete(*r, &*v, {});
-    pump();
+    const auto gen = generation_;
+    complete(r, &*answer, {});
+    if (gen == generation_) pump();
 }
 
 void PlcPoller::complete(Request& r, const ResponseView* response, std::error_code error) {
@@ -285,7 +269,6 @@ void PlcPoller::complete(Request& r, const ResponseView* response, std::error_co
     }
     switch (r.kind) {
         case Request::Kind::probe:
-        case Request::Kind::handshake:
             return;
         case Request::Kind::write:
         case Request::Kind::read_back:

@@ -1,5 +1,5 @@
-// PlcPoller's private state shared by its source files (poller.cpp: scheduling and
-// answers; poller_io.cpp: sockets; poller_write.cpp: writes; poller_offline.cpp: online,
+// PlcPoller's private state shared by its source files (poller.cpp: scheduling, the
+// client and its answers; poller_write.cpp: writes; poller_offline.cpp: online,
 // offline and back-off). Not for use outside the poller.
 #pragma once
 

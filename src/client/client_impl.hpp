@@ -39,6 +39,7 @@ struct Client::Impl final : FrameSink {
           tracker(*this, options.gateway_count),
           timer(io) {
         tracker.set_quarantine(quarantine());
+        tracker.set_exact_destination(options.destination_as_given);
         transport::TransportOptions t;
         t.host = options.host;
         t.port = options.port;
@@ -115,7 +116,7 @@ struct Client::Impl final : FrameSink {
 
     NodeAddress derive_destination(const transport::LinkInfo& info) const {
         NodeAddress d = options.destination;
-        if (d.node == 0) d.node = info.remote_node;
+        if (d.node == 0 && !options.destination_as_given) d.node = info.remote_node;
         return d;
     }
 

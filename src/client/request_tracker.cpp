@@ -7,13 +7,14 @@ namespace fins {
 
 RequestTracker::RequestTracker(FrameSink& sink, std::uint8_t gateway_count)
     : sink_(sink),
-      requests_(max_in_flight),
       sids_(default_timeout * default_quarantine_timeouts),
       gateway_count_(gateway_count) {
     by_sid_.fill(none);
+    // Room for max_in_flight slots (about 2 KB each, the frame buffer), made as they are
+    // first needed: a client that keeps a few requests in flight (fins-bridge's thousand,
+    // `window` each) touches a few slots, not 540 KB. Reserved, so a slot never moves.
+    requests_.reserve(max_in_flight);
     free_requests_.reserve(max_in_flight);
-    for (std::size_t i = max_in_flight; i-- > 0;)
-        free_requests_.push_back(static_cast<std::uint16_t>(i));
 }
 
 Header RequestTracker::make_header(std::uint8_t service_id, bool response_required) const noexcept {
@@ -39,7 +40,12 @@ Result<void> RequestTracker::submit(CommandCode command, Bytes parameters,
         return Unexpected(make_error_code(ClientError::invalid_argument));
     if (header_size + command_code_size + parameters.size() > max_frame_)
         return Unexpected(make_error_code(ClientError::request_too_long));
-    if (free_requests_.empty()) return Unexpected(make_error_code(ClientError::too_many_in_flight));
+    if (free_requests_.empty()) {
+        if (requests_.size() >= max_in_flight)
+            return Unexpected(make_error_code(ClientError::too_many_in_flight));
+        requests_.emplace_back();
+        free_requests_.push_back(static_cast<std::uint16_t>(requests_.size() - 1));
+    }
     const auto index = free_requests_.back();
     Request& r = requests_[index];
     r.header = make_header(0, true);
@@ -168,9 +174,12 @@ void RequestTracker::fail_all(std::error_code reason, SteadyTime now) {
 bool RequestTracker::addresses_match(const Header& request, const Header& response) const noexcept {
     // A field sent as 00 ("local network", "local node") may come back as the real value.
     auto same = [](std::uint8_t sent, std::uint8_t got) { return sent == 0 || sent == got; };
+    // Unless the destination was given as is: then it answers as the node it was sent to.
+    const bool node = exact_destination_ ? request.destination.node == response.source.node
+                                         : same(request.destination.node, response.source.node);
     const auto& to = request.destination;
     const auto& from = request.source;
-    return same(to.network, response.source.network) && same(to.node, response.source.node) &&
+    return same(to.network, response.source.network) && node &&
            to.unit == response.source.unit && same(from.network, response.destination.network) &&
            same(from.node, response.destination.node) && from.unit == response.destination.unit;
 }

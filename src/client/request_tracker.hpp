@@ -155,6 +155,9 @@ class RequestTracker {
     }
     [[nodiscard]] const NodeAddress& source() const noexcept { return source_; }
     void set_gateway_count(std::uint8_t count) noexcept { gateway_count_ = count; }
+    // An answer must come from exactly the destination's node, 00 included
+    // (ClientOptions::destination_as_given); off: a 00 sent may come back as the real value.
+    void set_exact_destination(bool exact) noexcept { exact_destination_ = exact; }
     void set_quarantine(std::chrono::nanoseconds q) noexcept { sids_.set_quarantine(q); }
     // A clean SID rests rest_rtts round trips (at least min_clean_rest) before reuse.
     static constexpr int rest_rtts = 4;
@@ -190,7 +193,7 @@ class RequestTracker {
     void fail_all(std::error_code reason, SteadyTime now);
 
     FrameSink& sink_;
-    std::vector<Request> requests_;             // max_in_flight of them
+    std::vector<Request> requests_;             // up to max_in_flight, made on demand
     std::vector<std::uint16_t> free_requests_;  // indexes into requests_
     std::array<std::uint16_t, 256> by_sid_{};   // request index of each SID in flight
     std::deque<std::uint16_t> queue_;           // held or waiting for a SID, oldest first
@@ -206,6 +209,7 @@ class RequestTracker {
     NodeAddress source_;
     TrackerStats stats_;
     std::optional<NodeAddress> other_node_;
+    bool exact_destination_ = false;
 };
 
 }  // namespace fins

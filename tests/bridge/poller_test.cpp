@@ -1,7 +1,7 @@
 // The poller's pure parts, driven by an invented clock (no sockets, no sleeping): the
 // drift-free tick grid and its overrun count, the start phases, the back-off with full
-// jitter, and the in-flight window's answer matching (poll_schedule.hpp,
-// request_window.hpp).
+// jitter (poll_schedule.hpp). Answer matching, SIDs and retries are fins::Client's
+// (tests/client); the poller on it: poller_engine_test.cpp.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -9,7 +9,6 @@
 #include <vector>
 
 #include "bridge/poll_schedule.hpp"
-#include "bridge/request_window.hpp"
 #include "fins/commands/memory_area.hpp"
 
 namespace fins::bridge {
@@ -98,149 +97,6 @@ TEST(PollerBackoff, FullJitterSpreadsEachWaitOverZeroToTheCap) {
         EXPECT_GT(in, 130) << from;
         EXPECT_LT(in, 270) << from;
     }
-}
-
-constexpr std::uint8_t plc_node = 7;
-
-Header answer_header(std::uint8_t sid, std::uint8_t node = plc_node) {
-    Header h;
-    h.source = {0, node, 0};
-    h.destination = {0, 254, 0};
-    h.service_id = sid;
-    return h;
-}
-
-Request sent(RequestWindow& w, Clock::time_point now, std::size_t frame,
-             CommandCode command = MemoryAreaRead::code) {
-    Request r;
-    r.frame = frame;
-    r.command = command;
-    r.service_id = w.allocate(now);
-    r.deadline = now + 1s;
-    w.add(r);
-    return r;
-}
-
-TEST(PollerWindow, MatchesAnAnswerBySidSourceNodeAndCommandOnly) {
-    RequestWindow w(4, 2s);
-    const auto a = sent(w, t0, 0);
-    const auto b = sent(w, t0, 1, MultipleMemoryAreaRead::code);
-    EXPECT_NE(a.service_id, b.service_id);
-    EXPECT_EQ(w.size(), 2u);
-    // Another node, or another command, with a's SID: not a's answer.
-    EXPECT_FALSE(w.take_answer(answer_header(a.service_id, 9), MemoryAreaRead::code, plc_node, t0));
-    EXPECT_FALSE(
-        w.take_answer(answer_header(a.service_id), MultipleMemoryAreaRead::code, plc_node, t0));
-    EXPECT_FALSE(w.take_answer(answer_header(static_cast<std::uint8_t>(b.service_id + 1)),
-                               MemoryAreaRead::code, plc_node, t0));
-    auto got =
-        w.take_answer(answer_header(b.service_id), MultipleMemoryAreaRead::code, plc_node, t0);
-    ASSERT_TRUE(got);
-    EXPECT_EQ(got->frame, 1u);
-    // The same answer again (a duplicated datagram) finds nothing.
-    EXPECT_FALSE(
-        w.take_answer(answer_header(b.service_id), MultipleMemoryAreaRead::code, plc_node, t0));
-    got = w.take_answer(answer_header(a.service_id), MemoryAreaRead::code, plc_node, t0);
-    ASSERT_TRUE(got);
-    EXPECT_EQ(got->frame, 0u);
-    EXPECT_TRUE(w.empty());
-}
-
-// The answer a PLC gives under another node than the one addressed: refused as every
-// answer not ours, and recognised, so the poller can say what to configure.
-TEST(PollerWindow, TellsAnAnswerFromAnotherNodeToAFrameInFlight) {
-    RequestWindow w(4, 2s);
-    const auto a = sent(w, t0, 0);
-    const auto other = answer_header(a.service_id, 12);
-    EXPECT_TRUE(w.from_other_node(other, MemoryAreaRead::code, plc_node));
-    EXPECT_FALSE(w.take_answer(other, MemoryAreaRead::code, plc_node, t0));
-    EXPECT_EQ(w.size(), 1u);  // still in flight: it times out
-    // Not from another node: the right node, another command, a SID not in flight.
-    EXPECT_FALSE(w.from_other_node(answer_header(a.service_id), MemoryAreaRead::code, plc_node));
-    EXPECT_FALSE(w.from_other_node(other, MultipleMemoryAreaRead::code, plc_node));
-    EXPECT_FALSE(w.from_other_node(answer_header(static_cast<std::uint8_t>(a.service_id + 1), 12),
-                                   MemoryAreaRead::code, plc_node));
-    ASSERT_TRUE(w.take_answer(answer_header(a.service_id), MemoryAreaRead::code, plc_node, t0));
-    // Answered (quarantined): a late copy from another node is nothing to report.
-    EXPECT_FALSE(w.from_other_node(other, MemoryAreaRead::code, plc_node));
-}
-
-TEST(PollerWindow, ALateAnswerAfterAResendNeverCompletesAnotherRequest) {
-    RequestWindow w(4, 2s);
-    const auto first = sent(w, t0, 0);
-    // No answer within the timeout: the frame is taken out and resent with a new SID.
-    std::vector<Request> expired;
-    w.take_expired(t0 + 999ms, expired);
-    EXPECT_TRUE(expired.empty());
-    w.take_expired(t0 + 1s, expired);
-    ASSERT_EQ(expired.size(), 1u);
-    const auto resent = sent(w, t0 + 1s, 0);
-    EXPECT_NE(resent.service_id, first.service_id);
-    // The late answer to the first send arrives: nothing in flight has its SID.
-    EXPECT_FALSE(w.take_answer(answer_header(first.service_id), MemoryAreaRead::code, plc_node,
-                               t0 + 1100ms));
-    EXPECT_TRUE(w.take_answer(answer_header(resent.service_id), MemoryAreaRead::code, plc_node,
-                              t0 + 1200ms));
-    // Hundreds of frames within the quarantine (SIDs wrap around): none gets the first SID,
-    // so its answer arriving even later still finds nothing.
-    auto now = t0 + 1200ms;
-    for (int i = 0; i < 600; ++i) {
-        now += 1ms;
-        const auto r = sent(w, now, 1);
-        ASSERT_NE(r.service_id, first.service_id) << i;
-        ASSERT_TRUE(
-            w.take_answer(answer_header(r.service_id), MemoryAreaRead::code, plc_node, now));
-        ASSERT_FALSE(
-            w.take_answer(answer_header(first.service_id), MemoryAreaRead::code, plc_node, now));
-    }
-}
-
-TEST(PollerWindow, SidsAreReusedAfterTheQuarantineAndNeverWhileInFlight) {
-    RequestWindow w(64, 2s);
-    std::set<std::uint8_t> in_flight;
-    for (int i = 0; i < 64; ++i)
-        EXPECT_TRUE(in_flight.insert(sent(w, t0, 0).service_id).second);
-    EXPECT_TRUE(w.full());
-    std::vector<Request> all;
-    w.take_all(t0, all);
-    EXPECT_EQ(all.size(), 64u);
-    EXPECT_TRUE(w.empty());
-    // The 192 never used go first; then, within the quarantine, the oldest released ones.
-    std::set<std::uint8_t> next;
-    for (int i = 0; i < 192; ++i) {
-        const auto r = sent(w, t0 + 1s, 0);
-        EXPECT_FALSE(in_flight.contains(r.service_id));
-        next.insert(r.service_id);
-        ASSERT_TRUE(
-            w.take_answer(answer_header(r.service_id), MemoryAreaRead::code, plc_node, t0 + 1s));
-    }
-    EXPECT_EQ(next.size(), 192u);
-    // After the quarantine every SID may be used again.
-    const auto r = sent(w, t0 + 10s, 0);
-    EXPECT_TRUE(in_flight.contains(r.service_id));
-}
-
-TEST(PollerWindow, TheEarliestDeadlineIsTheOneToWaitFor) {
-    RequestWindow w(4, 2s);
-    EXPECT_FALSE(w.earliest_deadline());
-    Request r;
-    r.command = MemoryAreaRead::code;
-    r.service_id = w.allocate(t0);
-    r.deadline = t0 + 3s;
-    w.add(r);
-    r.service_id = w.allocate(t0);
-    r.deadline = t0 + 1s;
-    w.add(r);
-    EXPECT_EQ(w.earliest_deadline(), t0 + 1s);
-    Request hs{Request::Kind::handshake};
-    hs.deadline = t0 + 500ms;
-    w.add(hs);
-    EXPECT_EQ(w.earliest_deadline(), t0 + 500ms);
-    // The handshake is never an answer's match, whatever SID the answer carries.
-    EXPECT_FALSE(w.take_answer(answer_header(0), CommandCode{}, plc_node, t0));
-    w.remove_handshake();
-    EXPECT_EQ(w.size(), 2u);
-    EXPECT_EQ(w.earliest_deadline(), t0 + 1s);
 }
 
 }  // namespace

@@ -63,6 +63,22 @@ TEST(TcpClient, AConfiguredSourceNodeIsRequestedInTheHandshake) {
     EXPECT_EQ(client->source().node, 5);
 }
 
+// W342: a destination node 0 given as is is sent as node 0, not the handshake's node.
+TEST(TcpClient, W342DestinationNode00IsSentAsWrittenWhenGivenAsIs) {
+    TcpResponder server;
+    auto options = tcp_options(server);
+    options.destination = NodeAddress{0, 0, 0};
+    options.destination_as_given = true;
+    options.timeout = std::chrono::milliseconds(200);
+    auto client = connect_with(options);
+    ASSERT_TRUE(client);
+    EXPECT_EQ(client->destination(), (NodeAddress{0, 0, 0}));
+    (void)client->read_words(dm(0), 1);
+    auto frames = server.requests();
+    ASSERT_GE(frames.size(), 1u);
+    EXPECT_EQ(frames[0][4], 0) << "DA1 as written, not the server node 10";
+}
+
 TEST(TcpClient, WorksOverIpv6Loopback) {
     TcpResponder server({}, "::1");
     if (!server.ok()) GTEST_SKIP() << "no IPv6 loopback";

@@ -49,6 +49,34 @@ TEST(UdpClient, ConfiguredNodesAreUsedAsGiven) {
     EXPECT_EQ(frames[0][7], 7);
 }
 
+// W342 (DA1 00: "internal communications inside the local PLC"): a destination node 0
+// given as is goes out as node 0, not the node derived from the host's IP.
+TEST(UdpClient, W342DestinationNode00IsSentAsWrittenWhenGivenAsIs) {
+    UdpResponder server;
+    ClientOptions options;
+    options.destination = NodeAddress{0, 0, 0};
+    options.destination_as_given = true;
+    options.timeout = 200ms;
+    auto client = connect_udp(server, options);
+    ASSERT_TRUE(client);
+    EXPECT_EQ(client->destination(), (NodeAddress{0, 0, 0}));
+    (void)client->read_words(dm(0), 1);  // answered or not: what was sent is the point
+    auto frames = server.requests();
+    ASSERT_GE(frames.size(), 1u);
+    EXPECT_EQ(frames[0][4], 0) << "DA1 as written";
+    EXPECT_EQ(frames[0][7], 1) << "the source is still derived (127.0.0.1, not node 0)";
+}
+
+// Without destination_as_given, node 0 still means "derive" (existing users).
+TEST(UdpClient, DestinationNode0WithoutAsGivenIsDerived) {
+    UdpResponder server;
+    ClientOptions options;
+    options.destination = NodeAddress{0, 0, 0};
+    auto client = connect_udp(server, options);
+    ASSERT_TRUE(client);
+    EXPECT_EQ(client->destination(), (NodeAddress{0, 1, 0}));
+}
+
 TEST(UdpClient, TypedSendReadsAndWrites) {
     UdpResponder server;
     auto client = connect_udp(server);
