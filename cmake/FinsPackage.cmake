@@ -9,7 +9,7 @@
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
-set(fins_parts fins_codec fins_transport fins_client)
+set(fins_parts fins_codec fins_engine fins_transport fins_client)
 set(fins_objects)
 foreach(part ${fins_parts})
   set_target_properties(${part} PROPERTIES POSITION_INDEPENDENT_CODE ON)

@@ -11,7 +11,7 @@
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/steady_timer.hpp>
 
-#include "client/request_tracker.hpp"
+#include "engine/request_tracker.hpp"
 #include "fins/client.hpp"
 #include "fins/host_link.hpp"
 #include "transport/asio.hpp"

@@ -7,7 +7,7 @@
 #include <thread>
 #include <vector>
 
-#include "client/request_tracker.hpp"  // default_quarantine_timeouts
+#include "engine/request_tracker.hpp"  // default_quarantine_timeouts
 #include "fins/client.hpp"
 #include "fins/commands/file_memory.hpp"
 

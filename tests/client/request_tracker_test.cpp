@@ -1,5 +1,5 @@
 // RequestTracker with a fake wire and a fake clock: no sockets, no sleeps.
-#include "client/request_tracker.hpp"
+#include "engine/request_tracker.hpp"
 #include "client/tracker_fixture.hpp"
 
 #include <gtest/gtest.h>

@@ -1,10 +1,10 @@
 // RequestTracker and SidPool: a service ID that may still get a late answer is not
-// handed out again (issue 7 item 1; client/sid_pool.hpp). Fake wire, fake clock.
+// handed out again (issue 7 item 1; engine/sid_pool.hpp). Fake wire, fake clock.
 #include <gtest/gtest.h>
 
 #include <vector>
 
-#include "client/request_tracker.hpp"
+#include "engine/request_tracker.hpp"
 #include "client/tracker_fixture.hpp"
 
 using namespace fins;

@@ -10,7 +10,7 @@
 #include <optional>
 #include <vector>
 
-#include "client/request_tracker.hpp"
+#include "engine/request_tracker.hpp"
 
 namespace fins::test {
 

@@ -8,6 +8,7 @@
 #include <spdlog/spdlog.h>
 #include <boost/asio/post.hpp>
 
+#include "engine/request_tracker.hpp"  // default_timeout, default_quarantine_timeouts
 #include "fins/commands/memory_area.hpp"
 #include "plc/plc.hpp"
 #include "server/metrics/metrics.hpp"
@@ -52,6 +53,7 @@ struct NetworkInstructions::Port {
     CommandCode command;
     InstructionRoute route;  // the way the last transmission went
     unsigned transmissions = 0;
+    bool answered = false;  // an answer matched (its SID needs no quarantine)
     std::uint64_t generation = 0;
     asio::steady_timer timer;
 };
@@ -77,21 +79,19 @@ void NetworkInstructions::stop() {
     alive_ = std::make_shared<bool>(true);
     for (auto& p : ports_) {
         p->timer.cancel();
+        if (p->busy) release_sid(*p, false);
         p->busy = false;
         p->done = nullptr;
     }
     in_flight_ = 0;
 }
 
-std::uint8_t NetworkInstructions::next_sid() noexcept {
-    // A SID comes back only after 224 others: a late answer to a finished instruction
-    // never meets a new one with its SID while fewer than 32 run.
-    for (;;) {
-        ++sid_;
-        const bool used = std::any_of(ports_.begin(), ports_.end(),
-                                      [&](const auto& p) { return p->busy && p->sid == sid_; });
-        if (!used) return sid_;
-    }
+void NetworkInstructions::release_sid(Port& p, bool answered) {
+    const auto unanswered = p.transmissions - (answered && p.transmissions > 0 ? 1U : 0U);
+    // Twice the instruction's own timeout (fins::Client: default_quarantine_timeouts).
+    sids_->set_quarantine(instruction_timeout(p.request.options.timeout) *
+                          default_quarantine_timeouts);
+    sids_->release(p.sid, unanswered, std::chrono::steady_clock::now());
 }
 
 void NetworkInstructions::complete_later(InstructionCallback done, InstructionResult result) {
@@ -126,12 +126,20 @@ void NetworkInstructions::start(InstructionRequest request, InstructionCallback 
                               communications_error(EndCode::too_many_send_frames,
                                                    "32 instructions are already running"));
     }
+    if (!sids_) sids_ = std::make_unique<SidPool>(default_timeout * default_quarantine_timeouts);
+    const auto sid = sids_->acquire(std::chrono::steady_clock::now());
+    if (!sid) {  // every free SID is quarantined (more than 224 late answers pending)
+        ++counters_.errors;
+        return complete_later(std::move(done),
+                              communications_error(EndCode::too_many_send_frames,
+                                                   "no service ID free (quarantined)"));
+    }
     const auto index = static_cast<std::size_t>(free - ports_.begin());
     Port& p = **free;
     p.busy = true;
     p.done = std::move(done);
     p.transmissions = 0;
-    p.sid = next_sid();
+    p.sid = *sid;
     ++in_flight_;
     show_port(index, true, std::nullopt);
 
@@ -166,6 +174,7 @@ void NetworkInstructions::start(InstructionRequest request, InstructionCallback 
     }
     p.frame_size = w.size();
     p.request = std::move(request);
+    p.answered = false;
     transmit(index);
 }
 
@@ -191,6 +200,7 @@ void NetworkInstructions::transmit(std::size_t index) {
                       communications_error(EndCode::retries_failed, "the frame could not be sent"));
     const bool no_answer = (p.frame[0] & icf_no_response) != 0;
     if (no_answer && sent == InstructionTransport::Sent::ok) {
+        p.answered = true;  // nothing answers it: its SID needs no quarantine
         InstructionResult r;
         r.detail = "sent (no response requested)";
         return finish(index, std::move(r));
@@ -258,6 +268,7 @@ bool NetworkInstructions::on_response(Bytes frame, const InstructionRoute& from)
     }
     const auto index = static_cast<std::size_t>(it - ports_.begin());
     Port& p = **it;
+    p.answered = true;
     InstructionResult r;
     r.end_code = view->code.raw();
     if (p.request.kind == InstructionKind::sendcmd)
@@ -304,6 +315,7 @@ void NetworkInstructions::finish(std::size_t index, InstructionResult result) {
     Port& p = *ports_[index];
     ++p.generation;
     p.timer.cancel();
+    release_sid(p, p.answered);
     p.busy = false;
     --in_flight_;
     result.port = static_cast<int>(index);

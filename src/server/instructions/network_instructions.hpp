@@ -15,6 +15,14 @@
 // destination. Any other process can send a datagram to port 9600: a forged answer
 // is counted as unmatched and the instruction goes on waiting (then retries, 0205).
 //
+// Service IDs and retries: one rule with fins::Client (engine/request_tracker.hpp, W596
+// 3 Send/Rcv/SendCmd "Option"): a retry resends the identical frame with the same SID;
+// SIDs come from the engine's SidPool (engine/sid_pool.hpp): a SID whose instruction
+// got no answer to some transmission (timed out, retried, or ended by a send failure) is
+// quarantined for twice that instruction's timeout, clean SIDs are reused least recently
+// used first. A late answer to an ended instruction therefore never completes a later
+// one; it is counted as unmatched.
+//
 // W596 3 parameters and limits:
 //   destination network 0-127, node 0-254 (255 = broadcast: Send/SendCmd only, no
 //   response), unit 00-FF; words 0-990 (0: Done without sending); timeout in 0.1 s
@@ -50,6 +58,7 @@
 #include <boost/asio/ip/udp.hpp>
 #include <boost/asio/steady_timer.hpp>
 
+#include "engine/sid_pool.hpp"
 #include "fins/address.hpp"
 #include "fins/frame.hpp"
 #include "server/instructions/instruction_parameters.hpp"
@@ -149,7 +158,8 @@ class NetworkInstructions {
     // True when `h`, arrived by `from`, is the answer port `p`'s command asked for.
     [[nodiscard]] bool answers(const Port& p, const Header& h,
                                const InstructionRoute& from) const noexcept;
-    std::uint8_t next_sid() noexcept;
+    // Ends port `index`'s use of its SID (unanswered transmissions quarantine it).
+    void release_sid(Port& p, bool answered);
 
     asio::any_io_executor executor_;
     plc::Plc& plc_;
@@ -157,7 +167,10 @@ class NetworkInstructions {
     InstructionTransport& transport_;
     std::vector<std::unique_ptr<Port>> ports_;
     std::size_t in_flight_ = 0;
-    std::uint8_t sid_ = 0;
+    // The engine's SID pool (engine/sid_pool.hpp, the rule of fins::Client): a SID whose
+    // frame went unanswered is quarantined, so a late answer never completes a later
+    // instruction. Made on first use, like the ports.
+    std::unique_ptr<SidPool> sids_;
     bool flags_ = false;  // the profile shows ports in A202/A203-A210/A219
     Counters counters_;
     std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);

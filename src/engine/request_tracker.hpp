@@ -5,7 +5,7 @@
 //
 // Contract (W596 section 3, Send/Rcv/SendCmd pp. 3-6..3-16, "Option": isNonResp,
 // TimeOut, Retry 0-15):
-// - Service IDs (SID): see client/sid_pool.hpp. A SID whose request was retransmitted,
+// - Service IDs (SID): see engine/sid_pool.hpp. A SID whose request was retransmitted,
 //   timed out or failed after it was sent is quarantined (ClientOptions::sid_quarantine,
 //   by default twice the timeout) so that no late answer can complete a later request;
 //   clean SIDs are reused least recently used first. Up to 256 requests are accepted at
@@ -52,7 +52,7 @@
 #include <system_error>
 #include <vector>
 
-#include "client/sid_pool.hpp"
+#include "engine/sid_pool.hpp"
 #include "fins/byte_io.hpp"
 #include "fins/error.hpp"
 #include "fins/frame.hpp"

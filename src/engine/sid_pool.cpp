@@ -1,4 +1,4 @@
-#include "client/sid_pool.hpp"
+#include "engine/sid_pool.hpp"
 
 namespace fins {
 

@@ -1,4 +1,4 @@
-#include "client/request_tracker.hpp"
+#include "engine/request_tracker.hpp"
 
 #include <algorithm>
 #include <utility>
