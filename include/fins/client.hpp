@@ -34,7 +34,7 @@
 // that it duplicates answers (an answer to a SID that had all its answers), every SID
 // released within `sid_quarantine` of that is quarantined too. When no SID is usable a
 // request waits in a queue (its timeout runs) instead of reusing one early. This holds
-// as long as no datagram outlives `sid_quarantine` in the network (client/sid_pool.hpp).
+// as long as no datagram outlives `sid_quarantine` in the network (engine/sid_pool.hpp).
 //
 // Errors (all std::error_code): EndCode for a non-zero end code in send<C>() and the
 // helpers (end-code flag bits 0x0040/0x0080 alone still count as success; send_raw()
