@@ -106,7 +106,7 @@ struct ClientOptions {
     // Sent as written, node 0 too (W342: DA1 00 is "the local PLC"), and answered only from
     // exactly that node (another node's answer: other_node(), a timeout). Off: 00 derives.
     bool destination_as_given = false;
-    NodeAddress source;       // node 0: derive (see above); TCP: sent in the handshake
+    NodeAddress source;  // node 0: derive (see above); TCP: sent in the handshake
     // Per attempt; also bounds connecting and the TCP handshake. W596 p. 3-16: 0 means 2.0 s.
     std::chrono::milliseconds timeout{2000};
     unsigned retries = 0;  // W596 p. 3-16 Option.Retry: 0-15

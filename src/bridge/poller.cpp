@@ -19,8 +19,8 @@ ClientOptions client_options(const Plc& plc) {
     ClientOptions o;
     o.host = plc.host;
     o.port = plc.port;
-    o.protocol =
-        plc.transport == Transport::tcp ? ClientOptions::Protocol::tcp : ClientOptions::Protocol::udp;
+    o.protocol = plc.transport == Transport::tcp ? ClientOptions::Protocol::tcp
+                                                 : ClientOptions::Protocol::udp;
     if (plc.dest) {
         o.destination = *plc.dest;
         o.destination_as_given = true;

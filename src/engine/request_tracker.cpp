@@ -179,8 +179,8 @@ bool RequestTracker::addresses_match(const Header& request, const Header& respon
                                          : same(request.destination.node, response.source.node);
     const auto& to = request.destination;
     const auto& from = request.source;
-    return same(to.network, response.source.network) && node &&
-           to.unit == response.source.unit && same(from.network, response.destination.network) &&
+    return same(to.network, response.source.network) && node && to.unit == response.source.unit &&
+           same(from.network, response.destination.network) &&
            same(from.node, response.destination.node) && from.unit == response.destination.unit;
 }
 

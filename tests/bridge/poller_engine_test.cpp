@@ -46,8 +46,8 @@ class RecordingResponder {
         requests_.push_back(req);
         // ICF response, RSV, GCT, the request's source as destination and its destination
         // as source, the SID, MRC SRC, end code 00 00, data.
-        tx_ = {0xC0, 0x00, 0x02, req[6], req[7], req[8], req[3], req[4],
-               req[5], req[9], req[10], req[11], 0x00, 0x00, 0x00, 42};
+        tx_ = {0xC0,   0x00,   0x02,    req[6],  req[7], req[8], req[3], req[4],
+               req[5], req[9], req[10], req[11], 0x00,   0x00,   0x00,   42};
         boost::system::error_code ignored;
         socket_.send_to(net::buffer(tx_), peer_, 0, ignored);
     }

@@ -4,8 +4,8 @@
 
 #include <vector>
 
-#include "engine/request_tracker.hpp"
 #include "client/tracker_fixture.hpp"
+#include "engine/request_tracker.hpp"
 
 using namespace fins;
 using namespace fins::test;
@@ -31,8 +31,8 @@ TEST_F(TrackerTest, TimedOutServiceIdIsQuarantinedAndRequestsWaitRatherThanReuse
     for (std::size_t i = 0; i < 255; ++i)
         EXPECT_NE(submit(second[i], RequestTiming{1s, 0}, t0 + 110ms), 5);
     const auto frames_before = wire.frames.size();
-    ASSERT_TRUE(tracker.submit(read_code, read_params, RequestTiming{1s, 0},
-                               second[255].callback(), t0 + 110ms));
+    ASSERT_TRUE(tracker.submit(read_code, read_params, RequestTiming{1s, 0}, second[255].callback(),
+                               t0 + 110ms));
     EXPECT_EQ(wire.frames.size(), frames_before) << "waits: the only free SID is quarantined";
     EXPECT_EQ(tracker.stats().waited_for_id, 1u);
     EXPECT_EQ(tracker.next_deadline(), t0 + 300ms) << "the end of SID 5's quarantine";

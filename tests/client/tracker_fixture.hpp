@@ -30,7 +30,8 @@ inline const SteadyTime t0 = SteadyTime{} + 1h;
 inline constexpr std::array<std::uint8_t, 6> read_params{0x82, 0x00, 0x0A, 0x00, 0x00, 0x0A};
 
 inline std::vector<std::uint8_t> answer(Bytes request, std::uint16_t end_code = 0,
-                                 std::vector<std::uint8_t> data = {}, NodeAddress responder = plc) {
+                                        std::vector<std::uint8_t> data = {},
+                                        NodeAddress responder = plc) {
     auto req = decode_request(request);
     EXPECT_TRUE(req.has_value());
     std::vector<std::uint8_t> out(max_frame_size);

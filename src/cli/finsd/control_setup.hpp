@@ -43,8 +43,7 @@ std::vector<std::filesystem::path> default_control_sockets();
 // Makes `dir` ready to hold a control socket: created with `mode` when missing, then it
 // must be a directory (not a symbolic link) owned by `owner` that no one else may write
 // to (and, for `mode` 0700, not read either). An empty string when it is; why not else.
-std::string prepare_socket_directory(const std::filesystem::path& dir, mode_t mode,
-                                     uid_t owner);
+std::string prepare_socket_directory(const std::filesystem::path& dir, mode_t mode, uid_t owner);
 
 // The line `finsd ctl` prints after "cannot connect": how to start finsd with a channel.
 std::string control_channel_hint();
