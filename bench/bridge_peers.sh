@@ -70,25 +70,7 @@ stop_pid() {
 }
 trap cleanup EXIT
 
-# A loopback port free for TCP and UDP both (finsd takes both).
-free_port() {
-  /usr/bin/python3 -c 'import socket
-while True:
-    t = socket.socket(); t.bind(("127.0.0.1", 0)); p = t.getsockname()[1]
-    u = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-    try:
-        u.bind(("127.0.0.1", p)); print(p); break
-    except OSError: pass
-    finally: u.close(); t.close()'
-}
-# wait_for SECONDS COMMAND...: until COMMAND succeeds, at most SECONDS (tenths polled).
-wait_for() {
-  local deadline=$((SECONDS + $1)); shift
-  until "$@" >/dev/null 2>&1; do
-    ((SECONDS < deadline)) || return 1
-    sleep 0.1
-  done
-}
+source "$root/tests/scripts/round_trip_lib.sh"  # free_port, wait_for
 tcp_open() { (exec 3<>"/dev/tcp/127.0.0.1/$1") 2>/dev/null; }
 unit_ip() { echo "127.0.$((net3 + $1 / 250)).$((1 + $1 % 250))"; }
 

@@ -8,16 +8,9 @@
 set -euo pipefail
 bin=$1
 read -r -a emu <<<"${FINS_EMULATOR:-}"
-work=$(mktemp -d)
-pids=()
-cleanup() {
-  for pid in "${pids[@]}"; do kill "$pid" 2>/dev/null || true; done
-  for pid in "${pids[@]}"; do wait "$pid" 2>/dev/null || true; done
-  rm -rf "$work"
-}
-trap cleanup EXIT
+source "$(dirname "$0")/round_trip_lib.sh"  # free_port, wait_for, round_trip_workdir
+round_trip_workdir
 fail() { echo "cross round trip: $*" >&2; for f in "$work"/*.log; do echo "== $f"; tail -n 20 "$f"; done >&2; exit 1; }
-source "$(dirname "$0")/round_trip_lib.sh"  # free_port, wait_for
 run() { "${emu[@]}" "$bin/$1" "${@:2}"; }
 
 fins_port=$(free_port)

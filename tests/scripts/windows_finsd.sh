@@ -15,16 +15,9 @@ host_bin=$2
 wine=/usr/lib/wine/wine64
 [[ -x "$host_bin/fins" ]] || { echo "windows finsd: no host fins in $host_bin" >&2; exit 1; }
 [[ -f "$bin/finsd.exe" ]] || { echo "windows finsd: no finsd.exe in $bin" >&2; exit 1; }
-work=$(mktemp -d)
-pids=()
-cleanup() {
-  for pid in "${pids[@]}"; do kill "$pid" 2>/dev/null || true; done
-  for pid in "${pids[@]}"; do wait "$pid" 2>/dev/null || true; done
-  rm -rf "$work"
-}
-trap cleanup EXIT
+source "$(dirname "$0")/round_trip_lib.sh"  # free_port, wait_for, round_trip_workdir
+round_trip_workdir
 fail() { echo "windows finsd: $*" >&2; tail -n 20 "$work"/finsd*.log >&2 || true; exit 1; }
-source "$(dirname "$0")/round_trip_lib.sh"  # free_port, wait_for
 fins() { "$host_bin/fins" --host 127.0.0.1 --port "$port" "$@"; }
 values() { fins "$@" --json | grep -o '"values":\[[^]]*\]'; }
 passed=0

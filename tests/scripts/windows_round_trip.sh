@@ -9,16 +9,9 @@ bin=$1
 host_bin=$2
 wine=/usr/lib/wine/wine64
 [[ -x "$host_bin/finsd" ]] || { echo "windows round trip: no host finsd in $host_bin" >&2; exit 1; }
-work=$(mktemp -d)
-pids=()
-cleanup() {
-  for pid in "${pids[@]}"; do kill "$pid" 2>/dev/null || true; done
-  for pid in "${pids[@]}"; do wait "$pid" 2>/dev/null || true; done
-  rm -rf "$work"
-}
-trap cleanup EXIT
+source "$(dirname "$0")/round_trip_lib.sh"  # free_port, wait_for, round_trip_workdir
+round_trip_workdir
 fail() { echo "windows round trip: $*" >&2; tail -n 20 "$work/finsd.log" >&2 || true; exit 1; }
-source "$(dirname "$0")/round_trip_lib.sh"  # free_port, wait_for
 # wine's console output ends lines with CR LF: compare without the CR.
 fins() { "$wine" "$bin/fins.exe" --host 127.0.0.1 --port "$port" "$@" | tr -d '\r'; }
 
