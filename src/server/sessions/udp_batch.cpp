@@ -145,6 +145,17 @@ namespace {
 // The destination address of a received datagram as the control message a reply carries
 // to leave from it (interface 0 unless IPv6 needs it for a link-local address): its
 // length, 0 when the datagram came without one.
+// One control message of `level`/`type` carrying `value`, written at `out`: its length.
+template <typename T>
+std::size_t put_control(std::uint8_t* out, int level, int type, const T& value) noexcept {
+    auto* c = reinterpret_cast<cmsghdr*>(out);
+    c->cmsg_level = level;
+    c->cmsg_type = type;
+    c->cmsg_len = CMSG_LEN(sizeof value);
+    std::memcpy(CMSG_DATA(c), &value, sizeof value);
+    return CMSG_SPACE(sizeof value);
+}
+
 std::size_t reply_control(const msghdr& received, std::uint8_t* out) noexcept {
     for (cmsghdr* c = CMSG_FIRSTHDR(&received); c != nullptr;
          c = CMSG_NXTHDR(const_cast<msghdr*>(&received), c)) {
@@ -155,24 +166,14 @@ std::size_t reply_control(const msghdr& received, std::uint8_t* out) noexcept {
             // interface's own address (never 255.255.255.255).
             in_pktinfo reply{};
             reply.ipi_spec_dst = got.ipi_spec_dst;
-            auto* r = reinterpret_cast<cmsghdr*>(out);
-            r->cmsg_level = IPPROTO_IP;
-            r->cmsg_type = IP_PKTINFO;
-            r->cmsg_len = CMSG_LEN(sizeof reply);
-            std::memcpy(CMSG_DATA(r), &reply, sizeof reply);
-            return CMSG_SPACE(sizeof reply);
+            return put_control(out, IPPROTO_IP, IP_PKTINFO, reply);
         }
         if (c->cmsg_level == IPPROTO_IPV6 && c->cmsg_type == IPV6_PKTINFO) {
             in6_pktinfo reply{};
             std::memcpy(&reply, CMSG_DATA(c), sizeof reply);
             if (IN6_IS_ADDR_MULTICAST(&reply.ipi6_addr)) return 0;  // the route's choice
             if (!IN6_IS_ADDR_LINKLOCAL(&reply.ipi6_addr)) reply.ipi6_ifindex = 0;
-            auto* r = reinterpret_cast<cmsghdr*>(out);
-            r->cmsg_level = IPPROTO_IPV6;
-            r->cmsg_type = IPV6_PKTINFO;
-            r->cmsg_len = CMSG_LEN(sizeof reply);
-            std::memcpy(CMSG_DATA(r), &reply, sizeof reply);
-            return CMSG_SPACE(sizeof reply);
+            return put_control(out, IPPROTO_IPV6, IPV6_PKTINFO, reply);
         }
     }
     return 0;
