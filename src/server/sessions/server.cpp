@@ -171,6 +171,67 @@ struct Server::Impl {
     std::optional<std::chrono::steady_clock::time_point> accept_logged;
 };
 
+namespace {
+
+// The TCP listener (into `acceptor`) and the UDP socket on one port number. With port 0 one
+// of them takes a free number and the other the same one; that number can be taken for the
+// other protocol (any client socket's ephemeral port comes from the same range), so a pair
+// is looked for again, a bounded number of times, before "address in use" is the answer.
+// The attempts alternate which protocol draws the number: Linux draws TCP listeners' from
+// half the range only (odd numbers), UDP's from all of it.
+bool bind_tcp(asio::ip::tcp::acceptor& acceptor, const asio::ip::address& ip, std::uint16_t& port,
+              boost::system::error_code& ec) {
+    boost::system::error_code ignored;
+    acceptor.close(ignored);
+    const asio::ip::tcp::endpoint ep{ip, port};
+    acceptor.open(ep.protocol(), ec);
+    if (!ec) acceptor.set_option(asio::socket_base::reuse_address(true), ec);
+    if (!ec) acceptor.bind(ep, ec);
+    if (!ec) acceptor.listen(asio::socket_base::max_listen_connections, ec);
+    if (!ec) port = acceptor.local_endpoint(ec).port();
+    return !ec;
+}
+
+bool bind_udp(asio::ip::udp::socket& socket, const asio::ip::address& ip, std::uint16_t& port,
+              boost::system::error_code& ec) {
+    boost::system::error_code ignored;
+    socket.close(ignored);
+    const asio::ip::udp::endpoint ep{ip, port};
+    socket.open(ep.protocol(), ec);
+    if (!ec) socket.bind(ep, ec);
+    if (!ec) port = socket.local_endpoint(ec).port();
+    return !ec;
+}
+
+std::optional<asio::ip::udp::socket> bind_listeners(asio::io_context& io,
+                                                    const asio::ip::address& ip,
+                                                    const ServerOptions& options,
+                                                    asio::ip::tcp::acceptor& acceptor,
+                                                    boost::system::error_code& ec) {
+    asio::ip::udp::socket udp{io};
+    if (!options.tcp || !options.udp) {
+        std::uint16_t port = options.port;
+        if (options.tcp) bind_tcp(acceptor, ip, port, ec);
+        if (options.udp && bind_udp(udp, ip, port, ec)) return udp;
+        return std::nullopt;
+    }
+    const int attempts = options.port == 0 ? 64 : 1;
+    for (int attempt = 0; attempt < attempts; ++attempt) {
+        std::uint16_t port = options.port;
+        const bool udp_first = attempt % 2 == 1;
+        const bool both = udp_first
+                              ? bind_udp(udp, ip, port, ec) && bind_tcp(acceptor, ip, port, ec)
+                              : bind_tcp(acceptor, ip, port, ec) && bind_udp(udp, ip, port, ec);
+        if (both) return udp;
+        if (ec != asio::error::address_in_use) break;
+    }
+    boost::system::error_code ignored;
+    acceptor.close(ignored);
+    return std::nullopt;
+}
+
+}  // namespace
+
 Result<std::unique_ptr<Server>> Server::start(asio::io_context& io, plc::Plc& plc,
                                               const ServerOptions& options) {
     boost::system::error_code ec;
@@ -182,25 +243,9 @@ Result<std::unique_ptr<Server>> Server::start(asio::io_context& io, plc::Plc& pl
     // The CPU Unit is on from here: its scan cycle runs whether anyone asks or not.
     plc.power_on(std::chrono::system_clock::now());
 
-    std::uint16_t port = options.port;
-    if (options.tcp) {
-        const asio::ip::tcp::endpoint ep{ip, port};
-        impl->acceptor.open(ep.protocol(), ec);
-        if (!ec) impl->acceptor.set_option(asio::socket_base::reuse_address(true), ec);
-        if (!ec) impl->acceptor.bind(ep, ec);
-        if (!ec) impl->acceptor.listen(asio::socket_base::max_listen_connections, ec);
-        if (ec) return Unexpected(ec);
-        // With port 0 the UDP socket takes the same number TCP was given.
-        port = impl->acceptor.local_endpoint().port();
-    }
-    if (options.udp) {
-        const asio::ip::udp::endpoint ep{ip, port};
-        asio::ip::udp::socket socket{io};
-        socket.open(ep.protocol(), ec);
-        if (!ec) socket.bind(ep, ec);
-        if (ec) return Unexpected(ec);
-        impl->udp = std::make_shared<UdpSession>(std::move(socket), impl->dispatcher);
-    }
+    auto udp = bind_listeners(io, ip, options, impl->acceptor, ec);
+    if (ec) return Unexpected(ec);
+    if (udp) impl->udp = std::make_shared<UdpSession>(std::move(*udp), impl->dispatcher);
     impl->transport =
         std::make_unique<UdpInstructionTransport>(impl->udp, ip, self, options.remotes);
     impl->transport->set_tcp_route([raw = impl.get()](std::uint8_t client, Bytes frame) {
