@@ -6,8 +6,8 @@
 # - the Serial Gateway: finsd.exe --serial scu1.1=COM6,network=5 relays FINS/UDP requests
 #   for network 5 as Host Link FINS to a Linux finsd on the other end (--serial cpu=...);
 #   a write through the gateway is read back from the Linux finsd over its own FINS/UDP;
-# - the client: fins.exe --serial COM7 reads and writes D200 of the same Linux finsd
-#   (its scu1.2 port in Host Link mode).
+# - the client: fins.exe --serial COM10 (two digits: opened as \\.\COM10) reads and
+#   writes D200 of the same Linux finsd (its scu1.2 port in Host Link mode).
 # Each COM port is a symlink $WINEPREFIX/dosdevices/comN -> /dev/pts/M (removed on exit).
 # Usage: windows_host_link.sh WINDOWS_BIN_DIR HOST_BIN_DIR (WINEPREFIX and WINEDEBUG from
 # ctest's environment). Every wait is for a condition, bounded in time; every process
@@ -65,7 +65,7 @@ pty_pair client  # fins.exe <-> the Linux finsd's scu1.2 port (Host Link)
 client_a=$pty_a client_b=$pty_b
 map_com 5 "$cpu_a"
 map_com 6 "$gateway_a"
-map_com 7 "$client_a"
+map_com 10 "$client_a"
 
 # The Linux finsd behind the gateway, and at the end of fins.exe's line.
 linux_port=$(free_port)
@@ -100,8 +100,8 @@ check gw write D101 55 >/dev/null
 check test "$(timeout 60 "$host_bin/fins" --port "$linux_port" read D100 2 --json | json_values)" \
   = '"values":[777,55]'
 
-# The client: fins.exe on COM7, Host Link to the Linux finsd's scu1.2 port.
-win_fins() { timeout 60 "$wine" "$bin/fins.exe" --serial COM7 "$@" | tr -d '\r'; }
+# The client: fins.exe on COM10, Host Link to the Linux finsd's scu1.2 port.
+win_fins() { timeout 60 "$wine" "$bin/fins.exe" --serial COM10 "$@" | tr -d '\r'; }
 check win_fins write D200 31337 >/dev/null
 check test "$(win_fins read D200 --json | json_values)" = '"values":[31337]'
 check test "$(timeout 60 "$host_bin/fins" --port "$linux_port" read D200 --json | json_values)" \
