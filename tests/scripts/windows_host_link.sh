@@ -7,7 +7,10 @@
 #   for network 5 as Host Link FINS to a Linux finsd on the other end (--serial cpu=...);
 #   a write through the gateway is read back from the Linux finsd over its own FINS/UDP;
 # - the client: fins.exe --serial COM10 (two digits: opened as \\.\COM10) reads and
-#   writes D200 of the same Linux finsd (its scu1.2 port in Host Link mode).
+#   writes D200 of the same Linux finsd (its scu1.2 port in Host Link mode); a COM port
+#   that is not mapped is "cannot open" with exit 3;
+# - a line that goes away (socat ended): the gateway answers 0205 (fins exit 4), the
+#   Host Link port logs "lost" and retries, and finsd.exe keeps answering FINS/UDP.
 # Each COM port is a symlink $WINEPREFIX/dosdevices/comN -> /dev/pts/M (removed on exit).
 # Usage: windows_host_link.sh WINDOWS_BIN_DIR HOST_BIN_DIR (WINEPREFIX and WINEDEBUG from
 # ctest's environment). Every wait is for a condition, bounded in time; every process
@@ -37,10 +40,12 @@ fail() {
 passed=0
 check() { if "$@"; then passed=$((passed + 1)); else fail "failed: $*"; fi; }
 
-# pty_pair NAME: a socat pty pair, its two devices in $pty_a and $pty_b.
+# pty_pair NAME: a socat pty pair, its two devices in $pty_a and $pty_b, socat's PID in
+# $pty_pid.
 pty_pair() {
   socat -d -d pty,raw,echo=0 pty,raw,echo=0 2>"$work/$1.socat.log" &
-  pids+=($!)
+  pty_pid=$!
+  pids+=("$pty_pid")
   wait_for 10 grep -q "starting data transfer loop" "$work/$1.socat.log" ||
     fail "socat made no pty pair ($1)"
   local ptys
@@ -58,9 +63,9 @@ map_com() {
 json_values() { grep -o '"values":\[[^]]*\]'; }
 
 pty_pair cpu  # finsd.exe's Host Link port <-> the Linux fins
-cpu_a=$pty_a cpu_b=$pty_b
+cpu_a=$pty_a cpu_b=$pty_b cpu_socat=$pty_pid
 pty_pair gateway  # finsd.exe's Serial Gateway port <-> the Linux finsd's cpu port
-gateway_a=$pty_a gateway_b=$pty_b
+gateway_a=$pty_a gateway_b=$pty_b gateway_socat=$pty_pid
 pty_pair client  # fins.exe <-> the Linux finsd's scu1.2 port (Host Link)
 client_a=$pty_a client_b=$pty_b
 map_com 5 "$cpu_a"
@@ -106,4 +111,25 @@ check win_fins write D200 31337 >/dev/null
 check test "$(win_fins read D200 --json | json_values)" = '"values":[31337]'
 check test "$(timeout 60 "$host_bin/fins" --port "$linux_port" read D200 --json | json_values)" \
   = '"values":[31337]'
+set +e
+missing=$(timeout 60 "$wine" "$bin/fins.exe" --serial COM9 read D200 2>&1 | tr -d '\r')
+rc=${PIPESTATUS[0]}
+set -e
+check test "$rc" -eq 3
+check grep -q "cannot open the serial line: COM9" <<<"$missing"
+
+# Lines that go away: socat ended, its ptys gone under finsd.exe's open COM ports.
+kill "$gateway_socat"
+wait "$gateway_socat" 2>/dev/null || true
+set +e
+gone=$(gw read D100 2>&1)
+rc=$?
+set -e
+check test "$rc" -eq 4
+check grep -q "0x0205" <<<"$gone"
+kill "$cpu_socat"
+wait "$cpu_socat" 2>/dev/null || true
+check wait_for 30 grep -q "serial cpu (COM5): lost" "$work/finsd-exe.log"
+check test "$(timeout 60 "$host_bin/fins" --port "$port" read D100 --json | json_values)" \
+  = '"values":[4242]'
 echo "windows host link: $passed checks passed"
