@@ -14,6 +14,8 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "web/subscriptions.hpp"
+
 namespace fins::cli {
 
 namespace {
@@ -26,7 +28,7 @@ std::optional<std::filesystem::path> from_environment(const char* name) {
 
 #ifdef _WIN32
 // Windows: the user's own %LOCALAPPDATA%\finskit (its ACL admits the user alone), the
-// socket there as on Linux's /tmp/finsd-UID.
+// channel file there as the socket is in Linux's /tmp/finsd-UID.
 std::pair<std::filesystem::path, mode_t> own_directory() {
     const auto local = from_environment("LOCALAPPDATA");
     return {(local ? *local : std::filesystem::temp_directory_path()) / "finskit", 0700};
@@ -101,10 +103,16 @@ std::string prepare_socket_directory(const std::filesystem::path& dir, mode_t mo
 #endif
 
 std::string control_channel_hint() {
+#ifdef _WIN32
+    return "start finsd with a control channel: `finsd --control PATH`, then "
+           "`finsd ctl --socket PATH ...` (or set FINSD_SOCKET=PATH for both); without them "
+           "both use %LOCALAPPDATA%\\finskit\\finsd.sock (the channel file: port and token)";
+#else
     return "start finsd with a control channel: `finsd --control PATH`, then "
            "`finsd ctl --socket PATH ...` (or set FINSD_SOCKET=PATH for both); without them "
            "both use $XDG_RUNTIME_DIR/finsd.sock, else /run/finsd/finsd.sock (root) or "
            "/tmp/finsd-UID/finsd.sock";
+#endif
 }
 
 ControlStart start_control(asio::io_context& io, std::vector<server::ControlTarget> targets,
@@ -123,7 +131,19 @@ ControlStart start_control(asio::io_context& io, std::vector<server::ControlTarg
             return out;
         }
     }
-    auto started = server::ControlServer::start(io, std::move(targets), out.path);
+    server::ControlOptions options;
+    if (options.transport == server::ControlTransport::loopback_tcp) {
+        // The loopback channel's secret (control_channel_file.hpp): the CSPRNG that names
+        // the web page's sessions.
+        try {
+            options.token = web::new_session_id();
+        } catch (const std::exception& e) {
+            out.exit_code = 3;
+            out.error = fmt::format("control channel: no random token: {}", e.what());
+            return out;
+        }
+    }
+    auto started = server::ControlServer::start(io, std::move(targets), out.path, options);
     if (started) {
         out.server = std::move(*started);
         spdlog::info("finsd: control channel on {}", out.path.string());

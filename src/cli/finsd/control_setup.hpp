@@ -13,6 +13,9 @@
 // A socket finsd cannot open at a path given by 1 or 2 stops it (exit 3); at the default
 // (3-5) finsd warns why and runs without a control channel (another finsd may hold it).
 // `finsd ctl` without --socket/FINSD_SOCKET tries 3 then 4 or 5, the first that exists.
+// Windows (docs/windows.md): the path names the loopback channel's file (`<port> <token>`,
+// server/control/control_channel_file.hpp), by default %LOCALAPPDATA%\finskit\finsd.sock;
+// start_control draws the token from web::new_session_id's CSPRNG.
 #pragma once
 
 #include <sys/types.h>

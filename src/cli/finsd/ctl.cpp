@@ -1,8 +1,9 @@
 // `finsd ctl [--socket PATH] [--plc NAME|NET.NODE] VERB ...` (options before or after the
 // verb): sends one request to a running finsd's control channel (server/control/control.hpp)
-// and prints the answer line. Without --socket: $FINSD_SOCKET, else the first of the default
-// places finsd itself uses that holds a socket (control_setup.hpp). --plc picks a CPU Unit of a
-// plant (default the first).
+// and prints the answer line (Windows: through the channel file's loopback port and token,
+// server/control/control_channel_file.hpp). Without --socket: $FINSD_SOCKET, else the first of the
+// default places finsd itself uses that holds a socket (control_setup.hpp). --plc picks a CPU Unit
+// of a plant (default the first).
 //
 //   status                          the JSON snapshot
 //   battery-error on|off            low battery (error 00F7) / battery replaced
@@ -34,10 +35,11 @@
 
 #ifdef _WIN32
 #include <boost/asio/io_context.hpp>
-#include <boost/asio/local/stream_protocol.hpp>
+#include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/read_until.hpp>
 #include <boost/asio/write.hpp>
 
+#include "server/control/control_channel_file.hpp"
 #include "transport/asio.hpp"
 #else
 #include <poll.h>
@@ -69,21 +71,31 @@ constexpr int answer_timeout_ms = 5000;
 constexpr std::size_t max_answer_size = 1 << 20;
 
 #ifdef _WIN32
-// Windows 10's AF_UNIX sockets through Asio (the same JSON lines as on Linux): the
-// connection is made, the request written, then the answer read on an io_context run
-// for at most the wait (no bound: until the answer or the end of the connection).
+// The loopback channel (server/control/control_channel_file.hpp): the port and token read
+// from the channel file, a TCP connection to 127.0.0.1, the token line, then the same
+// request line as on Linux. The answer is read on an io_context run for at most the wait
+// (no bound: until the answer or the end of the connection).
 std::optional<std::string> send_request(const std::string& path, const std::string& request,
                                         std::optional<std::chrono::milliseconds> wait) {
-    using stream = asio::local::stream_protocol;
-    asio::io_context io;
-    stream::socket s(io);
-    boost::system::error_code ec;
-    if (s.connect(stream::endpoint(path), ec); ec) {
-        std::fprintf(stderr, "finsd ctl: cannot connect to %s: %s\n%s\n", path.c_str(),
-                     ec.message().c_str(), control_channel_hint().c_str());
+    const auto channel = server::read_channel_file(path);
+    if (!channel) {
+        const auto why = channel.error() == std::make_error_code(std::errc::invalid_argument)
+                             ? std::string("not a finsd control channel file")
+                             : channel.error().message();
+        std::fprintf(stderr, "finsd ctl: cannot connect to %s: %s\n%s\n", path.c_str(), why.c_str(),
+                     control_channel_hint().c_str());
         return std::nullopt;
     }
-    if (asio::write(s, asio::buffer(request + "\n"), ec); ec) {
+    asio::io_context io;
+    asio::ip::tcp::socket s(io);
+    boost::system::error_code ec;
+    if (s.connect({asio::ip::address_v4::loopback(), channel->port}, ec); ec) {
+        std::fprintf(stderr, "finsd ctl: cannot connect to %s (127.0.0.1:%u): %s\n%s\n",
+                     path.c_str(), static_cast<unsigned>(channel->port), ec.message().c_str(),
+                     control_channel_hint().c_str());
+        return std::nullopt;
+    }
+    if (asio::write(s, asio::buffer(channel->token + "\n" + request + "\n"), ec); ec) {
         std::fprintf(stderr, "finsd ctl: send: %s\n", ec.message().c_str());
         return std::nullopt;
     }
@@ -285,12 +297,17 @@ int run_ctl(int argc, char** argv) {
     const bool raw_line = verbs.send->parsed() && !verbs.raw.empty();
     if (!plc.empty() && !raw_line) request["plc"] = plc;
     if (socket.empty()) {
-        // The first default place that holds a socket, else the first (control_setup.hpp).
+        // The first default place that holds a socket (Windows: a channel file), else the
+        // first (control_setup.hpp).
         const auto places = default_control_sockets();
         socket = places.front().string();
         for (const auto& place : places) {
             std::error_code ec;
+#ifdef _WIN32
+            if (std::filesystem::is_regular_file(place, ec)) {
+#else
             if (std::filesystem::is_socket(place, ec)) {
+#endif
                 socket = place.string();
                 break;
             }

@@ -6,7 +6,9 @@
 // completes (the next line is read only then, so answers stay in request order).
 // Anything else answers {"error":"..."} and the connection stays open. A line longer
 // than max_line_size answers an error and closes the connection. Every handler runs on
-// the server's io_context, so a Plc is touched by one thread only.
+// the server's io_context, so a Plc is touched by one thread only. One Session serves
+// both transports (a generic stream socket); on the loopback one it first reads the token
+// line (control_channel_file.hpp): a wrong or overlong one closes the connection unanswered.
 #include "server/control/control.hpp"
 
 #ifndef _WIN32
@@ -20,13 +22,17 @@
 #include <vector>
 
 #include <fmt/core.h>
+#include <boost/asio/generic/stream_protocol.hpp>
+#ifndef _WIN32
 #include <boost/asio/local/stream_protocol.hpp>
+#endif
 #include <boost/asio/read_until.hpp>
 #include <boost/asio/steady_timer.hpp>
 #include <boost/asio/streambuf.hpp>
 #include <boost/asio/write.hpp>
 #include <nlohmann/json.hpp>
 
+#include "server/control/control_channel_file.hpp"
 #include "server/control/control_dispatch.hpp"
 #include "server/control/control_requests.hpp"
 #include "server/sessions/failure_boundary.hpp"
@@ -37,7 +43,7 @@ namespace fins::server {
 namespace {
 
 using Json = nlohmann::json;
-using stream = asio::local::stream_protocol;
+using stream = asio::generic::stream_protocol;
 using Clock = std::chrono::steady_clock;
 
 // A SendCmd of 2,002 bytes is 4,004 hex digits plus its keys: room for it.
@@ -49,13 +55,24 @@ struct Shared {
     bool stopped = false;
 };
 
+// Compares every character whatever the first difference, so the time taken does not
+// tell a guesser how much of the token was right.
+bool same_token(const std::string& line, const std::string& token) {
+    if (line.size() != token.size()) return false;
+    unsigned char differ = 0;
+    for (std::size_t i = 0; i < token.size(); ++i)
+        differ = static_cast<unsigned char>(differ | (line[i] ^ token[i]));
+    return differ == 0;
+}
+
 class Session : public std::enable_shared_from_this<Session> {
   public:
     Session(stream::socket socket, std::shared_ptr<Shared> shared)
         : socket_(std::move(socket)),
           timer_(socket_.get_executor()),
           buffer_(max_line_size),
-          shared_(std::move(shared)) {}
+          shared_(std::move(shared)),
+          authenticated_(shared_->options.token.empty()) {}
 
     void start() { read(); }
     void close() {
@@ -68,6 +85,8 @@ class Session : public std::enable_shared_from_this<Session> {
     // Waiting for an instruction's answer: holds no slot.
     [[nodiscard]] bool waiting() const noexcept { return waiting_; }
     [[nodiscard]] Clock::time_point last_activity() const noexcept { return last_activity_; }
+    // Loopback: has sent the token (a Unix socket's clients always have).
+    [[nodiscard]] bool authenticated() const noexcept { return authenticated_; }
 
   private:
     void read() {
@@ -119,18 +138,34 @@ class Session : public std::enable_shared_from_this<Session> {
         timer_.cancel();
         last_activity_ = Clock::now();
         if (shared_->stopped || !open_) return;
+        if (!authenticated_) return on_token(ec, n);
         if (ec == asio::error::not_found) {  // the buffer is full and holds no newline
             return write(
                 control_error(fmt::format("request line longer than {} bytes", max_line_size)),
                 true);
         }
         if (ec) return close();
+        const std::string line = take_line(n);
+        serve(line);
+    }
+
+    // The n bytes read_until found, without their newline (nor a CR before it).
+    std::string take_line(std::size_t n) {
         const auto data = buffer_.data();
         std::string line(asio::buffers_begin(data),
                          asio::buffers_begin(data) + static_cast<std::ptrdiff_t>(n - 1));
         buffer_.consume(n);
         if (!line.empty() && line.back() == '\r') line.pop_back();
-        serve(line);
+        return line;
+    }
+
+    // The first line on the loopback channel: the token, or the end without a word.
+    void on_token(boost::system::error_code ec, std::size_t n) {
+        if (ec) return close();
+        const std::string line = take_line(n);
+        if (!same_token(line, shared_->options.token)) return close();
+        authenticated_ = true;
+        read();
     }
 
     void serve(const std::string& line) {
@@ -161,6 +196,7 @@ class Session : public std::enable_shared_from_this<Session> {
     asio::streambuf buffer_;
     std::shared_ptr<Shared> shared_;
     std::string reply_;
+    bool authenticated_;
     bool open_ = true;
     bool waiting_ = false;
     std::uint64_t generation_ = 0;
@@ -172,7 +208,9 @@ class Session : public std::enable_shared_from_this<Session> {
 struct ControlServer::Impl {
     Impl(asio::io_context& io, std::filesystem::path p) : acceptor(io), path(std::move(p)) {}
 
-    // Every slot taken by a client that waits for a line: the one idle longest goes.
+    // Every slot taken by a client that waits for a line: the one idle longest goes, one
+    // that has not sent the token before any that has (so connections that never send it
+    // cannot push out a client that did).
     void make_room() {
         std::erase_if(sessions, [](const auto& w) {
             const auto s = w.lock();
@@ -182,9 +220,11 @@ struct ControlServer::Impl {
         for (const auto& w : sessions)
             if (auto s = w.lock(); s != nullptr && !s->waiting()) holding.push_back(std::move(s));
         if (holding.size() < shared->options.max_connections || holding.empty()) return;
-        const auto oldest = std::min_element(
-            holding.begin(), holding.end(),
-            [](const auto& a, const auto& b) { return a->last_activity() < b->last_activity(); });
+        const auto oldest =
+            std::min_element(holding.begin(), holding.end(), [](const auto& a, const auto& b) {
+                if (a->authenticated() != b->authenticated()) return !a->authenticated();
+                return a->last_activity() < b->last_activity();
+            });
         (*oldest)->close();
     }
 
@@ -207,7 +247,7 @@ struct ControlServer::Impl {
             });
     }
 
-    stream::acceptor acceptor;
+    ControlAcceptor acceptor;
     std::filesystem::path path;
     std::shared_ptr<Shared> shared = std::make_shared<Shared>();
     std::vector<std::weak_ptr<Session>> sessions;
@@ -224,14 +264,13 @@ Result<std::unique_ptr<ControlServer>> ControlServer::start(asio::io_context& io
     return start(io, std::vector<ControlTarget>{std::move(target)}, path);
 }
 
-Result<std::unique_ptr<ControlServer>> ControlServer::start(asio::io_context& io,
-                                                            std::vector<ControlTarget> targets,
-                                                            const std::filesystem::path& path,
-                                                            ControlOptions options) {
-    if (targets.empty() || options.max_connections == 0)
-        return Unexpected(std::make_error_code(std::errc::invalid_argument));
-    // sockaddr_un holds at most 107 characters and a terminating NUL (108 on Linux and on
-    // Windows, whose AF_UNIX sockets the channel uses there too: docs/windows.md).
+#ifndef _WIN32
+namespace {
+
+// A Unix-domain socket at `path`, replacing a stale one (contract in control.hpp).
+Result<void> open_unix_channel(asio::io_context& io, ControlAcceptor& acceptor,
+                               const std::filesystem::path& path) {
+    // sockaddr_un holds at most 107 characters and a terminating NUL.
     constexpr std::size_t max_path = 107;
     const std::string name = path.string();
     if (path.empty() || name.size() > max_path)
@@ -240,32 +279,45 @@ Result<std::unique_ptr<ControlServer>> ControlServer::start(asio::io_context& io
     const auto st = std::filesystem::symlink_status(path, ec);
     if (std::filesystem::exists(st)) {
         // Replace a stale socket, never a regular file someone pointed us at by mistake,
-        // nor the socket of a finsd that still answers on it. (Windows shows a socket
-        // file as a reparse point, which the standard library does not call a socket.)
-#ifdef _WIN32
-        const bool socket_file =
-            !std::filesystem::is_regular_file(st) && !std::filesystem::is_directory(st);
-#else
-        const bool socket_file = std::filesystem::is_socket(st);
-#endif
-        if (!socket_file) return Unexpected(std::make_error_code(std::errc::file_exists));
-        stream::socket probe(io);
-        if (probe.connect(stream::endpoint(name), ec); !ec)
+        // nor the socket of a finsd that still answers on it.
+        if (!std::filesystem::is_socket(st))
+            return Unexpected(std::make_error_code(std::errc::file_exists));
+        asio::local::stream_protocol::socket probe(io);
+        if (probe.connect(asio::local::stream_protocol::endpoint(name), ec); !ec)
             return Unexpected(std::make_error_code(std::errc::address_in_use));
         std::filesystem::remove(path, ec);
     }
+    const stream::endpoint endpoint(asio::local::stream_protocol::endpoint{name});
+    if (acceptor.open(endpoint.protocol(), ec); ec) return Unexpected(ec);
+    if (acceptor.bind(endpoint, ec); ec) return Unexpected(ec);
+    ::chmod(path.c_str(), 0600);  // the channel changes the PLC: its owner only
+    if (acceptor.listen(asio::socket_base::max_listen_connections, ec); ec) return Unexpected(ec);
+    return {};
+}
+
+}  // namespace
+#endif
+
+Result<std::unique_ptr<ControlServer>> ControlServer::start(asio::io_context& io,
+                                                            std::vector<ControlTarget> targets,
+                                                            const std::filesystem::path& path,
+                                                            ControlOptions options) {
+    if (targets.empty() || options.max_connections == 0)
+        return Unexpected(std::make_error_code(std::errc::invalid_argument));
+    const bool loopback = options.transport == ControlTransport::loopback_tcp;
+    // A Unix socket's clients need no token (the socket's mode admits its owner only).
+    if (!loopback) options.token.clear();
     auto impl = std::make_unique<Impl>(io, path);
     impl->shared->targets = std::move(targets);
-    impl->shared->options = options;
-    const stream::endpoint endpoint(name);
-    if (impl->acceptor.open(endpoint.protocol(), ec); ec) return Unexpected(ec);
-    if (impl->acceptor.bind(endpoint, ec); ec) return Unexpected(ec);
-#ifndef _WIN32
-    ::chmod(path.c_str(), 0600);  // the channel changes the PLC: its owner only
+    impl->shared->options = std::move(options);
+    const auto& token = impl->shared->options.token;
+#ifdef _WIN32
+    const auto opened = open_loopback_channel(impl->acceptor, path, token);
+#else
+    const auto opened = loopback ? open_loopback_channel(impl->acceptor, path, token)
+                                 : open_unix_channel(io, impl->acceptor, path);
 #endif
-    // (Windows: the socket's directory is the user's own, %LOCALAPPDATA%\finskit.)
-    if (impl->acceptor.listen(asio::socket_base::max_listen_connections, ec); ec)
-        return Unexpected(ec);
+    if (!opened) return Unexpected(opened.error());  // (no stop: the path is left alone)
     impl->accept();
     return std::unique_ptr<ControlServer>(new ControlServer(std::move(impl)));
 }

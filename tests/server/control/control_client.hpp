@@ -1,7 +1,8 @@
-// A blocking client of the control channel with bounded waits, and scratch socket
-// paths (tests/server/control).
+// A blocking client of the control channel (Unix socket or loopback TCP) with bounded
+// waits, and scratch socket paths (tests/server/control).
 #pragma once
 
+#include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>
 #include <sys/un.h>
@@ -9,6 +10,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <string>
@@ -31,6 +33,15 @@ class ControlClient {
         sockaddr_un a{};
         a.sun_family = AF_UNIX;
         std::strncpy(a.sun_path, path.c_str(), sizeof a.sun_path - 1);
+        connected_ = ::connect(fd_, reinterpret_cast<const sockaddr*>(&a), sizeof a) == 0;
+    }
+    // The loopback channel's (control_channel_file.hpp): 127.0.0.1:port over TCP.
+    explicit ControlClient(std::uint16_t port) {
+        fd_ = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+        sockaddr_in a{};
+        a.sin_family = AF_INET;
+        a.sin_port = htons(port);
+        a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
         connected_ = ::connect(fd_, reinterpret_cast<const sockaddr*>(&a), sizeof a) == 0;
     }
     ~ControlClient() { ::close(fd_); }
