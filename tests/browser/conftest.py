@@ -7,8 +7,9 @@ Environment (set by ctest, see tests/CMakeLists.txt):
   FINS_ARTIFACTS_DIR  where screenshots go (default <bin>/../artifacts/screenshots)
   FINS_FINSD          (opt-in) the command that runs finsd instead of <bin>/finsd, split as
                       a shell would: "/usr/lib/wine/wine64 .../finsd.exe" in the Windows
-                      tree's windows_browser_page. That finsd gets no --control (Wine has no
-                      AF_UNIX sockets, docs/windows.md) and more time to start.
+                      tree's windows_browser_page. That finsd gets no --control (the tests'
+                      `finsd ctl` is the host's, a Unix socket; finsd.exe's channel is
+                      loopback TCP, docs/windows.md) and more time to start.
 """
 import json
 import os
