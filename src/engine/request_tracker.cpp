@@ -5,16 +5,17 @@
 
 namespace fins {
 
-RequestTracker::RequestTracker(FrameSink& sink, std::uint8_t gateway_count)
+RequestTracker::RequestTracker(FrameSink& sink, std::uint8_t gateway_count, std::size_t capacity)
     : sink_(sink),
       sids_(default_timeout * default_quarantine_timeouts),
+      capacity_(std::clamp<std::size_t>(capacity, 1, max_in_flight)),
       gateway_count_(gateway_count) {
     by_sid_.fill(none);
-    // Room for max_in_flight slots (about 2 KB each, the frame buffer), made as they are
+    // Room for `capacity` slots (about 2 KB each, the frame buffer), made as they are
     // first needed: a client that keeps a few requests in flight (fins-bridge's thousand,
     // `window` each) touches a few slots, not 540 KB. Reserved, so a slot never moves.
-    requests_.reserve(max_in_flight);
-    free_requests_.reserve(max_in_flight);
+    requests_.reserve(capacity_);
+    free_requests_.reserve(capacity_);
 }
 
 Header RequestTracker::make_header(std::uint8_t service_id, bool response_required,
@@ -50,7 +51,7 @@ Result<void> RequestTracker::submit(CommandCode command, Bytes parameters,
     if (header_size + command_code_size + parameters.size() > max_frame_)
         return Unexpected(make_error_code(ClientError::request_too_long));
     if (free_requests_.empty()) {
-        if (requests_.size() >= max_in_flight)
+        if (requests_.size() >= capacity_)
             return Unexpected(make_error_code(ClientError::too_many_in_flight));
         requests_.emplace_back();
         free_requests_.push_back(static_cast<std::uint16_t>(requests_.size() - 1));

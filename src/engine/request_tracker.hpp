@@ -8,10 +8,10 @@
 // - Service IDs (SID): see engine/sid_pool.hpp. A SID whose request was retransmitted,
 //   timed out or failed after it was sent is quarantined (ClientOptions::sid_quarantine,
 //   by default twice the timeout) so that no late answer can complete a later request;
-//   clean SIDs are reused least recently used first. Up to 256 requests are accepted at
-//   once; a request that finds no usable SID waits in a FIFO queue until
-//   one leaves quarantine; its clock starts when it is sent. The 257th request fails with
-//   ClientError::too_many_in_flight.
+//   clean SIDs are reused least recently used first. Up to 256 requests (the
+//   constructor's capacity) are accepted at once; a request that finds no usable SID
+//   waits in a FIFO queue until one leaves quarantine; its clock starts when it is sent.
+//   The 257th (capacity + 1st) request fails with ClientError::too_many_in_flight.
 // - The request frame is built once, at submit(), into a fixed per-request buffer (the
 //   SID and addresses are patched in when it is sent); no allocation per request besides
 //   the caller's Completion.
@@ -149,7 +149,10 @@ class RequestTracker {
 
     enum class Disposition { matched, stale, invalid };
 
-    explicit RequestTracker(FrameSink& sink, std::uint8_t gateway_count = default_gateway_count);
+    // `capacity`: the most requests accepted at once (at most max_in_flight; finsd's
+    // instructions: 32), the room reserved for their slots.
+    explicit RequestTracker(FrameSink& sink, std::uint8_t gateway_count = default_gateway_count,
+                            std::size_t capacity = max_in_flight);
     RequestTracker(const RequestTracker&) = delete;
     RequestTracker& operator=(const RequestTracker&) = delete;
 
@@ -256,6 +259,7 @@ class RequestTracker {
     std::uint8_t next_unanswered_sid_ = 0;
     std::chrono::nanoseconds smoothed_rtt_{0};  // of answers to first attempts
     std::size_t in_flight_ = 0;
+    std::size_t capacity_;
     std::size_t window_ = max_in_flight;
     std::size_t max_frame_ = max_frame_size;
     bool link_up_ = false;

@@ -155,7 +155,7 @@ struct NetworkInstructions::Link final : FrameSink, AnswerCheck {
     }
 
     NetworkInstructions& owner;
-    RequestTracker tracker{*this};
+    RequestTracker tracker{*this, default_gateway_count, max_instructions};
     asio::steady_timer timer;
     std::optional<SteadyTime> armed;
     std::uint64_t timer_generation = 0;
