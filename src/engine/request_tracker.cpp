@@ -131,7 +131,7 @@ void RequestTracker::link_up(const NodeAddress& destination, const NodeAddress& 
     link_up_ = true;
     sids_.reset();
     smoothed_rtt_ = {};
-    sids_.set_min_rest(min_clean_rest);
+    sids_.set_min_rest(rest_clean_ ? min_clean_rest : std::chrono::microseconds{0});
     pump(now);
 }
 
@@ -244,7 +244,7 @@ RequestTracker::Disposition RequestTracker::on_frame(Bytes frame, SteadyTime now
         return Disposition::invalid;
     }
     other_node_.reset();
-    if (requests_[index].transmissions == 1) {
+    if (rest_clean_ && requests_[index].transmissions == 1) {
         // Smoothed like TCP's SRTT (RFC 6298, gain 1/8); sets how long clean SIDs rest.
         const auto rtt = now - requests_[index].sent_at;
         smoothed_rtt_ =

@@ -213,6 +213,11 @@ class RequestTracker {
     // A clean SID rests rest_rtts round trips (at least min_clean_rest) before reuse.
     static constexpr int rest_rtts = 4;
     static constexpr std::chrono::microseconds min_clean_rest{500};
+    // Off: a clean SID is reused as soon as the least-recently-used order reaches it, with
+    // no rest (finsd's instructions: at most 32 in flight, so 224 other SIDs come first;
+    // a rest of 4 round trips made them wait for SIDs at 32 in flight). Takes effect at
+    // the next link_up().
+    void set_rest_clean_ids(bool rest) noexcept { rest_clean_ = rest; }
     [[nodiscard]] const SidPool& service_ids() const noexcept { return sids_; }
 
   private:
@@ -269,6 +274,7 @@ class RequestTracker {
     TrackerStats stats_;
     std::optional<NodeAddress> other_node_;
     bool exact_destination_ = false;
+    bool rest_clean_ = true;
 };
 
 }  // namespace fins

@@ -207,5 +207,31 @@ TEST_F(TrackerRoutes, NoResponseFramesTakeTheirOwnDestinationAndMayBeRefused) {
     EXPECT_EQ(tracker.stats().refused, 1u);
 }
 
+// finsd's instructions turn the clean-SID rest off (set_rest_clean_ids(false)): a SID
+// answered at once is used again as soon as the least-recently-used order reaches it;
+// with the rest (fins::Client's default) the 257th request at the same instant waits.
+TEST_F(TrackerRoutes, WithoutTheCleanRestAnAnsweredSidIsReusedAtOnce) {
+    const auto cycle = [&](RequestTracker& t, RouteWire& w) {
+        for (int i = 0; i < 257; ++i) {
+            Outcome o;
+            ASSERT_TRUE(t.submit(read_code, read_params, {}, o.callback(), t0).has_value());
+            if (t.waiting() > 0) return;
+            const auto& f = w.frames.back();
+            ASSERT_EQ(t.on_frame(answer(Bytes{f.data(), f.size()}), t0),
+                      RequestTracker::Disposition::matched);
+        }
+    };
+    cycle(tracker, wire);
+    EXPECT_EQ(tracker.stats().waited_for_id, 1u);
+    RouteWire other_wire;
+    RequestTracker no_rest{other_wire};
+    no_rest.set_rest_clean_ids(false);
+    no_rest.link_up(plc, host, t0);
+    cycle(no_rest, other_wire);
+    EXPECT_EQ(no_rest.stats().waited_for_id, 0u);
+    EXPECT_EQ(other_wire.frames.size(), 257u);
+    EXPECT_EQ(other_wire.frames.back()[9], other_wire.frames.front()[9]);
+}
+
 }  // namespace
 }  // namespace fins::test

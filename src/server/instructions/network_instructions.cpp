@@ -77,6 +77,9 @@ struct NetworkInstructions::Port {
 // its next deadline.
 struct NetworkInstructions::Link final : FrameSink, AnswerCheck {
     explicit Link(NetworkInstructions& o) : owner(o), timer(o.executor_) {
+        // As before the one engine: 32 instructions at most, so a clean SID comes round
+        // again after 224 others; no round-trip rest on top (it stalled 32 in flight).
+        tracker.set_rest_clean_ids(false);
         // Every request names its own destination and source (RequestOptions): the link's
         // addresses are never used.
         tracker.link_up(o.self_, o.self_, now());
