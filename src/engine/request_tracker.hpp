@@ -8,10 +8,10 @@
 // - Service IDs (SID): see engine/sid_pool.hpp. A SID whose request was retransmitted,
 //   timed out or failed after it was sent is quarantined (ClientOptions::sid_quarantine,
 //   by default twice the timeout) so that no late answer can complete a later request;
-//   clean SIDs are reused least recently used first. Up to 256 requests are accepted at
-//   once; a request that finds no usable SID waits in a FIFO queue until
-//   one leaves quarantine; its clock starts when it is sent. The 257th request fails with
-//   ClientError::too_many_in_flight.
+//   clean SIDs are reused least recently used first. Up to 256 requests (the
+//   constructor's capacity) are accepted at once; a request that finds no usable SID
+//   waits in a FIFO queue until one leaves quarantine; its clock starts when it is sent.
+//   The 257th (capacity + 1st) request fails with ClientError::too_many_in_flight.
 // - The request frame is built once, at submit(), into a fixed per-request buffer (the
 //   SID and addresses are patched in when it is sent); no allocation per request besides
 //   the caller's Completion.
@@ -40,6 +40,17 @@
 //   because a request may already have been executed by the PLC.
 // - Completions are never called from inside submit(). They are called after the slot is
 //   freed, so a completion may submit again; a completion must not destroy the tracker.
+// - Per request (RequestOptions; finsd's network instructions, which reach many nodes by
+//   many ways through one tracker): its own destination and source instead of the
+//   link's; a tag the sink and the answer check get back; its own SID quarantine. The
+//   sink may refuse a request's frame (FrameSink::send_request(): no route, connection
+//   not established, the kernel refused the last attempt): that request alone fails with
+//   the sink's error, at the next on_timer() (its deadline becomes `now`, so never inside
+//   submit()); a refused frame counts as not sent (it cannot be answered). The sink hears
+//   of every transmission that timed out (FrameSink::unanswered()). on_frame() may be
+//   given an AnswerCheck: it decides, instead of the address rule above, whether an
+//   answer with the SID and command code of a request in flight is that request's (the
+//   owner knows which way the frame went and how that way rewrote the addresses).
 #pragma once
 
 #include <array>
@@ -84,6 +95,17 @@ struct TrackerStats {
     std::uint64_t other_node_answers = 0;  // of those: a request's answer from another node
     std::uint64_t quarantined = 0;         // SIDs put into quarantine
     std::uint64_t waited_for_id = 0;       // requests that had to wait for a usable SID
+    std::uint64_t refused = 0;             // requests failed because the sink refused a frame
+};
+
+// Per-request options of submit() and submit_no_response() (see the contract above).
+struct RequestOptions {
+    std::optional<NodeAddress> destination;  // unset: the link's (link_up())
+    std::optional<NodeAddress> source;       // unset: the link's
+    // Handed back to FrameSink::send_request(), FrameSink::unanswered() and AnswerCheck.
+    std::uintptr_t tag = 0;
+    // This request's SID quarantine (engine/sid_pool.hpp); zero: the tracker's.
+    std::chrono::nanoseconds quarantine{0};
 };
 
 // Where frames go. send_frame() must copy the bytes (the slot buffer is reused) and
@@ -91,9 +113,32 @@ struct TrackerStats {
 class FrameSink {
   public:
     virtual void send_frame(Bytes frame) = 0;
+    // A request's frame (same rules as send_frame()), with its RequestOptions::tag;
+    // `last`: no retry follows if it goes unanswered. An error refuses the frame: the
+    // tracker fails that request alone with it. By default: send_frame(), never refused.
+    virtual std::error_code send_request(Bytes frame, std::uintptr_t tag, bool last) {
+        (void)tag;
+        (void)last;
+        send_frame(frame);
+        return {};
+    }
+    // A transmission of request `tag` got no answer within its timeout (called from
+    // on_timer() before the request is retried or failed; not for a refused frame).
+    virtual void unanswered(std::uintptr_t tag) { (void)tag; }
 
   protected:
     ~FrameSink() = default;
+};
+
+// The owner's check of an answer (see the contract above): true when `response`, which
+// has the SID and command code of the request tagged `tag` sent with header `request`,
+// is that request's answer. Must not call back into the tracker.
+class AnswerCheck {
+  public:
+    virtual bool answers(std::uintptr_t tag, const Header& request, const Header& response) = 0;
+
+  protected:
+    ~AnswerCheck() = default;
 };
 
 class RequestTracker {
@@ -104,7 +149,10 @@ class RequestTracker {
 
     enum class Disposition { matched, stale, invalid };
 
-    explicit RequestTracker(FrameSink& sink, std::uint8_t gateway_count = default_gateway_count);
+    // `capacity`: the most requests accepted at once (at most max_in_flight; finsd's
+    // instructions: 32), the room reserved for their slots.
+    explicit RequestTracker(FrameSink& sink, std::uint8_t gateway_count = default_gateway_count,
+                            std::size_t capacity = max_in_flight);
     RequestTracker(const RequestTracker&) = delete;
     RequestTracker& operator=(const RequestTracker&) = delete;
 
@@ -118,12 +166,15 @@ class RequestTracker {
     // too_many_in_flight, request_too_long or invalid_argument (retries > 15); `done` is
     // then left untouched (not moved from) and never called.
     Result<void> submit(CommandCode command, Bytes parameters, const RequestTiming& timing,
-                        Completion&& done, SteadyTime now);
+                        Completion&& done, SteadyTime now, const RequestOptions& options = {});
     // ICF bit 0 set: sends and forgets (no SID is reserved: nothing answers). Fails with
-    // not_connected while the link is down. Returns the SID put in the frame.
-    Result<std::uint8_t> submit_no_response(CommandCode command, Bytes parameters);
+    // not_connected while the link is down, or with the sink's error when it refuses the
+    // frame. Returns the SID put in the frame.
+    Result<std::uint8_t> submit_no_response(CommandCode command, Bytes parameters,
+                                            const RequestOptions& options = {});
 
-    Disposition on_frame(Bytes frame, SteadyTime now);
+    // `check`: the owner decides which answers match (see the contract above).
+    Disposition on_frame(Bytes frame, SteadyTime now, AnswerCheck* check = nullptr);
     // Retransmits or fails every request whose deadline is <= now, and sends queued
     // requests whose SID has left quarantine.
     void on_timer(SteadyTime now);
@@ -162,6 +213,11 @@ class RequestTracker {
     // A clean SID rests rest_rtts round trips (at least min_clean_rest) before reuse.
     static constexpr int rest_rtts = 4;
     static constexpr std::chrono::microseconds min_clean_rest{500};
+    // Off: a clean SID is reused as soon as the least-recently-used order reaches it, with
+    // no rest (finsd's instructions: at most 32 in flight, so 224 other SIDs come first;
+    // a rest of 4 round trips made them wait for SIDs at 32 in flight). Takes effect at
+    // the next link_up().
+    void set_rest_clean_ids(bool rest) noexcept { rest_clean_ = rest; }
     [[nodiscard]] const SidPool& service_ids() const noexcept { return sids_; }
 
   private:
@@ -178,12 +234,19 @@ class RequestTracker {
         SteadyTime deadline{};
         SteadyTime sent_at{};  // first transmission
         std::size_t size = 0;
+        std::uintptr_t tag = 0;
+        std::optional<NodeAddress> destination;  // own addresses (RequestOptions)
+        std::optional<NodeAddress> source;
+        std::chrono::nanoseconds quarantine{0};
+        std::error_code refused;  // the sink refused its frame: fails at the next on_timer()
         std::array<std::uint8_t, max_frame_size> frame{};
         Completion done;
     };
 
-    Header make_header(std::uint8_t service_id, bool response_required) const noexcept;
-    void transmit(Request& request);
+    Header make_header(std::uint8_t service_id, bool response_required,
+                       const RequestOptions& options) const noexcept;
+    // Hands the frame to the sink; a refusal marks the request (deadline `now`).
+    void transmit(Request& request, SteadyTime now);
     // Gives queued requests a SID, oldest first, and sends them; stops at the first that
     // finds none.
     void pump(SteadyTime now);
@@ -201,6 +264,7 @@ class RequestTracker {
     std::uint8_t next_unanswered_sid_ = 0;
     std::chrono::nanoseconds smoothed_rtt_{0};  // of answers to first attempts
     std::size_t in_flight_ = 0;
+    std::size_t capacity_;
     std::size_t window_ = max_in_flight;
     std::size_t max_frame_ = max_frame_size;
     bool link_up_ = false;
@@ -210,6 +274,7 @@ class RequestTracker {
     TrackerStats stats_;
     std::optional<NodeAddress> other_node_;
     bool exact_destination_ = false;
+    bool rest_clean_ = true;
 };
 
 }  // namespace fins

@@ -15,13 +15,19 @@
 // destination. Any other process can send a datagram to port 9600: a forged answer
 // is counted as unmatched and the instruction goes on waiting (then retries, 0205).
 //
-// Service IDs and retries: one rule with fins::Client (engine/request_tracker.hpp, W596
-// 3 Send/Rcv/SendCmd "Option"): a retry resends the identical frame with the same SID;
-// SIDs come from the engine's SidPool (engine/sid_pool.hpp): a SID whose instruction
-// got no answer to some transmission (timed out, retried, or ended by a send failure) is
-// quarantined for twice that instruction's timeout, clean SIDs are reused least recently
-// used first. A late answer to an ended instruction therefore never completes a later
-// one; it is counted as unmatched.
+// One engine with fins::Client (issue 27): the instructions run on the client's
+// RequestTracker (engine/request_tracker.hpp, W596 3 Send/Rcv/SendCmd "Option"), one per
+// node, each request with its own destination, this node as source and the port as
+// tag. It keeps the SIDs, timeouts and retries: a retry resends the identical frame with
+// the same SID; a SID whose instruction got no answer to some transmission (timed out or
+// retried) is quarantined for twice that instruction's timeout, clean SIDs are reused
+// least recently used first, so a late answer to an ended instruction never completes a
+// later one (it is counted as unmatched). When every free SID is quarantined (more than
+// 224 late answers pending) an instruction waits for one, its port busy, its clock not
+// started. A frame the transport refuses (no route, no port, connection not established,
+// or the kernel refused the last attempt) ends only that instruction and quarantines
+// nothing: it never left. This class keeps what is the node's own: ports and flags,
+// parameters, the frames' contents, the way an answer must come back (below), results.
 //
 // W596 3 parameters and limits:
 //   destination network 0-127, node 0-254 (255 = broadcast: Send/SendCmd only, no
@@ -58,7 +64,7 @@
 #include <boost/asio/ip/udp.hpp>
 #include <boost/asio/steady_timer.hpp>
 
-#include "engine/sid_pool.hpp"
+#include "engine/request_tracker.hpp"
 #include "fins/address.hpp"
 #include "fins/frame.hpp"
 #include "server/instructions/instruction_parameters.hpp"
@@ -149,17 +155,15 @@ class NetworkInstructions {
 
   private:
     struct Port;
-    void transmit(std::size_t port);
-    void arm(std::size_t port);
-    void on_timeout(std::size_t port, std::uint64_t generation);
+    // The tracker, its sink (the transport), its answer check (the route) and its timer.
+    struct Link;
+    // The tracker's completion of port `index`'s request.
+    void on_answer(std::size_t port, Result<ResponseView> answer);
+    // The result of a response that matched port `index`'s request.
+    InstructionResult result_of(std::size_t port, const ResponseView& view);
     void finish(std::size_t port, InstructionResult result);
     void complete_later(InstructionCallback done, InstructionResult result);
     void show_port(std::size_t port, bool busy, std::optional<std::uint16_t> completion);
-    // True when `h`, arrived by `from`, is the answer port `p`'s command asked for.
-    [[nodiscard]] bool answers(const Port& p, const Header& h,
-                               const InstructionRoute& from) const noexcept;
-    // Ends port `index`'s use of its SID (unanswered transmissions quarantine it).
-    void release_sid(Port& p, bool answered);
 
     asio::any_io_executor executor_;
     plc::Plc& plc_;
@@ -167,10 +171,8 @@ class NetworkInstructions {
     InstructionTransport& transport_;
     std::vector<std::unique_ptr<Port>> ports_;
     std::size_t in_flight_ = 0;
-    // The engine's SID pool (engine/sid_pool.hpp, the rule of fins::Client): a SID whose
-    // frame went unanswered is quarantined, so a late answer never completes a later
-    // instruction. Made on first use, like the ports.
-    std::unique_ptr<SidPool> sids_;
+    // Made on first use, like the ports (its request slots are made as needed too).
+    std::unique_ptr<Link> link_;
     bool flags_ = false;  // the profile shows ports in A202/A203-A210/A219
     Counters counters_;
     std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);

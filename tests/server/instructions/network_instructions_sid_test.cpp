@@ -64,6 +64,53 @@ TEST_F(Engine, W596_3_LateAnswerToATimedOutInstructionDoesNotCompleteALaterOne) 
     engine_.stop();
 }
 
+// Issue 27: the instructions run on the client's tracker, which tells the transport of
+// every transmission that went unanswered (a FINS/TCP client connection counts them),
+// retries included, and of none that was answered.
+TEST_F(Engine, Issue27_TheTransportHearsOfEveryUnansweredTransmission) {
+    std::optional<InstructionResult> result;
+    auto r = send(1);
+    r.options.retries = 2;
+    start(r, result);
+    wait(result);
+    EXPECT_EQ(result->error_id_ex, 0x0205);
+    ASSERT_EQ(transport_.unanswered_routes.size(), 3u);
+    for (const auto& way : transport_.unanswered_routes)
+        EXPECT_TRUE(way.same_way(transport_.route));
+    result.reset();
+    start(send(1), result);
+    EXPECT_TRUE(respond(answer(transport_.frames.back(), 0x0000)));
+    wait(result);
+    EXPECT_TRUE(result->done());
+    EXPECT_EQ(transport_.unanswered_routes.size(), 3u);
+}
+
+// Issue 27: a frame the transport refuses never left, so nothing can answer it late: its
+// SID is not quarantined and is the next instruction's again (before, it was
+// quarantined like a timed-out one).
+TEST_F(Engine, Issue27_ARefusedFrameDoesNotQuarantineItsSid) {
+    std::optional<InstructionResult> result;
+    transport_.answer = InstructionTransport::Sent::no_route;
+    auto r = send(1);
+    r.options.timeout = 600;  // a quarantine would last 120 s
+    start(r, result);
+    wait(result);
+    EXPECT_EQ(result->error_id_ex, 0x0501);
+    const auto refused_sid = transport_.frames[0][9];
+    transport_.answer = InstructionTransport::Sent::ok;
+    // Every other SID once (answered at once), then the refused one comes round again.
+    bool again = false;
+    for (int i = 0; i < 256 && !again; ++i) {
+        std::optional<InstructionResult> quick;
+        start(send(1), quick);
+        again = transport_.frames.back()[9] == refused_sid;
+        ASSERT_TRUE(respond(answer(transport_.frames.back(), 0x0000)));
+        poll();
+        ASSERT_TRUE(quick.has_value());
+    }
+    EXPECT_TRUE(again);
+}
+
 // W596 3 (no-response mode): nothing answers such a frame, so its SID is not quarantined;
 // a schedule sending many of them never runs out of SIDs.
 TEST_F(Engine, W596_3_NoResponseFramesDoNotUseUpServiceIds) {
