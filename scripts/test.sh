@@ -21,6 +21,26 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
 fuzz_seconds=${FINS_FUZZ_SECONDS:-20}
 soak_seconds=${FINS_SOAK_SECONDS:-20}
+# Each stage's wall time (bash's SECONDS), printed at the end and on any exit, so that a
+# CI log shows where its minutes went (docs/testing.md).
+stage_names=()
+stage_starts=()
+stage() {
+  echo "== $1 (at ${SECONDS} s)"
+  stage_names+=("$1")
+  stage_starts+=("$SECONDS")
+}
+stage_times() {
+  local i end
+  ((${#stage_names[@]})) || return 0
+  echo "== stage times (total ${SECONDS} s)"
+  for i in "${!stage_names[@]}"; do
+    end=${stage_starts[i + 1]:-$SECONDS}
+    printf '%6d s  %s\n' $((end - stage_starts[i])) "${stage_names[i]}"
+  done
+}
+trap stage_times EXIT
+stage "deps: Debian packages"
 "$root/scripts/deps.sh"
 
 summary=()
@@ -34,9 +54,9 @@ run_ctest() {  # DIR LABEL [CTEST OPTIONS...]
   rm -f "$log"
 }
 
-echo "== ASan+UBSan build"
+stage "ASan+UBSan build"
 "$root/scripts/build.sh" asan
-echo "== ASan+UBSan tests"
+stage "ASan+UBSan tests"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   run_ctest build-asan asan
 
@@ -44,9 +64,9 @@ ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:ha
 # fins-bridge processes they start, which inherit TSAN_OPTIONS) goes to a file under
 # $tsan_logs; any file there fails the stage, even from a process whose exit status no test
 # looks at. Suppressions: third-party code only (tests/tsan.supp says whose and why).
-echo "== TSan build (the multi-threaded tests)"
+stage "TSan build (the multi-threaded tests)"
 "$root/scripts/build.sh" tsan
-echo "== TSan tests"
+stage "TSan tests"
 tsan_logs=$(mktemp -d)
 tsan_ok=1
 TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$root/tests/tsan.supp:log_path=$tsan_logs/tsan" \
@@ -61,7 +81,7 @@ if ((!tsan_ok)); then
   printf '%s\n' "${summary[@]}"; exit 1
 fi
 
-echo "== soak (${soak_seconds}s, ASan+UBSan finsd)"
+stage "soak (${soak_seconds}s, ASan+UBSan finsd)"
 soak_log=$(mktemp)
 if "$root/scripts/soak.sh" asan --seconds "$soak_seconds" --interval 5 | tee "$soak_log"; then :; else
   summary+=("soak: FAILED"); rm -f "$soak_log"; printf '%s\n' "${summary[@]}"; exit 1
@@ -70,8 +90,9 @@ soak_ok=1
 summary+=("soak: $(grep -E '^soak: [0-9]+ s,' "$soak_log" | tail -n 1 | sed 's/^soak: //')")
 rm -f "$soak_log"
 
-echo "== fuzz (${fuzz_seconds}s per target)"
+stage "fuzz: build"
 "$root/scripts/build.sh" fuzz
+stage "fuzz: ${fuzz_seconds}s per target"
 # A libFuzzer run uses one core: as many run at once as there are cores (each still for
 # $fuzz_seconds), so the stage takes 17 x 20 s / 2 rather than 17 x 20 s on CI's 2 cores.
 fuzz_dir=$(mktemp -d)
@@ -105,10 +126,11 @@ summary+=("fuzz: $fuzz_ok targets ran clean")
 
 # ---- issue 28: Linux arm64 (docs/platforms.md). The cross tree's unit tests and a
 # finsd/fins/fins-bridge round trip under qemu-aarch64, then its .debs, checked.
-echo "== arm64: cross build, tests under qemu-user"
+stage "arm64: cross build"
 "$root/scripts/build.sh" arm64
+stage "arm64: tests under qemu-user"
 run_ctest build-arm64 arm64
-echo "== arm64: packages"
+stage "arm64: packages"
 "$root/scripts/package.sh" arm64
 log=$(mktemp)
 "$root/scripts/package_check_arm64.sh" "$root"/build-arm64/*.deb | tee "$log"
@@ -118,10 +140,11 @@ rm -f "$log"
 
 # ---- issue 28: Windows (docs/windows.md). The MinGW-w64 tree's unit tests and fins.exe
 # against the ASan finsd under wine, then the zip, checked (a CMake project built against it).
-echo "== windows: cross build, tests under wine"
+stage "windows: cross build"
 "$root/scripts/build.sh" windows
+stage "windows: tests under wine"
 run_ctest build-windows windows
-echo "== windows: zip"
+stage "windows: zip"
 "$root/scripts/package.sh" windows
 log=$(mktemp)
 "$root/scripts/package_check_windows.sh" "$root"/build-windows/finskit-*-windows-x86_64.zip \
@@ -135,22 +158,22 @@ rm -f "$log"
 # (Doxygen, warnings as errors); consumers built against it installed in a temporary
 # prefix (CMake and pkg-config); the Python tests; the .deb installed, exercised and
 # purged (root only, as on CI).
-echo "== package: Release build, API reference, .deb"
+stage "package: Release build, API reference, .deb"
 "$root/scripts/package.sh"
 package_passed=0
-echo "== package: consumers against the installed libfins"
+stage "package: consumers against the installed libfins"
 log=$(mktemp)
 "$root/scripts/consumers.sh" "$root/build-pkg" | tee "$log"
 n=$(grep -Eo 'consumers: [0-9]+ checks passed' "$log" | grep -Eo '[0-9]+')
 summary+=("consumers: $n checks passed"); package_passed=$((package_passed + n))
-echo "== package: Python tests (pytest)"
+stage "package: Python tests (pytest)"
 python=$(sed -n 's/^Python3_EXECUTABLE:[A-Z]*=//p' "$root/build-pkg/CMakeCache.txt")
 PYTHONDONTWRITEBYTECODE=1 PYTHONPATH="$root/build-pkg/python" "${python:-python3}" -m pytest -q -p no:cacheprovider \
   "$root/python/tests" | tee "$log"
 n=$(grep -Eo '[0-9]+ passed' "$log" | tail -n 1 | grep -Eo '[0-9]+')
 summary+=("python: $n passed"); package_passed=$((package_passed + n))
 if [[ $(id -u) -eq 0 ]]; then
-  echo "== package: install, run and purge the .deb"
+  stage "package: install, run and purge the .deb"
   "$root/scripts/package_test.sh" "$root"/build-pkg/*.deb | tee "$log"
   n=$(grep -Eo 'package: [0-9]+ checks passed' "$log" | grep -Eo '[0-9]+')
   summary+=("deb: $n checks passed"); package_passed=$((package_passed + n))

@@ -119,6 +119,10 @@ void Bridge::stop() {
     if (mqtt_) mqtt_->stop(format_->bridge_status(false));
 }
 
+bool Bridge::looking_up() const noexcept {
+    return (mqtt_ && mqtt_->looking_up()) || (session_ && session_->looking_up());
+}
+
 void Bridge::reconcile() {
     if (stopped_) return;
     for (auto& [name, p] : pollers_) {

@@ -66,6 +66,8 @@ class Bridge final : public PollerEvents {
     bool start(std::string& error);
     // Stops polling, publishes the offline status and disconnects.
     void stop();
+    // A broker's name is being looked up (MqttClient::looking_up()).
+    [[nodiscard]] bool looking_up() const noexcept;
     // Starts polling owned PLCs that are not polled and stops the others.
     void reconcile();
 

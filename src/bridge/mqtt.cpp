@@ -10,6 +10,7 @@
 #include <random>
 
 #include <spdlog/spdlog.h>
+#include <boost/asio/post.hpp>
 
 namespace fins::bridge {
 
@@ -38,6 +39,7 @@ MqttClient::MqttClient(asio::io_context& io, const Mqtt& config, Message will, M
       persistent_(persistent),
       misc_timer_(io),
       retry_timer_(io),
+      resolver_(io),
       backoff_(config.backoff_min, config.backoff_max, seed()) {}
 
 MqttClient::~MqttClient() {
@@ -91,6 +93,48 @@ void MqttClient::connect() {
     retrying_ = false;
     if (closing_) return;
     const Broker& b = config_.brokers[broker_ % config_.brokers.size()];
+    boost::system::error_code ec;
+    (void)asio::ip::make_address(b.host, ec);
+    untried_.clear();
+    if (!ec) return connect_to(b.host, b.port);  // an address: nothing to look up
+    const auto attempt = ++resolving_;
+    looking_up_ = true;
+    resolver_.async_resolve(
+        b.host, std::to_string(b.port), asio::ip::tcp::resolver::numeric_service,
+        [this, alive = std::weak_ptr<int>(alive_), attempt, host = b.host, port = b.port](
+            boost::system::error_code error, const asio::ip::tcp::resolver::results_type& found) {
+            if (alive.expired()) return;
+            if (attempt == resolving_) looking_up_ = false;
+            if (closing_ || attempt != resolving_) return;
+            if (error || found.empty()) {
+                spdlog::warn("MQTT broker {}:{}: {}", host, port,
+                             error ? error.message() : "the name has no address");
+                lost();  // a failed attempt: the next broker after the backoff
+                return;
+            }
+            // TLS checks the broker's certificate against the name (and sends it as SNI).
+            untried_.clear();
+            if (!config_.ca_file.empty()) {
+                untried_.push_back(host);
+            } else {
+                for (const auto& entry : found) {
+                    auto address = entry.endpoint().address().to_string();
+                    if (std::find(untried_.begin(), untried_.end(), address) == untried_.end())
+                        untried_.push_back(std::move(address));
+                }
+            }
+            std::reverse(untried_.begin(), untried_.end());  // taken from the back
+            next_address(port);
+        });
+}
+
+void MqttClient::next_address(std::uint16_t port) {
+    auto host = std::move(untried_.back());
+    untried_.pop_back();
+    connect_to(host, port);
+}
+
+void MqttClient::connect_to(const std::string& host, std::uint16_t port) {
     accepted_ = false;
     if (handlers_.will && will_sent_) {
         will_ = handlers_.will();
@@ -102,10 +146,10 @@ void MqttClient::connect() {
     // The old socket (if any) is closed by libmosquitto here and the new one may get its
     // number: stop watching it first.
     unwrap();
-    const int rc = mosquitto_connect_async(mosq_, b.host.c_str(), b.port,
+    const int rc = mosquitto_connect_async(mosq_, host.c_str(), port,
                                            static_cast<int>(config_.keepalive.count()));
     if (rc != MOSQ_ERR_SUCCESS)
-        spdlog::warn("MQTT broker {}:{}: {}", b.host, b.port, mosquitto_strerror(rc));
+        spdlog::warn("MQTT broker {}:{}: {}", host, port, mosquitto_strerror(rc));
     sync();
 }
 
@@ -226,6 +270,18 @@ void MqttClient::lost() {
     queued_ = 0;  // what libmosquitto held for the lost connection is gone
     const bool was_accepted = accepted_;
     accepted_ = false;
+    if (!was_accepted && !untried_.empty()) {
+        // The same broker's next address, at once (after this call returns).
+        retrying_ = true;
+        asio::post(io_, [this, alive = std::weak_ptr<int>(alive_)] {
+            if (alive.expired() || closing_) return;
+            retrying_ = false;
+            if (untried_.empty()) return connect();
+            next_address(config_.brokers[broker_ % config_.brokers.size()].port);
+        });
+        return;
+    }
+    untried_.clear();
     if (was_accepted) {
         backoff_.reset();  // a lost session: the same broker first
     } else {
@@ -244,6 +300,7 @@ void MqttClient::stop(const Message& last) {
     if (closing_ || mosq_ == nullptr) return;
     closing_ = true;
     retry_timer_.cancel();
+    resolver_.cancel();
     misc_timer_.cancel();
     unwrap();  // from here on the socket is driven below, bounded in time
     if (connected_) {

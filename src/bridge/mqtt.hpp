@@ -19,10 +19,17 @@
 //   is lost for good.
 // - incoming: commands are passed to the handler as they are read.
 // Connection: the brokers are tried in turn (mosquitto_connect_async: the TCP connect does
-// not block); after a failure or a lost connection the next attempt waits uniform(0,
-// min(backoff_max, backoff_min x 2^n)) (full jitter, n reset by an accepted connection). The
-// Will is the bridge's offline status. Every CONNECT attempt has a generation number; the
-// connected handler gets the generation of the connection it belongs to.
+// not block). A broker given by name is resolved first on Asio's resolver (getaddrinfo off
+// this thread, as fins::Client resolves a PLC): a name that does not resolve, or a DNS
+// server that does not answer, is a failed attempt that never holds up the pollers.
+// Without TLS libmosquitto then gets the addresses one at a time (the next when an attempt
+// fails before CONNACK, as libmosquitto itself would try them), so it looks up nothing.
+// With TLS it gets
+// the name, which its certificate check and SNI need, and looks it up once more itself
+// (blocking, but just after the same lookup succeeded). After a failure or a lost connection the
+// next attempt waits uniform(0, min(backoff_max, backoff_min x 2^n)) (full jitter, n reset by an
+// accepted connection). The Will is the bridge's offline status. Every CONNECT attempt has a
+// generation number; the connected handler gets the generation of the connection it belongs to.
 // Session: a persistent client (clean_session = false, `persistent`) keeps its
 // subscriptions on the broker while it is away, and the broker queues the QoS 1 messages
 // published to them meanwhile and delivers them on the next CONNECT with the same client id
@@ -40,6 +47,7 @@
 #include <vector>
 
 #include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/posix/stream_descriptor.hpp>
 #include <boost/asio/steady_timer.hpp>
 
@@ -98,6 +106,9 @@ class MqttClient {
     [[nodiscard]] bool connected() const noexcept { return connected_; }
     // The CONNECT attempt the client is on (1 for the first).
     [[nodiscard]] std::uint64_t generation() const noexcept { return generation_; }
+    // A lookup of the broker's name is under way on Asio's resolver thread (which the
+    // io_context's destructor joins: getaddrinfo cannot be interrupted).
+    [[nodiscard]] bool looking_up() const noexcept { return looking_up_; }
     [[nodiscard]] MqttStats stats() const noexcept {
         return {published_, dropped_, connects_, received_};
     }
@@ -107,7 +118,12 @@ class MqttClient {
     static void on_disconnect(mosquitto*, void* self, int rc);
     static void on_publish(mosquitto*, void* self, int mid);
     static void on_message(mosquitto*, void* self, const ::mosquitto_message* m);
+    // The next attempt: resolves the broker's name (connect_to() follows).
     void connect();
+    // mosquitto_connect_async to `host` (the broker's address, or its name with TLS).
+    void connect_to(const std::string& host, std::uint16_t port);
+    // connect_to() the next of untried_ (not empty).
+    void next_address(std::uint16_t port);
     // After every libmosquitto call: follows its socket (wrapped again when it changed, a
     // lost connection when it is gone) and waits for what it needs.
     void sync();
@@ -136,6 +152,11 @@ class MqttClient {
     bool retrying_ = false;    // between a failed/lost connection and the next attempt
     asio::steady_timer misc_timer_;
     asio::steady_timer retry_timer_;
+    asio::ip::tcp::resolver resolver_;
+    std::uint64_t resolving_ = 0;  // the attempt a resolution belongs to (0: none)
+    bool looking_up_ = false;
+    // The current broker's addresses (or its name, with TLS) not tried yet in this attempt.
+    std::vector<std::string> untried_;
     Backoff backoff_;
     std::shared_ptr<int> alive_ = std::make_shared<int>(0);  // for handlers that outlive this
     std::size_t broker_ = 0;

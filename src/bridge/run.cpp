@@ -1,6 +1,8 @@
 #include "bridge/run.hpp"
 
 #include <csignal>
+#include <cstdio>
+#include <cstdlib>
 
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
@@ -48,6 +50,15 @@ int run(const BridgeConfig& given, const std::string& log_level) {
     spdlog::info("fins-bridge {} polling {} PLCs", config.instance, config.plcs.size());
     io.run();
     bridge.stop();
+    if (bridge.looking_up()) {
+        // The goodbye is done. What is left is a broker name's lookup that a DNS server does
+        // not answer: the io_context's destructor would wait for it (the system resolver's
+        // own timeout, up to 30 s per attempt). Nothing else is pending: end here.
+        spdlog::warn("fins-bridge: not waiting for the lookup of a broker's name");
+        spdlog::shutdown();
+        std::fflush(nullptr);
+        std::_Exit(0);
+    }
     return 0;
 }
 

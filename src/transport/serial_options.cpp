@@ -85,7 +85,8 @@ tl::expected<SerialSpec, std::string> parse_serial_spec(std::string_view text, S
     const auto comma = text.find(',');
     spec.line.device = std::string(text.substr(0, comma));
     if (spec.line.device.empty())
-        return tl::unexpected(std::string("no serial device (e.g. /dev/ttyUSB0,baud=9600)"));
+        return tl::unexpected(
+            fmt::format("no serial device (e.g. {},baud=9600)", example_serial_device));
     std::string_view rest =
         comma == std::string_view::npos ? std::string_view{} : text.substr(comma + 1);
     while (comma != std::string_view::npos) {

@@ -29,6 +29,13 @@ enum class SerialKeys {
     port,  // also unit, mode, timeout, network (finsd --serial)
 };
 
+// The device the error messages give as an example: a COM port on Windows.
+#ifdef _WIN32
+inline constexpr std::string_view example_serial_device = "COM3";
+#else
+inline constexpr std::string_view example_serial_device = "/dev/ttyUSB0";
+#endif
+
 // Baud rates accepted (the CS/CJ serial ports' 300 .. 230,400 bit/s).
 bool valid_baud(unsigned baud) noexcept;
 

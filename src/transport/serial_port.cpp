@@ -11,6 +11,21 @@
 #include <cerrno>
 
 namespace fins::transport {
+namespace {
+
+#ifdef _WIN32
+constexpr int refused_setting = ERROR_INVALID_PARAMETER;
+
+// Wine's ntdll exports wine_get_version (Wine's documented way for a program to tell).
+bool under_wine() noexcept {
+    const HMODULE ntdll = ::GetModuleHandleW(L"ntdll.dll");
+    return ntdll != nullptr && ::GetProcAddress(ntdll, "wine_get_version") != nullptr;
+}
+#else
+constexpr int refused_setting = EINVAL;
+#endif
+
+}  // namespace
 
 boost::system::error_code SerialPort::open(const SerialSettings& line) {
     close();
@@ -29,7 +44,9 @@ boost::system::error_code SerialPort::open(const SerialSettings& line) {
         port_.set_option(serial_port_base::character_size(line.data_bits), ec);
         // Linux ptys (socat) refuse 7 data bits (EINVAL); they have no line, and Host Link
         // characters are 7-bit ASCII, so the 8-bit bytes of a pty carry them unchanged.
-        if (ec.value() == EINVAL && is_pseudo_terminal()) ec.clear();
+        // Under Wine a COM port mapped onto a pty gets the same refusal through
+        // SetCommState (ERROR_INVALID_PARAMETER).
+        if (ec.value() == refused_setting && is_pseudo_terminal()) ec.clear();
     }
     if (!ec) port_.set_option(serial_port_base::parity(parity), ec);
     if (!ec) port_.set_option(serial_port_base::stop_bits(stop), ec);
@@ -45,7 +62,10 @@ boost::system::error_code SerialPort::open(const SerialSettings& line) {
 
 bool SerialPort::is_pseudo_terminal() noexcept {
 #ifdef _WIN32
-    return false;  // COM ports, real or (Wine, com0com) mapped: no pty rule to bend
+    // Windows' own COM ports (and com0com's virtual pairs) take 7 data bits: no pty rule
+    // to bend. Wine maps a COM port onto a Unix tty (a dosdevices symlink); a real UART
+    // there takes 7 data bits too, so one that refuses them is a pty.
+    return port_.is_open() && under_wine();
 #else
     struct stat st {};
     if (!port_.is_open() || ::fstat(port_.native_handle(), &st) != 0) return false;

@@ -27,7 +27,8 @@ class SerialPort {
     // Discards what the kernel holds unread or unsent (TCIOFLUSH).
     void flush() noexcept;
     [[nodiscard]] asio::serial_port& port() noexcept { return port_; }
-    // True for a pseudo-terminal (e.g. one end of a socat pair).
+    // True for a pseudo-terminal (e.g. one end of a socat pair). On Windows: true for any
+    // open port under Wine (asked only once the port refused 7 data bits), false otherwise.
     [[nodiscard]] bool is_pseudo_terminal() noexcept;
 
   private:

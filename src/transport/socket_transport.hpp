@@ -14,6 +14,8 @@
 #include <utility>
 
 #include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/address.hpp>
+#include <boost/asio/post.hpp>
 #include <boost/asio/steady_timer.hpp>
 
 #include "fins/error.hpp"
@@ -51,6 +53,23 @@ class SocketTransport : public Transport {
             if (life.expired() || gen != generation_ || ec || state_ != State::opening) return;
             finish_open(Unexpected(make_error_code(ClientError::timeout)));
         });
+        // An address is not looked up: Asio resolves on one thread for the whole io_context,
+        // and a lookup that waits for a silent DNS server (a broker's name in fins-bridge,
+        // another PLC's) would hold this PLC up behind it. (A scoped IPv6 address, "::1%eth0",
+        // goes to getaddrinfo, which refuses an interface that does not exist; Asio's parser
+        // would take it as scope 0.)
+        boost::system::error_code not_an_address;
+        const auto address = asio::ip::make_address(options_.host, not_an_address);
+        if (!not_an_address && options_.host.find('%') == std::string::npos) {
+            asio::post(socket_.get_executor(),
+                       [this, life, gen, on_resolved = std::move(on_resolved),
+                        results = Resolved::create({address, options_.port}, options_.host,
+                                                   std::to_string(options_.port))] {
+                           if (life.expired() || gen != generation_) return;
+                           on_resolved(results);
+                       });
+            return;
+        }
         resolver_.async_resolve(options_.host, std::to_string(options_.port),
                                 Protocol::resolver::numeric_service,
                                 [this, life, gen, on_resolved = std::move(on_resolved)](

@@ -5,11 +5,16 @@ looks for or downloads a driver). Everything runs on loopback; every wait is bou
 Environment (set by ctest, see tests/CMakeLists.txt):
   FINS_BIN_DIR        the build's bin/ (finsd, fins)
   FINS_ARTIFACTS_DIR  where screenshots go (default <bin>/../artifacts/screenshots)
+  FINS_FINSD          (opt-in) the command that runs finsd instead of <bin>/finsd, split as
+                      a shell would: "/usr/lib/wine/wine64 .../finsd.exe" in the Windows
+                      tree's windows_browser_page. That finsd gets no --control (Wine has no
+                      AF_UNIX sockets, docs/windows.md) and more time to start.
 """
 import json
 import os
 import re
 import select
+import shlex
 import shutil
 import signal
 import subprocess
@@ -24,7 +29,10 @@ BIN = Path(os.environ.get("FINS_BIN_DIR", ROOT / "build-asan" / "bin"))
 ARTIFACTS = Path(os.environ.get("FINS_ARTIFACTS_DIR", BIN.parent / "artifacts" / "screenshots"))
 CHROMIUM = "/usr/bin/chromium"
 CHROMEDRIVER = "/usr/bin/chromedriver"
-START_TIMEOUT = 20.0  # an ASan finsd on a busy 2-core machine
+FINSD = shlex.split(os.environ.get("FINS_FINSD", "")) or [str(BIN / "finsd")]
+FOREIGN_FINSD = "FINS_FINSD" in os.environ and FINSD != [str(BIN / "finsd")]
+# An ASan finsd on a busy 2-core machine; finsd.exe under wine starts slower still.
+START_TIMEOUT = 60.0 if FOREIGN_FINSD else 20.0
 
 
 def free_port(host="127.0.0.1"):
@@ -46,8 +54,10 @@ class Finsd:
     def __init__(self, args, config=None, http="127.0.0.1:0", token=None):
         self.dir = Path(tempfile.mkdtemp(prefix="finsd-browser-"))
         self.control = self.dir / "finsd.sock"
-        cmd = [str(BIN / "finsd"), "--port", "0", "--control", str(self.control),
-               "--http", http] + list(args)
+        cmd = FINSD + ["--port", "0"]
+        if not FOREIGN_FINSD:
+            cmd += ["--control", str(self.control)]
+        cmd += ["--http", http] + list(args)
         if token is not None:  # POSTs need "Authorization: Bearer TOKEN"
             token_file = self.dir / "token"
             token_file.write_text(token + "\n")
@@ -79,7 +89,7 @@ class Finsd:
             ready, _, _ = select.select([fd], [], [], min(left, 0.5))
             if ready:
                 out += os.read(fd, 4096)
-            m = re.search(r"^listening (\d+)$", out.decode(errors="replace"), re.M)
+            m = re.search(r"^listening (\d+)\r?$", out.decode(errors="replace"), re.M)
             if m:
                 self.port = int(m.group(1))
             # finsd logs "finsd: HTTP on ADDRESS port N" (docs/web.md "Starting it").

@@ -54,8 +54,13 @@ TEST(SerialOptions, ClearErrors) {
         EXPECT_FALSE(s) << text;
         return s ? std::string{} : s.error();
     };
-    EXPECT_EQ(error(""), "no serial device (e.g. /dev/ttyUSB0,baud=9600)");
-    EXPECT_EQ(error(",baud=9600"), "no serial device (e.g. /dev/ttyUSB0,baud=9600)");
+#ifdef _WIN32
+    const std::string no_device = "no serial device (e.g. COM3,baud=9600)";
+#else
+    const std::string no_device = "no serial device (e.g. /dev/ttyUSB0,baud=9600)";
+#endif
+    EXPECT_EQ(error(""), no_device);
+    EXPECT_EQ(error(",baud=9600"), no_device);
     EXPECT_NE(error("/dev/x,baud=9601").find("baud '9601': not one of 300"), std::string::npos);
     EXPECT_EQ(error("/dev/x,data=6"), "data '6': data bits are 7 or 8");
     EXPECT_EQ(error("/dev/x,stop=3"), "stop '3': stop bits are 1 or 2");

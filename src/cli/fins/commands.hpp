@@ -228,4 +228,20 @@ Result<typename C::Response> send_noting_flags(Client& client, const C& command,
 // Connects with the global options, or prints why not and sets `exit_code`.
 std::unique_ptr<Client> open_client(const GlobalOptions& g, Output& out, int& exit_code);
 
+// Connects and sends `command`: its response, or nullopt with `rc` set and the failure
+// printed (the verb's name, C::name, says what failed).
+template <class C>
+std::optional<typename C::Response> send(const GlobalOptions& g, Output& out, int& rc,
+                                         const C& command) {
+    auto client = open_client(g, out, rc);
+    if (!client) return std::nullopt;
+    auto r = client->send(command);
+    if (!r) {
+        rc = out.failure(r.error(), std::string(C::name));
+        return std::nullopt;
+    }
+    rc = exit_ok;
+    return *r;
+}
+
 }  // namespace fins::cli

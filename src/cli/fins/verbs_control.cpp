@@ -42,20 +42,6 @@ struct ControlArgs {
     bool keep_day_of_week = false;
 };
 
-template <class C>
-std::optional<typename C::Response> send(const GlobalOptions& g, Output& out, int& rc,
-                                         const C& command) {
-    auto client = open_client(g, out, rc);
-    if (!client) return std::nullopt;
-    auto r = client->send(command);
-    if (!r) {
-        rc = out.failure(r.error(), std::string(C::name));
-        return std::nullopt;
-    }
-    rc = exit_ok;
-    return *r;
-}
-
 int run_mode(const GlobalOptions& g, Output& out, bool to_program, bool monitor) {
     int rc = exit_ok;
     const char* mode = to_program ? "PROGRAM" : (monitor ? "MONITOR" : "RUN");

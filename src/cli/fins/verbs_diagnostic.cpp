@@ -95,20 +95,6 @@ Json bit_names(std::uint16_t word, const std::array<const char*, 16>& names, std
     return list;
 }
 
-template <class C>
-std::optional<typename C::Response> send(const GlobalOptions& g, Output& out, int& rc,
-                                         const C& command) {
-    auto client = open_client(g, out, rc);
-    if (!client) return std::nullopt;
-    auto r = client->send(command);
-    if (!r) {
-        rc = out.failure(r.error(), std::string(C::name));
-        return std::nullopt;
-    }
-    rc = exit_ok;
-    return *r;
-}
-
 // For commands whose non-zero end codes carry data (0C 01 3001, 21 02 1104).
 template <class C>
 std::optional<RawResponse> send_raw(const GlobalOptions& g, Output& out, int& rc,

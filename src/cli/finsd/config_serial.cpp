@@ -82,7 +82,8 @@ tl::expected<SerialPortConfig, std::string> parse_serial_option(std::string_view
     };
     const auto eq = text.find('=');
     if (eq == std::string_view::npos)
-        return fail("not NAME=DEVICE[,baud=...] (e.g. cpu=/dev/ttyUSB0,unit=0)");
+        return fail(fmt::format("not NAME=DEVICE[,baud=...] (e.g. cpu={},unit=0)",
+                                transport::example_serial_device));
     auto port = parse_serial_name(text.substr(0, eq));
     if (!port) return fail(port.error());
     auto spec = transport::parse_serial_spec(text.substr(eq + 1), transport::SerialKeys::port);
