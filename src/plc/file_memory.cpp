@@ -1,11 +1,6 @@
 // plc::FileMemory: the 22 xx file devices (see file_memory.hpp for the rules).
-// Linux (POSIX *at calls); Windows: file_memory_win.cpp.
-#ifndef _WIN32
+// Shared by Linux and Windows: the host calls are file_memory_os.hpp's.
 #include "plc/file_memory.hpp"
-
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -33,33 +28,38 @@ std::uint32_t date_of(std::int64_t mtime) noexcept {
                           static_cast<unsigned>(tm.tm_min), static_cast<unsigned>(tm.tm_sec));
 }
 
-FileEntry entry_of(const std::string& name, const struct stat& st, bool directory) {
+FileEntry entry_of(const std::string& name, const host::Info& info, bool directory) {
     FileEntry e;
     e.name = *FileName::from(name);
-    e.date = date_of(st.st_mtime);
-    e.size = directory ? 0 : static_cast<std::uint32_t>(st.st_size);
+    e.date = date_of(info.mtime);
+    e.size = directory ? 0 : static_cast<std::uint32_t>(info.size);
     e.attribute = directory ? attribute_directory : attribute_archive;
     return e;
 }
 
-FileEntry dot_entry(std::string_view dots, const struct stat& st) {
+FileEntry dot_entry(std::string_view dots, const host::Info& info) {
     FileEntry e;
     e.name.bytes.fill(0x20);
     for (std::size_t i = 0; i < dots.size(); ++i)
         e.name.bytes[i] = '.';
-    e.date = date_of(st.st_mtime);
+    e.date = date_of(info.mtime);
     e.attribute = attribute_directory;
     return e;
 }
 
-constexpr const char* volume_file = ".volume";
+const std::string volume_file = ".volume";
 
 // The volume label's date lives in the mtime of an empty hidden file, made with the
 // device directory (22 04 dates it again).
+void date_volume(int device, CivilSeconds date) noexcept {
+    bool exists = false;
+    const Fd v(host::create_file(device, volume_file, exists));
+    host::set_mtime_at(device, volume_file, date);
+}
+
 void ensure_volume(int device) noexcept {
     if (host::kind_of(device, volume_file) != Kind::missing) return;
-    const Fd v(::openat(device, volume_file, O_WRONLY | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0644));
-    host::set_mtime(device, volume_file, Clock::host_local(std::chrono::system_clock::now()));
+    date_volume(device, Clock::host_local(std::chrono::system_clock::now()));
 }
 
 }  // namespace
@@ -75,7 +75,7 @@ FileMemory::FileMemory(const Profile& profile)
 
 FileMemory::~FileMemory() {
     close_devices();
-    if (root_fd_ >= 0) ::close(root_fd_);
+    host::close(root_fd_);
     if (own_root_) {
         std::error_code ec;
         std::filesystem::remove_all(root_, ec);
@@ -94,34 +94,27 @@ std::uint8_t FileMemory::em_non_file_banks() const noexcept {
 Result<void> FileMemory::attach(const std::filesystem::path& root) {
     std::error_code ec;
     std::filesystem::create_directories(root, ec);
-    const int fd = ::open(root.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    if (fd < 0) return Unexpected(std::error_code(errno, std::generic_category()));
-    // Device directories that are symlinks: opened now, following that one link.
+    std::error_code error;
+    Fd fd(host::open_root(root, error));
+    if (!fd.valid()) return Unexpected(error);
+    // Device directories that are links: opened now, following that one link.
     constexpr std::array<const char*, 3> devices = {"card", "em", "cassette"};
     std::array<Fd, 3> linked;
     std::vector<DeviceLink> links;
     std::error_code refused;
     for (std::size_t i = 0; i < devices.size(); ++i) {
-        struct stat st {};
-        if (::fstatat(fd, devices[i], &st, AT_SYMLINK_NOFOLLOW) != 0 || !S_ISLNK(st.st_mode))
-            continue;
+        if (!host::is_link(fd.get(), devices[i])) continue;
         DeviceLink link{devices[i], std::filesystem::read_symlink(root / devices[i], ec), {}};
-        linked[i] = Fd(::openat(fd, devices[i], O_RDONLY | O_DIRECTORY | O_CLOEXEC));
-        if (!linked[i].valid()) {
-            link.error = std::error_code(errno, std::generic_category());
-            if (!refused) refused = link.error;
-        }
+        linked[i] = Fd(host::open_linked_directory(fd.get(), devices[i], link.error));
+        if (!linked[i].valid() && !refused) refused = link.error;
         links.push_back(std::move(link));
     }
     device_links_ = std::move(links);
-    if (refused) {
-        ::close(fd);
-        return Unexpected(refused);
-    }
+    if (refused) return Unexpected(refused);
     close_devices();
-    if (root_fd_ >= 0) ::close(root_fd_);
+    host::close(root_fd_);
     if (own_root_) std::filesystem::remove_all(root_, ec);
-    root_fd_ = fd;
+    root_fd_ = fd.release();
     root_ = root;
     own_root_ = false;
     device_fds_[0] = linked[0].release();
@@ -132,7 +125,7 @@ Result<void> FileMemory::attach(const std::filesystem::path& root) {
         if (kept >= 0) {
             host::clear(kept, true);
             if (i < 2) ensure_volume(kept);
-        } else if (const Fd dir = host::open_directory(root_fd_, devices[i]); dir.valid()) {
+        } else if (const Fd dir(host::open_directory(root_fd_, devices[i])); dir.valid()) {
             host::clear(dir.get(), true);
         }
     }
@@ -141,10 +134,10 @@ Result<void> FileMemory::attach(const std::filesystem::path& root) {
 
 Result<void> FileMemory::ensure_root() {
     if (root_fd_ >= 0) return {};
-    std::string pattern = (std::filesystem::temp_directory_path() / "finsd-files-XXXXXX").string();
-    if (::mkdtemp(pattern.data()) == nullptr)
-        return Unexpected(std::error_code(errno, std::generic_category()));
-    if (auto r = attach(pattern); !r) return r;
+    std::error_code error;
+    const auto dir = host::make_temp_directory(error);
+    if (error) return Unexpected(error);
+    if (auto r = attach(dir); !r) return r;
     own_root_ = true;
     return {};
 }
@@ -172,9 +165,9 @@ Result<FileMemory::Device> FileMemory::open_device(std::uint16_t disk) {
     // are counted once and then tracked (used()).
     int& fd = device_fds_[d.index];
     if (fd < 0) {
-        if (::mkdirat(root_fd_, dir, 0755) != 0 && errno != EEXIST)
+        if (host::make_directory(root_fd_, dir) == host::Status::failed)
             return fail(EndCode::memory_error);
-        fd = host::open_directory(root_fd_, dir).release();
+        fd = host::open_directory(root_fd_, dir);
         if (fd < 0) return fail(EndCode::memory_error);
         used_[d.index].reset();
         ensure_volume(fd);
@@ -186,11 +179,11 @@ Result<FileMemory::Device> FileMemory::open_device(std::uint16_t disk) {
 void FileMemory::close_devices() noexcept {
     forget_open_files();
     for (std::size_t i = 0; i < 2; ++i) {
-        if (device_fds_[i] >= 0) ::close(device_fds_[i]);
+        host::close(device_fds_[i]);
         device_fds_[i] = -1;
         used_[i].reset();
     }
-    if (cassette_fd_ >= 0) ::close(cassette_fd_);
+    host::close(cassette_fd_);
     cassette_fd_ = -1;
 }
 
@@ -212,8 +205,8 @@ Result<FileNameReadResponse> FileMemory::list(const FileNameRead& c) {
     const Fd dir = host::open_path(device->fd, *path);
     if (!dir.valid()) return fail(EndCode::read_file_missing);
 
-    struct stat volume {};
-    const bool dated = ::fstatat(device->fd, volume_file, &volume, AT_SYMLINK_NOFOLLOW) == 0;
+    host::Info volume;
+    const bool dated = host::kind_of(device->fd, volume_file, &volume) != Kind::missing;
     std::vector<FileEntry> all;
     if (path->empty()) {
         // 5-3-32 "Total Number of Files": "Volume labels ... are all counted as files. (The
@@ -222,14 +215,14 @@ Result<FileNameReadResponse> FileMemory::list(const FileNameRead& c) {
         // attribute 08 (volume label), size 0, the date of the label (the last format).
         FileEntry label;
         label.name = *FileName::from(device->label);
-        label.date = dated ? date_of(volume.st_mtime) : 0;
+        label.date = dated ? date_of(volume.mtime) : 0;
         label.attribute = attribute_volume;
         all.push_back(label);
     } else {
-        struct stat st {};
-        ::fstat(dir.get(), &st);
-        all.push_back(dot_entry(".", st));
-        all.push_back(dot_entry("..", st));
+        host::Info info;
+        host::stat(dir.get(), info);
+        all.push_back(dot_entry(".", info));
+        all.push_back(dot_entry("..", info));
     }
     for (const auto& e :
          host::entries(dir.get(), [](std::string_view n) { return FileMemory::visible(n); }))
@@ -237,7 +230,7 @@ Result<FileNameReadResponse> FileMemory::list(const FileNameRead& c) {
 
     FileNameReadResponse r;
     r.disk.volume_label = *FileName::from(device->label);
-    if (dated) r.disk.date = date_of(volume.st_mtime);
+    if (dated) r.disk.date = date_of(volume.mtime);
     const auto used = bytes_in_use(*device);
     r.disk.total_capacity =
         static_cast<std::uint32_t>(std::min<std::uint64_t>(device->capacity, 0xFFFFFFFF));
@@ -262,9 +255,7 @@ EndCode FileMemory::format(std::uint16_t disk, std::uint8_t current_em_bank, Civ
     forget_open_files(device->index);
     used_[device->index].reset();
     if (!host::clear(device->fd, false)) return EndCode::memory_error;
-    const Fd v(
-        ::openat(device->fd, volume_file, O_WRONLY | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0644));
-    host::set_mtime(device->fd, volume_file, now);
+    date_volume(device->fd, now);
     return EndCode::normal_completion;
 }
 
@@ -289,7 +280,7 @@ Result<std::uint16_t> FileMemory::remove(const FileDelete& c) {
     // 5-3-36: names that do not exist are ignored; so are directories (22 15 removes those).
     for (const auto& name : names)
         if (host::kind_of(dir.get(), name) == Kind::file &&
-            ::unlinkat(dir.get(), name.c_str(), 0) == 0)
+            host::remove(dir.get(), name, false) == host::Status::ok)
             ++deleted;
     return deleted;
 }
@@ -309,7 +300,7 @@ EndCode FileMemory::copy(const FileCopy& c) {
     forget_open_files(target->index);
     date_open_files();  // the copy takes the source's date
     const Fd from_dir = host::open_path(source->fd, *from_path);
-    struct stat st {};
+    host::Info st;
     if (!from_dir.valid() || host::kind_of(from_dir.get(), *from, &st) != Kind::file)
         return EndCode::read_file_missing;
     const Fd to_dir = host::open_path(target->fd, *to_path);
@@ -320,7 +311,7 @@ EndCode FileMemory::copy(const FileCopy& c) {
     const auto used = bytes_in_use(*target);
     if (used + content->size() > target->capacity) return EndCode::address_range_exceeded;
     // 5-3-37: "The copy destination file is given the same date as the copy source file."
-    if (!host::replace(to_dir.get(), *to, *content, st.st_mtime, temp_counter_))
+    if (!host::replace(to_dir.get(), *to, *content, st.mtime, temp_counter_))
         return EndCode::memory_error;
     used_[target->index] = used + content->size();
     return EndCode::normal_completion;
@@ -342,10 +333,9 @@ EndCode FileMemory::rename(const FileNameChange& c) {
     if (kind != Kind::file && kind != Kind::directory) return EndCode::write_file_missing;
     if (*from == *to) return EndCode::file_name_exists;
     if (host::kind_of(dir.get(), *to) != Kind::missing) return EndCode::file_name_exists;
-    // renameat keeps the date (5-3-38 "the date of the file will remain unchanged").
-    if (::renameat(dir.get(), from->c_str(), dir.get(), to->c_str()) != 0)
-        return EndCode::memory_error;
-    ::fsync(dir.get());
+    // A rename keeps the date (5-3-38 "the date of the file will remain unchanged").
+    if (!host::rename(dir.get(), *from, *to)) return EndCode::memory_error;
+    host::sync(dir.get());
     return EndCode::normal_completion;
 }
 
@@ -365,16 +355,21 @@ EndCode FileMemory::directory(const DirectoryCreateDelete& c, CivilSeconds now) 
     if (c.operation == static_cast<std::uint16_t>(DirectoryOperation::create)) {
         if (kind != Kind::missing) return EndCode::file_name_exists;
         if (path->size() >= max_file_directories) return EndCode::cannot_register;
-        if (::mkdirat(dir.get(), name->c_str(), 0755) != 0) return EndCode::memory_error;
-        host::set_mtime(dir.get(), name->c_str(), now);
-        ::fsync(dir.get());
+        if (host::make_directory(dir.get(), *name) != host::Status::ok)
+            return EndCode::memory_error;
+        host::set_mtime_at(dir.get(), *name, now);
+        host::sync(dir.get());
         return EndCode::normal_completion;
     }
     if (kind != Kind::directory) return EndCode::write_file_missing;
-    if (::unlinkat(dir.get(), name->c_str(), AT_REMOVEDIR) != 0)
-        return errno == ENOTEMPTY || errno == EEXIST ? EndCode::cannot_change
-                                                     : EndCode::memory_error;
-    return EndCode::normal_completion;
+    switch (host::remove(dir.get(), *name, true)) {
+        case host::Status::ok:
+            return EndCode::normal_completion;
+        case host::Status::not_empty:
+            return EndCode::cannot_change;
+        default:
+            return EndCode::memory_error;
+    }
 }
 
 // ---- whole files for 22 0A .. 22 0C ----
@@ -412,4 +407,3 @@ EndCode FileMemory::create(std::uint16_t disk, const FileName& file, const std::
 }
 
 }  // namespace fins::plc
-#endif

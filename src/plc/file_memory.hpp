@@ -8,7 +8,8 @@
 // letters, digits and ! & $ # ' { } - ^ ( ) _ ~; no "~~" start, no 00/E5 first byte, no
 // DOS device names; paths "\A\B" of at most 65 characters and 4 directories below the
 // root) before any host call, and the host is then walked one component at a time with
-// openat(O_NOFOLLOW): a symlink planted in a device directory is never followed. Names are
+// openat(O_NOFOLLOW) (Windows: checked CreateFileW opens, file_memory_os.hpp): a symlink
+// (or junction) planted in a device directory is never followed. Names are
 // case-insensitive and stored upper case (FAT convention; the seed does not say); host
 // entries that are not valid upper-case 8.3 names (".volume", temp files, "foo.txt")
 // are invisible to FINS.

@@ -1,12 +1,7 @@
 // plc::FileMemory: the Memory Cassette of a CP1H (disk 8003, W342 5-3-43). Items are
 // host files in <root>/cassette, reached like the file devices: one directory fd opened
-// with O_NOFOLLOW, names that are single components chosen by finsd (never by a request).
-// Linux (POSIX *at calls); Windows: file_memory_win.cpp.
-#ifndef _WIN32
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
+// without following a link, names that are single components chosen by finsd (never by
+// a request). Shared by Linux and Windows: the host calls are file_memory_os.hpp's.
 #include "plc/file_memory.hpp"
 #include "plc/file_memory_device.hpp"
 #include "plc/file_memory_host.hpp"
@@ -19,9 +14,9 @@ Result<int> FileMemory::cassette_directory() {
     if (!cassette_mounted_) return fail(EndCode::file_device_missing);
     if (!ensure_root()) return fail(EndCode::memory_error);
     if (cassette_fd_ < 0) {
-        if (::mkdirat(root_fd_, "cassette", 0755) != 0 && errno != EEXIST)
+        if (host::make_directory(root_fd_, "cassette") == host::Status::failed)
             return fail(EndCode::memory_error);
-        cassette_fd_ = host::open_directory(root_fd_, "cassette").release();
+        cassette_fd_ = host::open_directory(root_fd_, "cassette");
         if (cassette_fd_ < 0) return fail(EndCode::memory_error);
     }
     return cassette_fd_;
@@ -55,9 +50,8 @@ EndCode FileMemory::initialize_cassette() {
     const auto dir = cassette_directory();
     if (!dir) return EndCode{static_cast<std::uint16_t>(dir.error().value())};
     if (!host::clear(*dir, false)) return EndCode::memory_error;
-    ::fsync(*dir);
+    host::sync(*dir);
     return EndCode::normal_completion;
 }
 
 }  // namespace fins::plc
-#endif

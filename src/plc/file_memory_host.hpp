@@ -1,9 +1,8 @@
-// Private to plc::FileMemory: the host side of the file devices. Every helper works on
-// directory file descriptors and single, already-checked name components; none takes
-// a path with a separator, and none follows a symlink (O_NOFOLLOW, AT_SYMLINK_NOFOLLOW).
+// Private to plc::FileMemory: the host side of the file devices, on top of the host calls
+// of file_memory_os.hpp (POSIX or Windows). Every helper works on directory handles and
+// single, already-checked name components; none takes a path with a separator, and none
+// follows a link.
 #pragma once
-
-#include <sys/stat.h>
 
 #include <cstdint>
 #include <optional>
@@ -13,17 +12,24 @@
 
 #include "fins/byte_io.hpp"
 #include "fins/error.hpp"
+#include "plc/file_memory_os.hpp"
 
 namespace fins::plc::host {
 
-// An owned file descriptor.
+// An owned handle (file_memory_os.hpp).
 class Fd {
   public:
     Fd() = default;
     explicit Fd(int fd) noexcept : fd_(fd) {}
-    ~Fd();
+    ~Fd() { host::close(fd_); }
     Fd(Fd&& other) noexcept : fd_(other.release()) {}
-    Fd& operator=(Fd&& other) noexcept;
+    Fd& operator=(Fd&& other) noexcept {
+        if (this != &other) {
+            host::close(fd_);
+            fd_ = other.release();
+        }
+        return *this;
+    }
     Fd(const Fd&) = delete;
     Fd& operator=(const Fd&) = delete;
     [[nodiscard]] int get() const noexcept { return fd_; }
@@ -38,24 +44,20 @@ class Fd {
     int fd_ = -1;
 };
 
-enum class Kind : std::uint8_t { missing, file, directory, other };
-
 struct Entry {
     std::string name;
     Kind kind = Kind::other;
-    struct stat info {};
+    Info info;
 };
 
 // lstat-like, relative to `dir`.
-Kind kind_of(int dir, const std::string& name, struct stat* info = nullptr) noexcept;
+Kind kind_of(int dir, const std::string& name, Info* info = nullptr) noexcept;
 // What kind_of() says, without asking for the file's times: on Linux 6.13+ (multigrain
 // timestamps) a stat that reads mtime makes the next write stamp a fine-grained time,
 // which dirties the inode and journals it: about 15 us per 22 03 chunk instead of 2.
-// st_mode, st_ino, st_dev and st_size of `info` are filled, nothing else.
-Kind identity_of(int dir, const std::string& name, struct stat* info) noexcept;
-// Opens the sub-directory `name` of `dir` (O_DIRECTORY | O_NOFOLLOW); invalid when absent.
-Fd open_directory(int dir, const std::string& name) noexcept;
-// Walks `components` from `dir`; invalid when one is missing or not a directory.
+// kind, size, device and inode of `info` are filled, not mtime.
+Kind identity_of(int dir, const std::string& name, Info* info) noexcept;
+// Walks `components` from `dir`; invalid when one is missing, not a directory or a link.
 Fd open_path(int dir, const std::vector<std::string>& components) noexcept;
 // The entries of `dir` whose names `visible` accepts, sorted by name.
 std::vector<Entry> entries(int dir, bool (*visible)(std::string_view name));
@@ -65,23 +67,22 @@ std::uint64_t used_bytes(int dir, int depth = 0) noexcept;
 bool clear(int dir, bool only_temps, int depth = 0) noexcept;
 // Whole regular file `name` (nullopt: missing or not a regular file, or unreadable).
 std::optional<std::vector<std::uint8_t>> read_all(int dir, const std::string& name);
-// Writes `content` to a new temp file in `dir`, fsyncs it, dates it `mtime`, renames it
-// to `name` (replacing) and fsyncs `dir`. False on any host error (the temp is removed).
+// Writes `content` to a new temp file in `dir`, syncs it, dates it `mtime`, renames it
+// to `name` (replacing) and syncs `dir`. False on any host error (the temp is removed).
 bool replace(int dir, const std::string& name, Bytes content, std::int64_t mtime,
              unsigned& counter) noexcept;
 // Extending writes (22 03 0002, or 0003 at the file's end): `data` written at
 // `old_size`, the file's size now, all of it or nothing. A write the host refuses part
-// way (ENOSPC, EFBIG, EIO) is cut back to `old_size` with ftruncate, so the file stays
-// exactly as the last acknowledged write left it (5-3-34: a refused write changes
-// nothing). False on any host error.
-// The regular file `name` in `dir` (opened without following a symlink), then dated.
+// way (ENOSPC, EFBIG, EIO) is cut back to `old_size`, so the file stays exactly as the
+// last acknowledged write left it (5-3-34: a refused write changes nothing). False on
+// any host error.
+// The regular file `name` in `dir` (opened without following a link), then dated.
 bool extend_at(int dir, const std::string& name, std::uint64_t old_size, Bytes data,
                std::int64_t mtime) noexcept;
-// An open descriptor of a regular file; the caller dates the file later.
+// An open handle of a regular file; the caller dates the file later.
 bool extend_undated(int fd, std::uint64_t old_size, Bytes data) noexcept;
-// Sets the modification time of an open file.
-bool set_mtime_fd(int fd, std::int64_t mtime) noexcept;
-// Sets the modification time of `name` (not following symlinks).
-bool set_mtime(int dir, const char* name, std::int64_t mtime) noexcept;
+// Reads `size` bytes at `offset`, fewer only at the file's end; false on a host error.
+bool read_fully(int fd, std::uint8_t* data, std::size_t size, std::uint64_t offset,
+                std::size_t& done) noexcept;
 
 }  // namespace fins::plc::host

@@ -1,11 +1,6 @@
 // plc::FileMemory: descriptors kept open between the chunks of one 22 03 transfer (see
 // FileMemory::OpenFile in file_memory.hpp).
-// Linux (POSIX *at calls); Windows: file_memory_win.cpp.
-#ifndef _WIN32
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
+// Shared by Linux and Windows: the host calls are file_memory_os.hpp's.
 #include <algorithm>
 
 #include "plc/file_memory.hpp"
@@ -35,10 +30,10 @@ FileMemory::OpenFile* FileMemory::find_open_file(std::size_t device,
 FileMemory::OpenFile* FileMemory::keep_open(std::size_t device, std::string key, int directory,
                                             const std::string& name) {
     // Read and write: 22 02 chunks read through it, 22 03 chunks extend it.
-    const int fd = ::openat(directory, name.c_str(), O_RDWR | O_NOFOLLOW | O_CLOEXEC);
-    struct stat st {};
-    if (fd < 0 || ::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-        if (fd >= 0) ::close(fd);
+    const int fd = host::open_file(directory, name, host::Access::read_write);
+    host::Info st;
+    if (fd < 0 || !host::stat(fd, st)) {
+        host::close(fd);
         return nullptr;
     }
     if (open_files_.size() >= max_open_files) {
@@ -52,17 +47,17 @@ FileMemory::OpenFile* FileMemory::keep_open(std::size_t device, std::string key,
     f.key = std::move(key);
     f.directory = directory;
     f.fd = fd;
-    f.host_device = static_cast<std::uint64_t>(st.st_dev);
-    f.inode = static_cast<std::uint64_t>(st.st_ino);
+    f.host_device = st.device;
+    f.inode = st.inode;
     f.last_use = ++use_counter_;
     open_files_.push_back(std::move(f));
     return &open_files_.back();
 }
 
 void FileMemory::close_open_file(OpenFile* file) noexcept {
-    if (file->undated) host::set_mtime_fd(file->fd, file->last_write);
-    ::close(file->fd);
-    ::close(file->directory);
+    if (file->undated) host::set_mtime(file->fd, file->last_write);
+    host::close(file->fd);
+    host::close(file->directory);
     const auto index = static_cast<std::ptrdiff_t>(file - open_files_.data());
     open_files_.erase(open_files_.begin() + index);
 }
@@ -75,7 +70,7 @@ void FileMemory::forget_open_files(std::optional<std::size_t> device) noexcept {
 void FileMemory::date_open_files() noexcept {
     for (auto& f : open_files_)
         if (f.undated) {
-            host::set_mtime_fd(f.fd, f.last_write);
+            host::set_mtime(f.fd, f.last_write);
             f.undated = false;
         }
 }
@@ -89,4 +84,3 @@ void FileMemory::close_idle_files(CivilSeconds now) noexcept {
 }
 
 }  // namespace fins::plc
-#endif

@@ -1,14 +1,8 @@
 // plc::FileMemory: 22 02 SINGLE FILE READ and 22 03 SINGLE FILE WRITE (see
 // file_memory.hpp for the rules; the descriptors kept open between 22 03 chunks are in
 // file_memory_open_files.cpp).
-// Linux (POSIX *at calls); Windows: file_memory_win.cpp.
-#ifndef _WIN32
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
+// Shared by Linux and Windows: the host calls are file_memory_os.hpp's.
 #include <algorithm>
-#include <cerrno>
 
 #include "plc/file_memory.hpp"
 #include "plc/file_memory_device.hpp"
@@ -30,13 +24,12 @@ Result<SingleFileReadResponse> FileMemory::read(const SingleFileRead& c) {
     // The chunks of one transfer read through the descriptor the first one opened (see
     // write()); a file that is no longer the one the name gives takes the walk again.
     const std::string key = open_file_key(*path, *name);
-    struct stat st {};
+    host::Info st;
     int fd = -1;
     Fd walked_fd;
     if (OpenFile* cached = find_open_file(device->index, key); cached != nullptr) {
         if (host::identity_of(cached->directory, *name, &st) == Kind::file &&
-            static_cast<std::uint64_t>(st.st_ino) == cached->inode &&
-            static_cast<std::uint64_t>(st.st_dev) == cached->host_device)
+            st.inode == cached->inode && st.device == cached->host_device)
             fd = cached->fd;
         else
             close_open_file(cached);
@@ -50,13 +43,13 @@ Result<SingleFileReadResponse> FileMemory::read(const SingleFileRead& c) {
             static_cast<void>(dir.release());
             fd = kept->fd;
         } else {
-            walked_fd = Fd(::openat(dir.get(), name->c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC));
-            if (!walked_fd.valid() || ::fstat(walked_fd.get(), &st) != 0 || !S_ISREG(st.st_mode))
+            walked_fd = Fd(host::open_file(dir.get(), *name, host::Access::read));
+            if (!walked_fd.valid() || !host::stat(walked_fd.get(), st))
                 return fail(EndCode::read_file_missing);
             fd = walked_fd.get();
         }
     }
-    const auto size = static_cast<std::uint64_t>(st.st_size);
+    const auto size = st.size;
     if (c.position > size) return fail(EndCode::address_range_error);
     const auto n = static_cast<std::size_t>(std::min<std::uint64_t>(c.length, size - c.position));
     SingleFileReadResponse r;
@@ -64,13 +57,8 @@ Result<SingleFileReadResponse> FileMemory::read(const SingleFileRead& c) {
     r.position = c.position;
     r.data.resize(n);
     std::size_t done = 0;
-    while (done < n) {
-        const auto got =
-            ::pread(fd, r.data.data() + done, n - done, static_cast<off_t>(c.position + done));
-        if (got < 0 && errno == EINTR) continue;
-        if (got <= 0) return fail(EndCode::memory_error);
-        done += static_cast<std::size_t>(got);
-    }
+    if (!host::read_fully(fd, r.data.data(), n, c.position, done) || done != n)
+        return fail(EndCode::memory_error);
     r.last = c.position + n == size;
     return r;
 }
@@ -91,15 +79,14 @@ EndCode FileMemory::write(const SingleFileWrite& c, CivilSeconds now) {
     // The chunks of one transfer: the directory and file stay open while the name still
     // names the same regular file (no walk, no open); anything else takes the walk.
     const std::string key = open_file_key(*path, *name);
-    struct stat st {};
+    host::Info st;
     auto kind = Kind::missing;
     int dir_fd = -1;
     Fd walked;
     OpenFile* cached = find_open_file(device->index, key);
     if (cached != nullptr) {
         kind = host::identity_of(cached->directory, *name, &st);
-        if (kind == Kind::file && static_cast<std::uint64_t>(st.st_ino) == cached->inode &&
-            static_cast<std::uint64_t>(st.st_dev) == cached->host_device) {
+        if (kind == Kind::file && st.inode == cached->inode && st.device == cached->host_device) {
             dir_fd = cached->directory;
         } else {
             close_open_file(cached);
@@ -114,7 +101,7 @@ EndCode FileMemory::write(const SingleFileWrite& c, CivilSeconds now) {
     }
     if (kind != Kind::missing && kind != Kind::file) return EndCode::file_name_exists;
     const bool exists = kind == Kind::file;
-    const std::uint64_t old_size = exists ? static_cast<std::uint64_t>(st.st_size) : 0;
+    const std::uint64_t old_size = exists ? st.size : 0;
 
     std::uint64_t offset = 0;
     switch (mode) {
@@ -182,4 +169,3 @@ EndCode FileMemory::write(const SingleFileWrite& c, CivilSeconds now) {
 }
 
 }  // namespace fins::plc
-#endif

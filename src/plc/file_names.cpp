@@ -1,5 +1,7 @@
 // The CPU Unit's name and path rules for plc::FileMemory (frames-serial-files 4.1):
-// pure text checks, no host access.
+// pure text checks, no host access, the one place for them on Linux and Windows. What
+// Windows treats specially never passes: ':' (streams), '\\' and '/', spaces, a trailing
+// dot (an extension is 1..3 characters after the only dot), and device names.
 #include <algorithm>
 #include <array>
 
@@ -18,12 +20,15 @@ char upper(char c) noexcept {
     return (c >= 'a' && c <= 'z') ? static_cast<char>(c - 'a' + 'A') : c;
 }
 
+// Names DOS and Windows give to devices, whatever the extension: CON, PRN, AUX, NUL,
+// CLOCK$, CONFIG$, CONIN$, CONOUT$, COM0..COM9, LPT0..LPT9. Refused on every host, so
+// that a card written under Linux is one Windows can hold (docs/file-memory.md).
 bool device_name(std::string_view base) noexcept {
-    static constexpr std::array<std::string_view, 6> names{"CON", "PRN",    "AUX",
-                                                           "NUL", "CLOCK$", "CONFIG$"};
+    static constexpr std::array<std::string_view, 8> names{
+        "CON", "PRN", "AUX", "NUL", "CLOCK$", "CONFIG$", "CONIN$", "CONOUT$"};
     if (std::find(names.begin(), names.end(), base) != names.end()) return true;
     return base.size() == 4 && (base.starts_with("COM") || base.starts_with("LPT")) &&
-           base[3] >= '1' && base[3] <= '9';
+           base[3] >= '0' && base[3] <= '9';
 }
 
 }  // namespace

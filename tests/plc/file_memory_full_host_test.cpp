@@ -2,7 +2,8 @@
 // write answers 250F and the file stays exactly as the last acknowledged write left it,
 // so the size 22 02 reports is the size a resuming client may trust. The full host is a
 // 64 KiB tmpfs mounted for the test (needs CAP_SYS_ADMIN, else the test is skipped) and
-// unmounted by it.
+// unmounted by it. Linux only: Windows has no tmpfs to mount (docs/windows.md).
+#ifndef _WIN32
 #include <gtest/gtest.h>
 
 #include <sys/mount.h>
@@ -95,3 +96,4 @@ TEST(FileMemoryFullHost, W342_5_3_34_RefusedExtendLeavesTheFileAsAcknowledged) {
 
 }  // namespace
 }  // namespace fins::plc
+#endif

@@ -6,15 +6,13 @@
 // device directory. Bounded (max_open_files), closed when idle and at destruction.
 #include <gtest/gtest.h>
 
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
 #include "plc/file_memory.hpp"
+#include "plc/file_memory_test_util.hpp"
 
 namespace fins::plc {
 namespace {
@@ -27,20 +25,16 @@ std::string slurp(const fs::path& p) {
 }
 
 std::size_t open_descriptors() {
-    std::size_t n = 0;
-    for ([[maybe_unused]] const auto& e : fs::directory_iterator("/proc/self/fd"))
-        ++n;
-    return n;
+    return test::open_handles();
 }
 
 class OpenFilesTest : public ::testing::Test {
   protected:
     OpenFilesTest() : files(profile) {
-        std::string pattern = (fs::temp_directory_path() / "fins-open-files-XXXXXX").string();
-        dir = ::mkdtemp(pattern.data());
+        dir = test::make_temp_dir("fins-open-files");
+        cleanup.dir = dir;
         EXPECT_TRUE(files.attach(dir / "root"));
     }
-    ~OpenFilesTest() override { fs::remove_all(dir); }
 
     EndCode write(std::string_view file, std::string_view content, FileWriteMode mode,
                   CivilSeconds now = 1'700'000'000, std::uint32_t position = 0) {
@@ -57,6 +51,7 @@ class OpenFilesTest : public ::testing::Test {
 
     Profile profile = cj2h();
     fs::path dir;
+    test::RemoveAll cleanup;  // after `files` closed its directories (Windows removes none held)
     FileMemory files;
 };
 
@@ -82,16 +77,13 @@ TEST_F(OpenFilesTest, W342_5_3_34_AppendsReuseOneDescriptor) {
     // (FileMemory::date_open_files): before 22 01 reads dates ...
     ASSERT_EQ(append("A.BIN", "6", 1'700'000'001), EndCode::normal_completion);
     ASSERT_TRUE(files.list({disk_memory_card, 0, 20, ""}));
-    struct stat st {};
-    ASSERT_EQ(::stat((card() / "A.BIN").c_str(), &st), 0);
-    EXPECT_EQ(st.st_mtime, 1'700'000'001);
+    EXPECT_EQ(test::mtime_of(card() / "A.BIN"), 1'700'000'001);
     EXPECT_EQ(files.open_files(), 1U);  // still open for the next chunk
     // ... and when the descriptor is closed (here: the card comes out).
     ASSERT_EQ(append("A.BIN", "7", 1'700'000'009), EndCode::normal_completion);
     files.remove_card();
     EXPECT_EQ(files.open_files(), 0U);
-    ASSERT_EQ(::stat((card() / "A.BIN").c_str(), &st), 0);
-    EXPECT_EQ(st.st_mtime, 1'700'000'009);
+    EXPECT_EQ(test::mtime_of(card() / "A.BIN"), 1'700'000'009);
 }
 
 // 22 02 chunks read through one kept descriptor too (issue 8 speed), and a file the
@@ -116,14 +108,32 @@ TEST_F(OpenFilesTest, W342_5_3_33_ReadsReuseOneDescriptorWhileTheNameHoldsTheFil
         std::ofstream out(card() / "R.BIN.new", std::ios::binary);
         out << "XYZ";
     }
-    fs::rename(card() / "R.BIN.new", card() / "R.BIN");
+    std::error_code replaced;
+    fs::rename(card() / "R.BIN.new", card() / "R.BIN", replaced);
+#ifdef _WIN32
+    // Windows refuses to replace a file that is open (finsd holds it for the next chunk):
+    // the swap does not happen, and the name still gives the file finsd reads.
+    if (replaced) {
+        fs::remove(card() / "R.BIN.new");
+        { std::ofstream(card() / "R.BIN", std::ios::binary) << "XYZ"; }
+    }
+#else
+    ASSERT_FALSE(replaced) << replaced.message();
+#endif
     auto third = read(0, 3);
     ASSERT_TRUE(third);
     EXPECT_EQ(std::string(third->data.begin(), third->data.end()), "XYZ");
     EXPECT_EQ(third->file_size, 3U);
     // Deleted on the host: dropped from the cache, and 2006 on the next read.
     fs::remove(card() / "R.BIN");
+#ifdef _WIN32
+    // Windows (wine too) removes a file that is open once its last handle closes: the
+    // name stays, with the bytes finsd read, until finsd lets go (here: the card comes out).
+    files.remove_card();
+    EXPECT_FALSE(fs::exists(card() / "R.BIN"));
+#else
     EXPECT_FALSE(read(0, 1));
+#endif
     EXPECT_EQ(files.open_files(), 0U);
 }
 
@@ -170,7 +180,8 @@ TEST_F(OpenFilesTest, FrameSerialFiles_4_1_HostSwapsAreNotFollowed) {
     const auto outside = dir / "outside.txt";
     { std::ofstream(outside) << "keep"; }
     fs::remove(card() / "A.BIN");
-    fs::create_symlink(outside, card() / "A.BIN");
+    if (!test::make_symlink(outside, card() / "A.BIN", false))
+        GTEST_SKIP() << "the host makes no symlinks here";
     EXPECT_EQ(append("A.BIN", "evil"), EndCode::file_name_exists);
     EXPECT_EQ(slurp(outside), "keep");
     EXPECT_EQ(files.open_files(), 0U);
@@ -178,6 +189,8 @@ TEST_F(OpenFilesTest, FrameSerialFiles_4_1_HostSwapsAreNotFollowed) {
 
 TEST_F(OpenFilesTest, W342_5_3_34_BoundedIdleClosedAndReleasedAtDestruction) {
     const auto before = open_descriptors();
+    // Wine's GetProcessHandleCount says 0: there, only open_files() is checked.
+    const bool counted = before != 0;
     {
         FileMemory other(profile);
         ASSERT_TRUE(other.attach(dir / "other"));
@@ -195,19 +208,25 @@ TEST_F(OpenFilesTest, W342_5_3_34_BoundedIdleClosedAndReleasedAtDestruction) {
                       EndCode::normal_completion);
         }
         EXPECT_EQ(other.open_files(), FileMemory::max_open_files);
-        EXPECT_EQ(open_descriptors(), baseline + 2 * FileMemory::max_open_files);
+        if (counted) {
+            EXPECT_EQ(open_descriptors(), baseline + 2 * FileMemory::max_open_files);
+        }
         // Idle for longer than open_file_idle_seconds (CPU clock): closed at the next 22 03.
         const std::vector<std::uint8_t> one{1};
         ASSERT_EQ(other.write({disk_memory_card, 1, *FileName::from("G.BIN"), 0, one, ""},
                               100 + FileMemory::open_file_idle_seconds + 1),
                   EndCode::normal_completion);
         EXPECT_EQ(other.open_files(), 0U);
-        EXPECT_EQ(open_descriptors(), baseline);
+        if (counted) {
+            EXPECT_EQ(open_descriptors(), baseline);
+        }
         ASSERT_EQ(other.write({disk_memory_card, 2, *FileName::from("G.BIN"), 0, one, ""}, 200),
                   EndCode::normal_completion);
         EXPECT_EQ(other.open_files(), 1U);
     }
-    EXPECT_EQ(open_descriptors(), before);
+    if (counted) {
+        EXPECT_EQ(open_descriptors(), before);
+    }
 }
 
 }  // namespace

@@ -192,6 +192,9 @@ TEST_F(Retained, WholePlcRestoresIoMemoryAndRefusesAnotherProfile) {
 // Issue 6 item 6: after a clean stop, a changed byte in the retained section of any
 // model (I/O memory, parameter areas, program, clock, logs, messages) is refused, and
 // the file is served again once the byte is back.
+// Linux only: the test patches the state file through an fstream while Storage opens it;
+// Windows refuses that sharing on purpose (storage_os.hpp, docs/windows.md).
+#ifndef _WIN32
 TEST_F(Retained, WholePlcEverySectionIsUnderTheChecksums) {
     const Profile p = *find_profile("cj1m");
     {
@@ -229,6 +232,7 @@ TEST_F(Retained, WholePlcEverySectionIsUnderTheChecksums) {
     EXPECT_TRUE(plc.storage().seal());
     EXPECT_TRUE(plc.storage().checksums_verified());
 }
+#endif
 
 TEST_F(Retained, EveryProfileRoundTripsItsLayout) {
     for (const auto& p : profiles()) {

@@ -1,7 +1,9 @@
 // plc::Storage: heap mode, and the state file of a data directory (restore after a
 // reopen, refusal of foreign, damaged or mismatching files, the lock, creation that is
 // atomic at every step). Checksums, full disks and moving aside: state_file_test.cpp.
+#ifndef _WIN32
 #include <sys/wait.h>
+#endif
 #include <unistd.h>
 
 #include <algorithm>
@@ -273,6 +275,8 @@ TEST_F(StorageFile, UnsealedCreationLeavesNoStateFile) {
     EXPECT_EQ(fs::file_size(state()), 2u * 4096u);
 }
 
+// Linux only: the child process is fork()ed (docs/windows.md).
+#ifndef _WIN32
 // A child process builds a state file and ends itself (_exit: no destructor, no
 // flush, as SIGKILL would) at creation step `stop_at`; returns the steps it passed,
 // or -1 when it finished without reaching that step.
@@ -332,6 +336,8 @@ TEST_F(StorageFile, CreationEndedAtAnyStepLeavesNoStateFileOrACompleteOne) {
     // renamed, directory synced.
     EXPECT_EQ(steps, 9);
 }
+
+#endif
 
 TEST_F(StorageFile, DuplicateSectionOnCreationFailsSeal) {
     auto s = Storage::open(dir_, "p1");
