@@ -44,8 +44,8 @@ void RequestTracker::transmit(Request& request, SteadyTime now) {
 }
 
 Result<void> RequestTracker::submit(CommandCode command, Bytes parameters,
-                                    const RequestTiming& timing, Completion&& done,
-                                    SteadyTime now, const RequestOptions& options) {
+                                    const RequestTiming& timing, Completion&& done, SteadyTime now,
+                                    const RequestOptions& options) {
     if (timing.retries > max_retries)
         return Unexpected(make_error_code(ClientError::invalid_argument));
     if (header_size + command_code_size + parameters.size() > max_frame_)
@@ -213,7 +213,7 @@ bool RequestTracker::addresses_match(const Header& request, const Header& respon
 }
 
 RequestTracker::Disposition RequestTracker::on_frame(Bytes frame, SteadyTime now,
-                                                    AnswerCheck* check) {
+                                                     AnswerCheck* check) {
     auto response = decode_response(frame);
     if (!response) {
         ++stats_.invalid_discarded;

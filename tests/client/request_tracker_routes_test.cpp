@@ -91,8 +91,7 @@ TEST_F(TrackerRoutes, PerRequestDestinationAndSourceAreSentAndAnswered) {
     from_link_node[7] = plc.node;
     EXPECT_EQ(tracker.on_frame(from_link_node, t0), RequestTracker::Disposition::invalid);
     EXPECT_FALSE(own.result);
-    EXPECT_EQ(tracker.on_frame(answer(own_bytes), t0),
-              RequestTracker::Disposition::matched);
+    EXPECT_EQ(tracker.on_frame(answer(own_bytes), t0), RequestTracker::Disposition::matched);
     ASSERT_TRUE(own.result && own.result->has_value());
     EXPECT_EQ(tracker.on_frame(answer(last(), 0, {}, plc), t0),
               RequestTracker::Disposition::matched);
@@ -122,10 +121,9 @@ TEST_F(TrackerRoutes, RefusedSendFailsOnlyThatRequest) {
     EXPECT_TRUE(tracker.is_link_up());
     EXPECT_EQ(tracker.in_flight(), 1u);
     EXPECT_FALSE(good.result);
-    EXPECT_EQ(tracker.on_frame(answer(Bytes{good_frame.data(), good_frame.size()}, 0, {},
-                                      other_plc),
-                               t0),
-              RequestTracker::Disposition::matched);
+    EXPECT_EQ(
+        tracker.on_frame(answer(Bytes{good_frame.data(), good_frame.size()}, 0, {}, other_plc), t0),
+        RequestTracker::Disposition::matched);
     EXPECT_TRUE(good.result && good.result->has_value());
 }
 
@@ -150,7 +148,8 @@ TEST_F(TrackerRoutes, RefusedRetryFailsWithTheSinksErrorAndQuarantinesTheSid) {
     EXPECT_EQ(tracker.service_ids().quarantine(), default_timeout * default_quarantine_timeouts);
     // Its own 30 s, not the tracker's 4 s: still quarantined after 10 s.
     SidPool probe = tracker.service_ids();
-    for (int i = 0; i < 255; ++i) (void)probe.acquire(t0 + 10s);
+    for (int i = 0; i < 255; ++i)
+        (void)probe.acquire(t0 + 10s);
     EXPECT_FALSE(probe.acquire(t0 + 10s).has_value());
     EXPECT_TRUE(probe.acquire(t0 + 31s).has_value());
 }

@@ -141,8 +141,8 @@ struct NetworkInstructions::Link final : FrameSink, AnswerCheck {
         armed = next;
         const auto generation = ++timer_generation;
         timer.expires_at(*next);
-        timer.async_wait([this, generation, alive = std::weak_ptr<bool>(owner.alive_)](
-                             boost::system::error_code ec) {
+        timer.async_wait([this, generation,
+                          alive = std::weak_ptr<bool>(owner.alive_)](boost::system::error_code ec) {
             const auto a = alive.lock();
             if (ec || !a || !*a || generation != timer_generation) return;
             armed.reset();

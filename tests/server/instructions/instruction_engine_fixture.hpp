@@ -32,7 +32,9 @@ struct FakeTransport : InstructionTransport {
         way = route;
         return answer;
     }
-    void unanswered(const server::InstructionRoute& way) override { unanswered_routes.push_back(way); }
+    void unanswered(const server::InstructionRoute& way) override {
+        unanswered_routes.push_back(way);
+    }
     Sent answer = Sent::ok;
     // Where the remote node is (the node address table's entry).
     server::InstructionRoute route{{asio::ip::make_address("127.0.0.5"), 9600}, nullptr, 0};
