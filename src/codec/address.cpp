@@ -1,5 +1,6 @@
 // PLC address strings <-> Address <-> FINS memory addresses (W342 5-2-2).
 #include "fins/address.hpp"
+#include "codec/hex.hpp"
 #include "fins/address_names.hpp"
 
 #include <algorithm>
@@ -18,12 +19,6 @@ constexpr char upper(char c) noexcept {
 }
 constexpr bool is_digit(char c) noexcept {
     return c >= '0' && c <= '9';
-}
-constexpr int hex_value(char c) noexcept {
-    c = upper(c);
-    if (is_digit(c)) return c - '0';
-    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-    return -1;
 }
 
 // Case-insensitive "does text start with prefix".
@@ -174,7 +169,7 @@ Result<Address> parse_address(std::string_view text) {
             if (bank.empty()) return fail(AddressError::bad_number);
             unsigned v = 0;
             for (char c : bank) {
-                const int h = hex_value(c);
+                const int h = hex::digit_value(c);
                 if (h < 0) return fail(AddressError::bad_number);
                 v = std::min(v * 16 + static_cast<unsigned>(h), 0x100u);
             }

@@ -1,5 +1,6 @@
 // FINS over Host Link (W342 3-5, 5-3-1; fins-frames.md section 4). See fins/host_link.hpp.
 #include "fins/host_link.hpp"
+#include "codec/hex.hpp"
 
 #include <algorithm>
 #include <string>
@@ -58,18 +59,9 @@ struct AsciiWriter {
     }
 };
 
-int hex_value(std::uint8_t c) noexcept {
-    if (c >= '0' && c <= '9') return c - '0';
-    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-    return -1;
-}
-
 // Two hex characters -> a byte, or -1.
 int hex_byte(Bytes two) noexcept {
-    const int hi = hex_value(two[0]);
-    const int lo = hex_value(two[1]);
-    return hi < 0 || lo < 0 ? -1 : hi * 16 + lo;
+    return hex::byte_value(static_cast<char>(two[0]), static_cast<char>(two[1]));
 }
 
 class HostLinkEndCodeCategory final : public std::error_category {
@@ -298,7 +290,7 @@ tl::expected<HostLinkFrame, HostLinkDecodeError> decode_host_link(Bytes frame, b
         }
     } else {
         if (text_end - pos < 1) return Error(e);
-        const int wait = hex_value(frame[pos]);
+        const int wait = hex::digit_value(static_cast<char>(frame[pos]));
         if (wait < 0) return Error(e);
         f.wait = static_cast<std::uint8_t>(wait);
         pos += 1;

@@ -1,5 +1,6 @@
 // Modbus-RTU / Modbus-ASCII framing (see fins/modbus.hpp).
 #include "fins/modbus.hpp"
+#include "codec/hex.hpp"
 
 #include <array>
 
@@ -10,13 +11,6 @@ namespace {
 constexpr std::uint8_t cr = 0x0D;
 constexpr std::uint8_t lf = 0x0A;
 constexpr std::size_t crc_size = 2;
-
-int hex_value(std::uint8_t c) noexcept {
-    if (c >= '0' && c <= '9') return c - '0';
-    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-    return -1;
-}
 
 constexpr std::array<std::uint8_t, 16> digits{'0', '1', '2', '3', '4', '5', '6', '7',
                                               '8', '9', 'A', 'B', 'C', 'D', 'E', 'F'};
@@ -134,10 +128,9 @@ AsciiParse parse_ascii_frame(Bytes stream) noexcept {
 std::optional<std::size_t> hex_decode(Bytes ascii, MutableBytes out) noexcept {
     if (ascii.size() % 2 != 0 || ascii.size() / 2 > out.size()) return std::nullopt;
     for (std::size_t i = 0; i < ascii.size(); i += 2) {
-        const int high = hex_value(ascii[i]);
-        const int low = hex_value(ascii[i + 1]);
-        if (high < 0 || low < 0) return std::nullopt;
-        out[i / 2] = static_cast<std::uint8_t>(high * 16 + low);
+        const int b = hex::byte_value(static_cast<char>(ascii[i]), static_cast<char>(ascii[i + 1]));
+        if (b < 0) return std::nullopt;
+        out[i / 2] = static_cast<std::uint8_t>(b);
     }
     return ascii.size() / 2;
 }

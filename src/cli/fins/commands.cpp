@@ -1,7 +1,6 @@
 #include "cli/fins/commands.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -9,6 +8,7 @@
 
 #include <fmt/core.h>
 
+#include "codec/hex.hpp"
 #include "fins/address.hpp"
 #include "fins/address_names.hpp"
 #include "fins/client.hpp"
@@ -55,19 +55,10 @@ std::string hex_bytes(Bytes b) {
 }
 
 std::optional<std::vector<std::uint8_t>> parse_hex(const std::vector<std::string>& parts) {
-    std::string digits;
+    std::string text;
     for (const auto& p : parts)
-        for (char c : p)
-            if (c != ' ' && c != ':') digits += c;
-    if (digits.size() % 2 != 0) return std::nullopt;
-    std::vector<std::uint8_t> out;
-    for (std::size_t i = 0; i < digits.size(); i += 2) {
-        unsigned v = 0;
-        auto [p, ec] = std::from_chars(digits.data() + i, digits.data() + i + 2, v, 16);
-        if (ec != std::errc{} || p != digits.data() + i + 2) return std::nullopt;
-        out.push_back(static_cast<std::uint8_t>(v));
-    }
-    return out;
+        text += p;
+    return hex::parse_bytes(text, " :");
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "codec/hex.hpp"
 #include "server/instructions/instruction_schedule.hpp"
 #include "server/instructions/network_instructions.hpp"
 
@@ -19,25 +20,8 @@ std::string hex4(std::uint16_t v) {
     return fmt::format("{:04X}", v);
 }
 
-std::optional<std::vector<std::uint8_t>> parse_hex(std::string text) {
-    std::erase_if(text, [](char c) { return c == ' ' || c == ':' || c == '_'; });
-    if (text.size() % 2 != 0) return std::nullopt;
-    std::vector<std::uint8_t> out;
-    out.reserve(text.size() / 2);
-    for (std::size_t i = 0; i < text.size(); i += 2) {
-        unsigned v = 0;
-        for (std::size_t k = 0; k < 2; ++k) {
-            const char c = text[i + k];
-            const int d = (c >= '0' && c <= '9')   ? c - '0'
-                          : (c >= 'A' && c <= 'F') ? c - 'A' + 10
-                          : (c >= 'a' && c <= 'f') ? c - 'a' + 10
-                                                   : -1;
-            if (d < 0) return std::nullopt;
-            v = v * 16 + static_cast<unsigned>(d);
-        }
-        out.push_back(static_cast<std::uint8_t>(v));
-    }
-    return out;
+std::optional<std::vector<std::uint8_t>> parse_hex(const std::string& text) {
+    return hex::parse_bytes(text, " :_");
 }
 
 // A non-negative integer key with a default; nullopt when present but not one.
