@@ -168,7 +168,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "fins_web_plcs: cannot start the FINS server\n");
         return 1;
     }
-    // What finsd's describe hook adds to an entry (cli/finsd/web_setup.cpp): the relay
+    // What finsd's describe hook adds to an entry (finsd/web_setup.cpp): the relay
     // counts and the unit's ports (every unit here reports the one FINS server's).
     const auto* server = (*fins_server).get();
     context.describe = [server](const fins::server::ControlTarget&, nlohmann::json& entry) {

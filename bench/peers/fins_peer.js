@@ -4,7 +4,7 @@
 // MEMORY AREA READ and published, all of them, as fins-bridge's `always` mode does:
 // `{prefix}/p{i}/g` `{"ts":ms,"values":{"t0":v,...}}` (ts: when the answer arrived).
 //
-// The cycles follow fins-bridge's rule (src/bridge/poll_schedule.hpp), so that the two
+// The cycles follow fins-bridge's rule (src/bridge/poll/poll_schedule.hpp), so that the two
 // overrun counts mean the same: cycle k of PLC i is due at start + phase_i + k x interval
 // whatever the earlier ones cost; a timer that fires after the next grid point skips the
 // points it missed, and a cycle due while the PLC's previous read is still in flight is

@@ -19,15 +19,15 @@
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/post.hpp>
 
-#include "cli/finsd/config.hpp"
-#include "cli/finsd/config_scenario.hpp"
-#include "cli/finsd/scenario_setup.hpp"
+#include "finsd/config.hpp"
+#include "finsd/config_scenario.hpp"
+#include "finsd/scenario_setup.hpp"
 #include "errors.hpp"
 #include "fins/address.hpp"
 #include "plc/injections.hpp"
 #include "plc/plc.hpp"
 #include "plc/profile.hpp"
-#include "plc/storage.hpp"
+#include "plc/storage/storage.hpp"
 #include "scenario/scenario.hpp"
 #include "server/scenario/scenario_control.hpp"
 #include "server/scenario/scenario_runner.hpp"
@@ -81,7 +81,7 @@ class VirtualPlc {
         if (level == spdlog::level::off && log_level != "off")
             throw BadArgument("log_level must be trace, debug, info, warn, error or off");
         spdlog::set_level(level);
-        const auto parsed_mode = fins::cli::finsd::parse_mode(mode);
+        const auto parsed_mode = fins::finsd::parse_mode(mode);
         if (!parsed_mode) throw BadArgument("mode must be program, monitor or run");
         auto model = find(profile);
         std::unique_ptr<fins::plc::Storage> storage;
@@ -158,7 +158,7 @@ class VirtualPlc {
         });
     }
     void set_mode(const std::string& mode) {
-        const auto parsed = fins::cli::finsd::parse_mode(mode);
+        const auto parsed = fins::finsd::parse_mode(mode);
         if (!parsed) throw BadArgument("mode must be program, monitor or run");
         on_plc([&] {
             plc_->change_mode(*parsed, std::chrono::system_clock::now());
@@ -220,13 +220,13 @@ class VirtualPlc {
   private:
     void start_scenario(const ScenarioSource& source) {
         auto loaded = source.is_text
-                          ? fins::cli::finsd::load_scenario_text(source.value, "<scenario>")
-                          : fins::cli::finsd::load_scenario_file(source.value);
+                          ? fins::finsd::load_scenario_text(source.value, "<scenario>")
+                          : fins::finsd::load_scenario_file(source.value);
         if (!loaded) throw BadArgument(loaded.error());
-        auto compiled = fins::cli::finsd::compile_scenario(*loaded, *plc_);
+        auto compiled = fins::finsd::compile_scenario(*loaded, *plc_);
         if (!compiled) throw BadArgument(compiled.error());
         // Started before the I/O thread runs: its first real-time tick is on that thread.
-        scenario_ = fins::cli::finsd::run_scenario(io_, std::optional(std::move(*loaded)),
+        scenario_ = fins::finsd::run_scenario(io_, std::optional(std::move(*loaded)),
                                                    std::move(*compiled), *plc_, std::nullopt,
                                                    scenario_worker_);
         server_->dispatcher().attach_faults(scenario_.get());

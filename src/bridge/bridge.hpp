@@ -47,8 +47,8 @@
 #include "bridge/mqtt.hpp"
 #include "bridge/ownership.hpp"
 #include "bridge/payload.hpp"
-#include "bridge/poller.hpp"
-#include "bridge/tag_failures.hpp"
+#include "bridge/poll/poller.hpp"
+#include "bridge/poll/tag_failures.hpp"
 
 namespace fins::bridge {
 

@@ -53,7 +53,7 @@
 
 #include "bridge/config.hpp"
 #include "bridge/payload.hpp"
-#include "bridge/poll_schedule.hpp"
+#include "bridge/poll/poll_schedule.hpp"
 
 struct mosquitto;
 struct mosquitto_message;

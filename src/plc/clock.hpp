@@ -22,7 +22,7 @@
 #include "fins/error.hpp"
 #include "plc/io_memory.hpp"
 #include "plc/profile.hpp"
-#include "plc/storage.hpp"
+#include "plc/storage/storage.hpp"
 
 namespace fins::plc {
 

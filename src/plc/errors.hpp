@@ -27,7 +27,7 @@
 
 #include "fins/commands/error_log.hpp"
 #include "plc/profile.hpp"
-#include "plc/storage.hpp"
+#include "plc/storage/storage.hpp"
 
 namespace fins::plc {
 

@@ -41,7 +41,7 @@
 #include "fins/error.hpp"
 #include "fins/memory_area.hpp"
 #include "plc/profile.hpp"
-#include "plc/storage.hpp"
+#include "plc/storage/storage.hpp"
 
 namespace fins::plc {
 

@@ -11,7 +11,7 @@
 #include <string_view>
 
 #include "plc/profile.hpp"
-#include "plc/storage.hpp"
+#include "plc/storage/storage.hpp"
 
 namespace fins::plc {
 

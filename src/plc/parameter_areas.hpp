@@ -36,7 +36,7 @@
 #include "fins/commands/parameter_area.hpp"
 #include "fins/error.hpp"
 #include "plc/profile.hpp"
-#include "plc/storage.hpp"
+#include "plc/storage/storage.hpp"
 
 namespace fins::plc {
 

@@ -21,7 +21,7 @@
 #include "fins/frame.hpp"
 #include "plc/clock.hpp"
 #include "plc/errors.hpp"
-#include "plc/file_memory.hpp"
+#include "plc/file_memory/file_memory.hpp"
 #include "plc/io_memory.hpp"
 #include "plc/loop_control.hpp"
 #include "plc/messages.hpp"
@@ -29,7 +29,7 @@
 #include "plc/profile.hpp"
 #include "plc/program.hpp"
 #include "plc/scan_cycle.hpp"
-#include "plc/storage.hpp"
+#include "plc/storage/storage.hpp"
 #include "plc/write_access_log.hpp"
 
 namespace fins::plc {

@@ -32,7 +32,7 @@
 #include "fins/commands/status.hpp"
 #include "plc/io_memory.hpp"
 #include "plc/profile.hpp"
-#include "plc/storage.hpp"
+#include "plc/storage/storage.hpp"
 
 namespace fins::plc {
 

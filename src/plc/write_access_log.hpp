@@ -21,7 +21,7 @@
 #include "fins/error.hpp"
 #include "fins/frame.hpp"
 #include "plc/profile.hpp"
-#include "plc/storage.hpp"
+#include "plc/storage/storage.hpp"
 
 namespace fins::plc {
 

@@ -1,5 +1,5 @@
 // A scenario as its file states it: tags (signals and links), inputs and events. Data only;
-// the loader (src/cli/finsd/config_scenario.cpp) fills it from TOML, Scenario::compile()
+// the loader (src/finsd/config_scenario.cpp) fills it from TOML, Scenario::compile()
 // checks it against a CPU Unit and turns it into something that runs. Every field the
 // file can get wrong carries the position of its TOML value so that compile errors point
 // at file:line:col.

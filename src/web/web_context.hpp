@@ -1,5 +1,5 @@
 // What finsd's HTTP/WebSocket front (src/web/) serves and under which rules. Built by
-// finsd (cli/finsd/web_setup) for a single node or a plant; read by the pure request
+// finsd (finsd/web_setup) for a single node or a plant; read by the pure request
 // handler (api.hpp), the WebSocket subscriptions (subscriptions.hpp) and the sessions.
 #pragma once
 

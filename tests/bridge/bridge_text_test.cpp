@@ -6,7 +6,7 @@
 #include <array>
 
 #include "bridge/json_payload.hpp"
-#include "bridge/tag_decode.hpp"
+#include "bridge/poll/tag_decode.hpp"
 #include "bridge_rig.hpp"
 
 namespace fins::bridge::test {

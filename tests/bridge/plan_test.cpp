@@ -1,5 +1,5 @@
 // The planner: tags in, frames out (plan.hpp).
-#include "bridge/plan.hpp"
+#include "bridge/poll/plan.hpp"
 
 #include <gtest/gtest.h>
 

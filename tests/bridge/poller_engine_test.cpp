@@ -13,7 +13,7 @@
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/udp.hpp>
 
-#include "bridge/poller.hpp"
+#include "bridge/poll/poller.hpp"
 #include "bridge_test_support.hpp"
 
 namespace fins::bridge {

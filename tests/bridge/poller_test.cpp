@@ -8,7 +8,7 @@
 #include <set>
 #include <vector>
 
-#include "bridge/poll_schedule.hpp"
+#include "bridge/poll/poll_schedule.hpp"
 #include "fins/commands/memory_area.hpp"
 
 namespace fins::bridge {

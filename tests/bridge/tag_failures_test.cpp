@@ -1,7 +1,7 @@
-// A PLC online whose every tag fails with an end code (bridge/tag_failures.hpp): its
+// A PLC online whose every tag fails with an end code (bridge/poll/tag_failures.hpp): its
 // status turns "failing" with the dest hint once every group's last cycle failed, and
 // "online" again at the first value; timeouts (the poller's offline path) do not count.
-#include "bridge/tag_failures.hpp"
+#include "bridge/poll/tag_failures.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,13 +1,13 @@
 // finsd's serial ports (issue 9): --serial NAME=DEVICE[,...] and the [serial] table,
-// parsed directly (cli/finsd/config_serial.hpp), no processes.
+// parsed directly (finsd/config_serial.hpp), no processes.
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
-#include "cli/finsd/config.hpp"
+#include "finsd/config.hpp"
 
-namespace fins::cli::finsd {
+namespace fins::finsd {
 namespace {
 
 TEST(FinsdSerialConfig, W342_3_5_CpuPortDefaultsToHostLink9600_7E2Unit0) {
@@ -144,4 +144,4 @@ TEST(FinsdSerialConfig, CrossChecks) {
 }
 
 }  // namespace
-}  // namespace fins::cli::finsd
+}  // namespace fins::finsd

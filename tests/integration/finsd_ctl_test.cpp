@@ -16,7 +16,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "cli/finsd/control_setup.hpp"
+#include "finsd/control_setup.hpp"
 #include "finsd_run.hpp"
 #include "raw_socket.hpp"
 
@@ -134,8 +134,8 @@ TEST(FinsdCtl, Newcomer6_FinsdAndCtlShareTheDefaultSocket) {
     const char* saved = std::getenv("FINSD_SOCKET");
     const std::string before = saved != nullptr ? saved : "";
     ::setenv("FINSD_SOCKET", "/tmp/x.sock", 1);
-    EXPECT_EQ(cli::default_control_socket(), "/tmp/x.sock");
-    EXPECT_EQ(cli::default_control_sockets(), std::vector<std::filesystem::path>{"/tmp/x.sock"});
+    EXPECT_EQ(finsd::default_control_socket(), "/tmp/x.sock");
+    EXPECT_EQ(finsd::default_control_sockets(), std::vector<std::filesystem::path>{"/tmp/x.sock"});
     ::unsetenv("FINSD_SOCKET");
     const char* xdg = std::getenv("XDG_RUNTIME_DIR");
     const std::filesystem::path own =
@@ -143,12 +143,12 @@ TEST(FinsdCtl, Newcomer6_FinsdAndCtlShareTheDefaultSocket) {
             ? std::filesystem::path("/run/finsd/finsd.sock")
             : std::filesystem::path("/tmp/finsd-" + std::to_string(::geteuid())) / "finsd.sock";
     if (xdg == nullptr || *xdg == '\0') {
-        EXPECT_EQ(cli::default_control_socket(), own);
-        EXPECT_EQ(cli::default_control_sockets(), std::vector<std::filesystem::path>{own});
+        EXPECT_EQ(finsd::default_control_socket(), own);
+        EXPECT_EQ(finsd::default_control_sockets(), std::vector<std::filesystem::path>{own});
     } else {
         const auto first = std::filesystem::path(xdg) / "finsd.sock";
-        EXPECT_EQ(cli::default_control_socket(), first);
-        EXPECT_EQ(cli::default_control_sockets(), (std::vector<std::filesystem::path>{first, own}));
+        EXPECT_EQ(finsd::default_control_socket(), first);
+        EXPECT_EQ(finsd::default_control_sockets(), (std::vector<std::filesystem::path>{first, own}));
     }
     if (!before.empty()) ::setenv("FINSD_SOCKET", before.c_str(), 1);
 }
@@ -205,34 +205,34 @@ TEST(FinsdCtl, Issue26_8_SocketDirectoryIsCreatedAndCheckedBeforeUse) {
     ScratchDir dir("ctldir");
     const uid_t me = ::geteuid();
     const auto fresh = dir.path() / "finsd-fresh";
-    EXPECT_EQ(cli::prepare_socket_directory(fresh, 0700, me), "");
+    EXPECT_EQ(finsd::prepare_socket_directory(fresh, 0700, me), "");
     struct stat st {};
     ASSERT_EQ(::lstat(fresh.c_str(), &st), 0);
     EXPECT_EQ(st.st_mode & 07777, 0700u);
-    EXPECT_EQ(cli::prepare_socket_directory(fresh, 0700, me), "");  // again: still fine
+    EXPECT_EQ(finsd::prepare_socket_directory(fresh, 0700, me), "");  // again: still fine
 
     const auto shared = dir.path() / "finsd-shared";
     ASSERT_EQ(::mkdir(shared.c_str(), 0700), 0);
     ASSERT_EQ(::chmod(shared.c_str(), 0777), 0);
-    EXPECT_TRUE(has(cli::prepare_socket_directory(shared, 0700, me), "has mode 0777"));
+    EXPECT_TRUE(has(finsd::prepare_socket_directory(shared, 0700, me), "has mode 0777"));
     ASSERT_EQ(::chmod(shared.c_str(), 0755), 0);
-    EXPECT_TRUE(has(cli::prepare_socket_directory(shared, 0700, me), "has mode 0755"));
-    EXPECT_EQ(cli::prepare_socket_directory(shared, 0755, me), "");  // /run/finsd's mode
+    EXPECT_TRUE(has(finsd::prepare_socket_directory(shared, 0700, me), "has mode 0755"));
+    EXPECT_EQ(finsd::prepare_socket_directory(shared, 0755, me), "");  // /run/finsd's mode
 
     const auto link = dir.path() / "finsd-link";
     std::filesystem::create_directory_symlink(fresh, link);
-    EXPECT_TRUE(has(cli::prepare_socket_directory(link, 0700, me), "is a symbolic link"));
+    EXPECT_TRUE(has(finsd::prepare_socket_directory(link, 0700, me), "is a symbolic link"));
     const auto file = dir.write("finsd-file", "x");
-    EXPECT_TRUE(has(cli::prepare_socket_directory(file, 0700, me), "is not a directory"));
+    EXPECT_TRUE(has(finsd::prepare_socket_directory(file, 0700, me), "is not a directory"));
 
-    EXPECT_TRUE(has(cli::prepare_socket_directory(fresh, 0700, me + 1),
+    EXPECT_TRUE(has(finsd::prepare_socket_directory(fresh, 0700, me + 1),
                     "is owned by uid " + std::to_string(me)));
     if (me == 0) {
         const auto theirs = dir.path() / "finsd-theirs";
         ASSERT_EQ(::mkdir(theirs.c_str(), 0700), 0);
         ASSERT_EQ(::chown(theirs.c_str(), 65534, 65534), 0);
         EXPECT_TRUE(
-            has(cli::prepare_socket_directory(theirs, 0700, 0), "is owned by uid 65534, not 0"));
+            has(finsd::prepare_socket_directory(theirs, 0700, 0), "is owned by uid 65534, not 0"));
     }
 }
 

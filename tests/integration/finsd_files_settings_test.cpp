@@ -2,9 +2,9 @@
 // capacity, the first EM file bank, each checked with the key named on error.
 #include <gtest/gtest.h>
 
-#include "cli/finsd/config.hpp"
+#include "finsd/config.hpp"
 
-namespace fins::cli::finsd {
+namespace fins::finsd {
 namespace {
 
 Expected<Settings> load(std::string_view text) {
@@ -61,4 +61,4 @@ TEST(FinsdFilesSettings, CassetteOnlyWhereTheProfileHasASlot) {
 }
 
 }  // namespace
-}  // namespace fins::cli::finsd
+}  // namespace fins::finsd

@@ -1,12 +1,12 @@
-// The [[plc]] configuration (cli/finsd/config_plant.hpp; README "A plant of several
+// The [[plc]] configuration (finsd/config_plant.hpp; README "A plant of several
 // networks"): parsed keys, positioned errors, and the plant's cross-field checks.
 #include <gtest/gtest.h>
 
-#include "cli/finsd/config.hpp"
-#include "cli/finsd/config_plant.hpp"
+#include "finsd/config.hpp"
+#include "finsd/config_plant.hpp"
 #include "server/routing/plant.hpp"
 
-namespace fins::cli::finsd {
+namespace fins::finsd {
 namespace {
 
 Expected<Settings> load(std::string_view text) {
@@ -377,4 +377,4 @@ tcp_max_pending = 4
 }
 
 }  // namespace
-}  // namespace fins::cli::finsd
+}  // namespace fins::finsd

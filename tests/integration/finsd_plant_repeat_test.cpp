@@ -4,11 +4,11 @@
 // the position, the key and the CPU Unit.
 #include <gtest/gtest.h>
 
-#include "cli/finsd/config.hpp"
-#include "cli/finsd/config_plant.hpp"
+#include "finsd/config.hpp"
+#include "finsd/config_plant.hpp"
 #include "server/routing/plant.hpp"
 
-namespace fins::cli::finsd {
+namespace fins::finsd {
 namespace {
 
 Expected<Settings> load(std::string_view text) {
@@ -124,4 +124,4 @@ TEST(FinsdPlantRepeat, TwoCpuUnitsOnOneDataDirAreRefused) {
 }
 
 }  // namespace
-}  // namespace fins::cli::finsd
+}  // namespace fins::finsd

@@ -1,10 +1,10 @@
 // finsd's settings without a process: the TOML loader, flag overrides, validation and
-// the [memory] initial values (src/cli/finsd/config.hpp, linked from fins_finsd).
-#include "cli/finsd/config.hpp"
+// the [memory] initial values (src/finsd/config.hpp, linked from fins_finsd).
+#include "finsd/config.hpp"
 
 #include <gtest/gtest.h>
 
-namespace fins::cli::finsd {
+namespace fins::finsd {
 namespace {
 
 using plc::NetworkWriteProtection;
@@ -269,4 +269,4 @@ TEST(FinsdSettings, RetainedEntriesAreSkippedOnARestoredState) {
 }
 
 }  // namespace
-}  // namespace fins::cli::finsd
+}  // namespace fins::finsd

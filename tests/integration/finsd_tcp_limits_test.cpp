@@ -1,10 +1,10 @@
 // finsd's FINS/TCP limit keys and flags (README "FINS/TCP identity and limits"): the
 // defaults, the [network] keys, their ranges and the flags that override them.
-#include "cli/finsd/config.hpp"
+#include "finsd/config.hpp"
 
 #include <gtest/gtest.h>
 
-namespace fins::cli::finsd {
+namespace fins::finsd {
 namespace {
 
 TEST(FinsdTcpLimits, DefaultsKeysRangesAndFlags) {
@@ -48,4 +48,4 @@ tcp_max_pending = 5
 }
 
 }  // namespace
-}  // namespace fins::cli::finsd
+}  // namespace fins::finsd

@@ -12,9 +12,9 @@
 
 #include <gtest/gtest.h>
 
-#include "cli/finsd/config.hpp"
+#include "finsd/config.hpp"
 #include "finsd_run.hpp"
-#include "plc/storage_guard.hpp"
+#include "plc/storage/storage_guard.hpp"
 
 namespace fins::test {
 namespace {
@@ -181,33 +181,33 @@ TEST(FinsdStateFile, TruncatedThenStoppedExits4AndWritesNothing) {
 }
 
 TEST(FinsdStateFile, StorageKeysAndFlags) {
-    using cli::finsd::Settings;
+    using finsd::Settings;
     Settings s;
     EXPECT_EQ(s.durability, plc::Durability::process);
-    ASSERT_TRUE(cli::finsd::load_config_text("[storage]\ndurability = \"power\"\n", "t.toml", s));
+    ASSERT_TRUE(finsd::load_config_text("[storage]\ndurability = \"power\"\n", "t.toml", s));
     EXPECT_EQ(s.durability, plc::Durability::power);
     const auto bad =
-        cli::finsd::load_config_text("[storage]\ndurability = \"disk\"\n", "t.toml", s);
+        finsd::load_config_text("[storage]\ndurability = \"disk\"\n", "t.toml", s);
     ASSERT_FALSE(bad);
     EXPECT_EQ(bad.error(), "t.toml:2:1: storage.durability: 'disk' is not process or power");
-    const auto unknown = cli::finsd::load_config_text("[storage]\nreset = true\n", "t.toml", s);
+    const auto unknown = finsd::load_config_text("[storage]\nreset = true\n", "t.toml", s);
     ASSERT_FALSE(unknown);
     EXPECT_EQ(unknown.error(), "t.toml:2:1: storage.reset: unknown key");
-    cli::finsd::Overrides o;
+    finsd::Overrides o;
     o.durability = "process";
     o.reset_state = true;
-    ASSERT_TRUE(cli::finsd::apply_overrides(o, s));
+    ASSERT_TRUE(finsd::apply_overrides(o, s));
     EXPECT_EQ(s.durability, plc::Durability::process);
     EXPECT_TRUE(s.reset_state);
     Finsd flag({"--durability", "sometimes"});
     EXPECT_EQ(flag.result().exit_code, 2);
     s.durability = plc::Durability::power;
-    const auto without_dir = cli::finsd::validate(s);
+    const auto without_dir = finsd::validate(s);
     ASSERT_FALSE(without_dir);
     EXPECT_EQ(without_dir.error(),
               "storage.durability: \"power\" needs data_dir (without one nothing is kept)");
     s.data_dir = "/tmp/d";
-    EXPECT_TRUE(cli::finsd::validate(s));
+    EXPECT_TRUE(finsd::validate(s));
 }
 
 }  // namespace

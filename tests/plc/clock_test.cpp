@@ -13,7 +13,7 @@
 
 #include "plc/clock.hpp"
 #include "plc/plc.hpp"
-#include "plc/storage.hpp"
+#include "plc/storage/storage.hpp"
 
 namespace fins::plc::test {
 namespace {

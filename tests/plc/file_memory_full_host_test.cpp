@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "plc/file_memory.hpp"
+#include "plc/file_memory/file_memory.hpp"
 
 namespace fins::plc {
 namespace {

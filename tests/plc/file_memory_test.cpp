@@ -9,7 +9,7 @@
 #include <fstream>
 #include <string>
 
-#include "plc/file_memory.hpp"
+#include "plc/file_memory/file_memory.hpp"
 #include "plc/file_memory_test_util.hpp"
 
 namespace fins::plc {

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "plc/io_memory.hpp"
-#include "plc/storage.hpp"
+#include "plc/storage/storage.hpp"
 
 namespace fins::plc::test {
 

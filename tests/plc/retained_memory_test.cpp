@@ -14,7 +14,7 @@
 
 #include "plc/io_memory_test_util.hpp"
 #include "plc/plc.hpp"
-#include "plc/storage.hpp"
+#include "plc/storage/storage.hpp"
 
 namespace fins::plc::test {
 namespace {

@@ -23,9 +23,9 @@
 
 #include <gtest/gtest.h>
 
-#include "plc/crc32c.hpp"
-#include "plc/storage.hpp"
-#include "plc/storage_guard.hpp"
+#include "plc/storage/crc32c.hpp"
+#include "plc/storage/storage.hpp"
+#include "plc/storage/storage_guard.hpp"
 
 namespace fins::plc::test {
 namespace {

@@ -18,7 +18,7 @@
 
 #include <gtest/gtest.h>
 
-#include "plc/storage.hpp"
+#include "plc/storage/storage.hpp"
 
 namespace fins::plc::test {
 namespace {

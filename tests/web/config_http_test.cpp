@@ -1,16 +1,16 @@
-// finsd's [http] table and --http flags (cli/finsd/config_http.hpp): what is accepted,
+// finsd's [http] table and --http flags (finsd/config_http.hpp): what is accepted,
 // and the refusals that keep a controllable server off the network without a token.
 #include <gtest/gtest.h>
 
 #include <string>
 
-#include "cli/finsd/config.hpp"
-#include "cli/finsd/config_http.hpp"
+#include "finsd/config.hpp"
+#include "finsd/config_http.hpp"
 
 namespace fins::test {
 namespace {
 
-using namespace fins::cli::finsd;
+using namespace fins::finsd;
 
 TEST(ConfigHttp, ParsesListenAddresses) {
     EXPECT_EQ(*parse_http_listen("127.0.0.1:8080"),

@@ -1,11 +1,11 @@
-// finsd's start of the HTTP front (cli/finsd/web_setup.hpp): the token file is read and
+// finsd's start of the HTTP front (finsd/web_setup.hpp): the token file is read and
 // required by POSTs, a missing one stops finsd with exit 2, no --http starts nothing.
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 
-#include "cli/finsd/web_setup.hpp"
+#include "finsd/web_setup.hpp"
 #include "web_server.hpp"
 
 namespace fins::test {
@@ -16,19 +16,19 @@ TEST(WebSetup, ReadsTheTokenFileAndServes) {
     plc::Plc plc;
     server::ControlTarget t;
     t.plc = &plc;
-    cli::finsd::HttpSettings http;
-    EXPECT_EQ(cli::finsd::start_web(io, http, {t}, {}).server, nullptr);  // no --http
+    finsd::HttpSettings http;
+    EXPECT_EQ(finsd::start_web(io, http, {t}, {}).server, nullptr);  // no --http
 
     http.listen = "127.0.0.1:0";
     http.control = true;
     http.token_file =
         std::filesystem::temp_directory_path() / ("finskit-token-" + std::to_string(::getpid()));
-    auto missing = cli::finsd::start_web(io, http, {t}, {});
+    auto missing = finsd::start_web(io, http, {t}, {});
     EXPECT_EQ(missing.exit_code, 2);
     EXPECT_NE(missing.error.find("--http-token-file"), std::string::npos);
 
     std::ofstream(*http.token_file) << "  s3cret \n";
-    auto started = cli::finsd::start_web(io, http, {t}, {});
+    auto started = finsd::start_web(io, http, {t}, {});
     ASSERT_NE(started.server, nullptr) << started.error;
     std::thread runner([&] { io.run(); });
     {

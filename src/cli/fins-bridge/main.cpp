@@ -13,7 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "bridge/config.hpp"
-#include "bridge/plan.hpp"
+#include "bridge/poll/plan.hpp"
 #include "bridge/run.hpp"
 
 int main(int argc, char** argv) {

@@ -11,7 +11,7 @@
 // Exit codes: 0 clean shutdown (SIGINT/SIGTERM: the state file is closed cleanly, with
 // checksums), 2 usage or configuration error, 3 start-up failure (cannot bind, state
 // file refused, in use or without room on disk, control socket), 4 the state file shrank
-// while finsd ran (truncated from outside: plc/storage_guard.hpp).
+// while finsd ran (truncated from outside: plc/storage/storage_guard.hpp).
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -31,20 +31,20 @@
 #include <boost/asio/signal_set.hpp>
 #include <boost/asio/steady_timer.hpp>
 
-#include "cli/finsd/config.hpp"
-#include "cli/finsd/config_plant.hpp"
-#include "cli/finsd/control_setup.hpp"
-#include "cli/finsd/ctl.hpp"
-#include "cli/finsd/process_os.hpp"
-#include "cli/finsd/scenario_setup.hpp"
-#include "cli/finsd/serial_gateway_setup.hpp"
-#include "cli/finsd/serial_ports.hpp"
-#include "cli/finsd/web_setup.hpp"
+#include "finsd/config.hpp"
+#include "finsd/config_plant.hpp"
+#include "finsd/control_setup.hpp"
+#include "finsd/ctl.hpp"
+#include "finsd/process_os.hpp"
+#include "finsd/scenario_setup.hpp"
+#include "finsd/serial_gateway_setup.hpp"
+#include "finsd/serial_ports.hpp"
+#include "finsd/web_setup.hpp"
 #include "plc/plc.hpp"
 #include "plc/profile.hpp"
-#include "plc/storage.hpp"
-#include "plc/storage_format.hpp"
-#include "plc/storage_guard.hpp"
+#include "plc/storage/storage.hpp"
+#include "plc/storage/storage_format.hpp"
+#include "plc/storage/storage_guard.hpp"
 #include "scenario/scenario.hpp"
 #include "server/control/control.hpp"
 #include "server/instructions/instruction_schedule.hpp"
@@ -54,8 +54,8 @@
 
 namespace {
 
-using fins::cli::finsd::Overrides;
-using fins::cli::finsd::Settings;
+using fins::finsd::Overrides;
+using fins::finsd::Settings;
 
 template <class T>
 void take(CLI::Option* option, const T& value, std::optional<T>& out) {
@@ -68,7 +68,7 @@ int fail(int code, const std::string& message) {
 }
 
 // The profile a foreign state file was written for, to name it in the refusal: the
-// header holds the profile name NUL-terminated (plc/storage.cpp), so look for each known
+// header holds the profile name NUL-terminated (plc/storage/storage.cpp), so look for each known
 // name there rather than depend on the header's offsets.
 std::string state_file_profile(const std::filesystem::path& dir) {
     std::ifstream f(dir / "finsd.state", std::ios::binary);
@@ -183,8 +183,8 @@ int configure(int argc, char** argv, Settings& settings) {
     app.add_option("--serial", o.serial,
                    "Serial port NAME=DEVICE[,baud=9600,parity=even,data=7,stop=2,unit=0,mode=..."
                    ",timeout=1]; NAME cpu, scuN.P or board.P (repeatable; docs/serial.md)");
-    fins::cli::finsd::HttpFlags http;
-    fins::cli::finsd::add_http_flags(app, http);
+    fins::finsd::HttpFlags http;
+    fins::finsd::add_http_flags(app, http);
 
     std::string scenario_file;
     auto* o_scenario = app.add_option(
@@ -214,12 +214,12 @@ int configure(int argc, char** argv, Settings& settings) {
             return fail(2,
                         "--scenario is for a single node: give each [[plc]] its own "
                         "[plc.scenario] (docs/scenarios.md)");
-        auto loaded = fins::cli::finsd::load_scenario_file(scenario_file);
+        auto loaded = fins::finsd::load_scenario_file(scenario_file);
         if (!loaded) return fail(2, loaded.error());
         settings.scenario = std::move(*loaded);
     }
     if (o_time->count() > 0)
-        if (auto r = fins::cli::finsd::override_scenario_time(settings, scenario_time); !r)
+        if (auto r = fins::finsd::override_scenario_time(settings, scenario_time); !r)
             return fail(2, r.error());
     take(o_profile, profile, o.profile);
     take(o_mode, mode, o.mode);
@@ -244,7 +244,7 @@ int configure(int argc, char** argv, Settings& settings) {
     take(o_durability, durability, o.durability);
     if (auto r = apply_overrides(o, settings); !r) return fail(2, r.error());
     if (auto r = validate(settings); !r) return fail(2, r.error());
-    fins::cli::finsd::apply_http_flags(http, settings.http);
+    fins::finsd::apply_http_flags(http, settings.http);
     if (auto r = check_http(settings.http); !r) return fail(2, r.error());
     // A node list protects nothing unless the mode reads it: refuse the flag rather than
     // let someone believe those nodes are refused (or, under "all", the only ones).
@@ -301,10 +301,10 @@ int open_plc(const Settings& s, const fins::plc::Profile& profile,
 
 int serve(const Settings& s) {
     spdlog::set_level(spdlog::level::from_str(s.log_level));
-    fins::cli::finsd::ignore_file_size_signal();
+    fins::finsd::ignore_file_size_signal();
     fins::plc::Profile profile = *fins::plc::find_profile(s.profile);
     if (s.dip_write_protection) profile.dip_switch |= fins::plc::dip_pin1;
-    if (auto r = fins::cli::finsd::mount_serial_units(s.serial, profile); !r)
+    if (auto r = fins::finsd::mount_serial_units(s.serial, profile); !r)
         return fail(2, r.error());
 
     std::unique_ptr<fins::plc::Plc> plc_owner;
@@ -326,11 +326,11 @@ int serve(const Settings& s) {
     const auto written = apply_initial_memory(s.memory, plc.memory(), restored);
     if (!s.memory.empty()) spdlog::info("finsd: {} [memory] entries written", written);
     plc.change_mode(s.mode, std::chrono::system_clock::now());
-    fins::cli::finsd::apply_cpu_options(s, plc);
+    fins::finsd::apply_cpu_options(s, plc);
     // [scenario], --scenario: compiled against this CPU Unit; every error is a start error.
     std::unique_ptr<fins::scenario::Scenario> scenario;
     if (s.scenario) {
-        auto compiled = fins::cli::finsd::compile_scenario(*s.scenario, plc);
+        auto compiled = fins::finsd::compile_scenario(*s.scenario, plc);
         if (!compiled) return fail(2, compiled.error());
         scenario = std::move(*compiled);
     }
@@ -339,8 +339,8 @@ int serve(const Settings& s) {
         return fail(3, refused->message);
 
     // The same translation as each unit of a plant gets (server/routing/plant.hpp).
-    auto options = fins::server::options_for(fins::cli::finsd::single_unit(s),
-                                             fins::cli::finsd::tcp_limits(s));
+    auto options = fins::server::options_for(fins::finsd::single_unit(s),
+                                             fins::finsd::tcp_limits(s));
     options.remotes = s.remotes;
     asio::io_context io{1};
     auto server = fins::server::Server::start(io, plc, options);
@@ -356,12 +356,12 @@ int serve(const Settings& s) {
     schedule.start();
     // Serial Gateway ports (scuN.P / board.P in mode gateway): serial_gateway_setup.hpp.
     fins::server::SerialPorts gateway_ports;
-    fins::cli::finsd::open_gateway_ports(io, s.serial, gateway_ports);
+    fins::finsd::open_gateway_ports(io, s.serial, gateway_ports);
     (*server)->attach_serial_ports(&gateway_ports);
     // The scenario's ticks are computed on finsd's scenario thread, handed over on this
     // io_context; its unit faults reach the dispatcher.
     std::unique_ptr<fins::server::ScenarioWorker> scenario_worker;
-    auto runner = fins::cli::finsd::run_scenario(io, s.scenario, std::move(scenario), plc,
+    auto runner = fins::finsd::run_scenario(io, s.scenario, std::move(scenario), plc,
                                                  std::nullopt, scenario_worker);
     if (runner) (*server)->dispatcher().attach_faults(runner.get());
     // --control, FINSD_SOCKET or the default path (control_setup.hpp).
@@ -372,12 +372,12 @@ int serve(const Settings& s) {
     target.instructions = &(*server)->instructions();
     target.schedule = &schedule;
     // --http (docs/web.md): the same CPU Unit, on this io_context.
-    auto web = fins::cli::finsd::start_web(io, s.http, {target}, {server->get()});
+    auto web = fins::finsd::start_web(io, s.http, {target}, {server->get()});
     if (web.exit_code >= 0) return fail(web.exit_code, web.error);
-    auto control_start = fins::cli::start_control(io, {std::move(target)}, s.control_socket);
+    auto control_start = fins::finsd::start_control(io, {std::move(target)}, s.control_socket);
     if (control_start.exit_code >= 0) return fail(control_start.exit_code, control_start.error);
     auto& control = control_start.server;
-    fins::cli::finsd::SerialPorts serial;
+    fins::finsd::SerialPorts serial;
     if (auto r = start_serial_ports(io, (*server)->dispatcher(), s.serial, serial); !r)
         return fail(2, r.error());
     // Before "listening": a SIGTERM right after that line still stops finsd cleanly.
@@ -436,11 +436,11 @@ int main(int argc, char** argv) {
     spdlog::set_default_logger(std::make_shared<spdlog::logger>(
         "", std::make_shared<spdlog::sinks::stderr_color_sink_mt>()));
     if (argc > 1 && std::string_view(argv[1]) == "ctl")
-        return fins::cli::run_ctl(argc - 1, argv + 1);
+        return fins::finsd::run_ctl(argc - 1, argv + 1);
     Settings settings;
     if (const int rc = configure(argc, argv, settings); rc >= 0) return rc;
     try {
-        if (!settings.plant.cpus.empty()) return fins::cli::finsd::serve_plant(settings);
+        if (!settings.plant.cpus.empty()) return fins::finsd::serve_plant(settings);
         return serve(settings);
     } catch (const std::exception& e) {
         return fail(3, e.what());

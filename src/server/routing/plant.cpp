@@ -14,7 +14,7 @@
 #include <spdlog/spdlog.h>
 
 #include "plc/profile.hpp"
-#include "plc/storage.hpp"
+#include "plc/storage/storage.hpp"
 #include "server/routing/router.hpp"
 #include "server/sessions/server.hpp"
 
@@ -61,7 +61,7 @@ std::optional<FileMemoryRefusal> set_up_file_memory(
     if (options.cassette) files.mount_cassette(*options.cassette);
     if (!data_dir) return std::nullopt;
     const auto r = files.attach(*data_dir);
-    // A device directory that is a symlink is followed (plc/file_memory.hpp): say so.
+    // A device directory that is a symlink is followed (plc/file_memory/file_memory.hpp): say so.
     for (const auto& link : files.device_links()) {
         const auto path = (*data_dir / link.device).string();
         if (link.error)
@@ -102,7 +102,7 @@ std::string validate_plant(const PlantConfig& config) {
         const std::string who = fmt::format("plc \"{}\"", cpu.name);
         if (cpu.name.empty()) return "plc: a CPU Unit without a name";
         if (!names.insert(cpu.name).second) return who + ": the name is used twice";
-        // Each state file is locked by its one CPU Unit (plc/storage.hpp).
+        // Each state file is locked by its one CPU Unit (plc/storage/storage.hpp).
         if (cpu.data_dir) {
             const auto [at, inserted] =
                 data_dirs.emplace(cpu.data_dir->lexically_normal(), cpu.name);

@@ -31,7 +31,7 @@
 #include "plc/plc.hpp"
 #include "plc/profile.hpp"
 #include "plc/routing_tables.hpp"
-#include "plc/storage.hpp"
+#include "plc/storage/storage.hpp"
 #include "server/instructions/instruction_udp.hpp"
 #include "server/routing/node_address_table.hpp"
 #include "server/sessions/server.hpp"
