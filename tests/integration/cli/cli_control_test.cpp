@@ -8,44 +8,19 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "integration/support/process.hpp"
+#include "integration/support/finsd_process.hpp"
 
 namespace fins::test {
 namespace {
 
-const std::string fins_bin = std::string(FINS_BIN_DIR) + "/fins";
-const std::string finsd_bin = std::string(FINS_BIN_DIR) + "/finsd";
-
-class CliControl : public ::testing::Test {
+class CliControl : public FinsdTest {
   protected:
-    void SetUp() override {
-        finsd_ = std::make_unique<Child>(
-            std::vector<std::string>{finsd_bin, "--port", "0", "--log-level", "warn"});
-        const std::string line = finsd_->read_line();
-        ASSERT_EQ(line.rfind("listening ", 0), 0u) << "finsd said: " << line;
-        port_ = line.substr(10);
-    }
-    void TearDown() override {
-        if (!finsd_) return;
-        finsd_->terminate();
-        auto r = finsd_->wait();
-        EXPECT_EQ(r.exit_code, 0) << r.err;
-    }
-    RunResult fins(std::vector<std::string> args, bool tcp = false) {
-        std::vector<std::string> argv{fins_bin, "--port", port_, "--timeout", "2"};
-        if (tcp) argv.push_back("--tcp");
-        argv.insert(argv.end(), args.begin(), args.end());
-        return run(argv);
-    }
     nlohmann::json json(std::vector<std::string> args, int expected_exit = 0) {
         args.push_back("--json");
         auto r = fins(args);
         EXPECT_EQ(r.exit_code, expected_exit) << r.out << r.err;
         return nlohmann::json::parse(r.out, nullptr, false);
     }
-
-    std::unique_ptr<Child> finsd_;
-    std::string port_;
 };
 
 TEST_F(CliControl, StopAndRunChangeTheMode) {

@@ -11,54 +11,22 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "integration/support/process.hpp"
+#include "integration/support/finsd_process.hpp"
 
 namespace fins::test {
 namespace {
 
 using Json = nlohmann::json;
 
-const std::string fins_bin = std::string(FINS_BIN_DIR) + "/fins";
-const std::string finsd_bin = std::string(FINS_BIN_DIR) + "/finsd";
-
-class CliDiagnostic : public ::testing::Test {
+class CliDiagnostic : public FinsdTest {
   protected:
-    void SetUp() override {
-        static int counter = 0;
-        socket_ = (std::filesystem::temp_directory_path() /
-                   ("fins-cli-ctl-" + std::to_string(::getpid()) + "-" + std::to_string(counter++)))
-                      .string();
-        finsd_ = std::make_unique<Child>(std::vector<std::string>{
-            finsd_bin, "--port", "0", "--log-level", "warn", "--control", socket_});
-        const std::string line = finsd_->read_line();
-        ASSERT_EQ(line.rfind("listening ", 0), 0u) << "finsd said: " << line;
-        port_ = line.substr(10);
-    }
-    void TearDown() override {
-        if (!finsd_) return;
-        finsd_->terminate();
-        auto r = finsd_->wait();
-        EXPECT_EQ(r.exit_code, 0) << r.err;
-    }
-    RunResult fins(std::vector<std::string> args) {
-        std::vector<std::string> argv{fins_bin, "--port", port_, "--timeout", "2"};
-        argv.insert(argv.end(), args.begin(), args.end());
-        return run(argv);
-    }
-    RunResult ctl(std::vector<std::string> args) {
-        std::vector<std::string> argv{finsd_bin, "ctl", "--socket", socket_};
-        argv.insert(argv.end(), args.begin(), args.end());
-        return run(argv);
-    }
+    CliDiagnostic() : FinsdTest({}, true) {}
+    RunResult ctl(const std::vector<std::string>& args) { return test::ctl(socket(), args); }
     void ctl_ok(std::vector<std::string> args) {
         auto r = ctl(args);
         ASSERT_EQ(r.exit_code, 0) << r.err;
         ASSERT_EQ(r.out, "{\"ok\":true}\n");
     }
-
-    std::unique_ptr<Child> finsd_;
-    std::string port_;
-    std::string socket_;
 };
 
 TEST_F(CliDiagnostic, StatusAfterInjectingBatteryFalAndMessage) {
@@ -248,8 +216,9 @@ TEST_F(CliDiagnostic, CtlVerbsAndExitCodes) {
     EXPECT_EQ(ctl({"bogus"}).exit_code, 2);
     // No --socket: $FINSD_SOCKET (else the default path finsd uses too; issue 18).
     EXPECT_EQ(
-        run({"/usr/bin/env", "FINSD_SOCKET=" + socket_, finsd_bin, "ctl", "status"}).exit_code, 0);
-    auto gone = run({finsd_bin, "ctl", "--socket", socket_ + ".missing", "status"});
+        run({"/usr/bin/env", "FINSD_SOCKET=" + socket(), finsd_path, "ctl", "status"}).exit_code,
+        0);
+    auto gone = run({finsd_path, "ctl", "--socket", socket() + ".missing", "status"});
     EXPECT_EQ(gone.exit_code, 3);
     EXPECT_NE(gone.err.find("cannot connect"), std::string::npos) << gone.err;
 }

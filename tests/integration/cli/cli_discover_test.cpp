@@ -26,10 +26,11 @@ class CliDiscover : public ::testing::Test {
         ASSERT_TRUE(a_->started()) << a_->result().err;
         port_ = std::to_string(a_->port());
         // The same port on another loopback address: finsd's --port 0 is only for the first.
-        b_ = std::make_unique<Child>(std::vector<std::string>{finsd_path, "--bind", "127.0.0.5",
-                                                              "--port", port_, "--node", "50",
-                                                              "--log-level", "warn"});
-        ASSERT_EQ(b_->read_line(), "listening " + port_);
+        b_ =
+            std::make_unique<Finsd>(std::vector<std::string>{"--bind", "127.0.0.5", "--node", "50"},
+                                    FinsdOptions{.port = a_->port()});
+        ASSERT_TRUE(b_->started()) << b_->result().err;
+        ASSERT_EQ(b_->port(), a_->port());
     }
     RunResult discover(std::vector<std::string> args) {
         std::vector<std::string> v{fins_bin, "--port", port_, "--timeout", "0.5", "discover"};
@@ -44,7 +45,7 @@ class CliDiscover : public ::testing::Test {
     }
 
     std::unique_ptr<Finsd> a_;
-    std::unique_ptr<Child> b_;
+    std::unique_ptr<Finsd> b_;
     std::string port_;
 };
 

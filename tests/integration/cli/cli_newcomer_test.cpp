@@ -168,10 +168,9 @@ TEST(CliConventions, VersionHelpPrefixesAndPlurals) {
 TEST(CliConventions, FinsdStdoutCarriesOnlyListeningAndCtlTakesOptionsAfterTheVerb) {
     ScratchDir dir("conventions");
     const std::string socket = (dir.path() / "ctl.sock").string();
-    Child d({finsd_path, "--port", "0", "--log-level", "info", "--control", socket});
-    const std::string line = d.read_line();
-    ASSERT_EQ(line.rfind("listening ", 0), 0u) << line;
-    EXPECT_TRUE(d.wait_for_stderr("FINS address"));  // the start-up log is on stderr
+    Finsd d({"--control", socket}, {.log_level = "info"});
+    ASSERT_TRUE(d.started()) << d.result().out << d.result().err;  // "listening" came first
+    EXPECT_TRUE(d.child().wait_for_stderr("FINS address"));        // the start-up log is on stderr
 
     auto after = run({finsd_path, "ctl", "status", "--socket", socket});
     EXPECT_EQ(after.exit_code, 0) << after.err;
@@ -185,8 +184,7 @@ TEST(CliConventions, FinsdStdoutCarriesOnlyListeningAndCtlTakesOptionsAfterTheVe
     EXPECT_EQ(missing.exit_code, 3);
     EXPECT_EQ(missing.err.rfind("finsd ctl: ", 0), 0u) << missing.err;
 
-    d.terminate();
-    auto r = d.wait();
+    auto r = d.stop();
     EXPECT_EQ(r.exit_code, 0);
     EXPECT_EQ(r.out, "") << "after the listening line stdout must stay empty";
 }

@@ -11,38 +11,10 @@
 
 #include "fins/command_table.hpp"
 #include "fins/commands/loop_control.hpp"
-#include "integration/support/process.hpp"
+#include "integration/support/finsd_process.hpp"
 
 namespace fins::test {
 namespace {
-
-const std::string fins_bin = std::string(FINS_BIN_DIR) + "/fins";
-const std::string finsd_bin = std::string(FINS_BIN_DIR) + "/finsd";
-
-class FinsdChild {
-  public:
-    explicit FinsdChild(std::vector<std::string> options) {
-        std::vector<std::string> argv{finsd_bin, "--port", "0", "--log-level", "warn"};
-        argv.insert(argv.end(), options.begin(), options.end());
-        child_ = std::make_unique<Child>(argv);
-        const std::string line = child_->read_line();
-        if (line.rfind("listening ", 0) == 0) port_ = line.substr(10);
-    }
-    ~FinsdChild() {
-        child_->terminate();
-        child_->wait();
-    }
-    [[nodiscard]] const std::string& port() const { return port_; }
-    RunResult fins(std::vector<std::string> args) const {
-        std::vector<std::string> argv{fins_bin, "--port", port_, "--timeout", "2"};
-        argv.insert(argv.end(), args.begin(), args.end());
-        return run(argv);
-    }
-
-  private:
-    std::unique_ptr<Child> child_;
-    std::string port_;
-};
 
 std::filesystem::path temp_file(const std::string& name) {
     return std::filesystem::temp_directory_path() /
@@ -50,8 +22,8 @@ std::filesystem::path temp_file(const std::string& name) {
 }
 
 TEST(CliParameterArea, ReadWriteAndClearRoutingTables) {
-    FinsdChild d({});
-    ASSERT_FALSE(d.port().empty());
+    Finsd d({});
+    ASSERT_TRUE(d.started()) << d.result().err;
     auto w = d.fins({"param-write", "routing", "510", "0x0A0B", "12"});
     EXPECT_EQ(w.exit_code, 0) << w.err;
     EXPECT_EQ(w.out, "wrote 2 words at routing 01FE (2 words sent in 1 block)\n");
@@ -74,7 +46,7 @@ TEST(CliParameterArea, ReadWriteAndClearRoutingTables) {
 }
 
 TEST(CliParameterArea, W342_5_3_7_WriteToAWholeAreaRewritesItWhole) {
-    FinsdChild d({});
+    Finsd d({});
     auto w = d.fins({"param-write", "plc-setup", "100", "1", "2", "3", "--json"});
     ASSERT_EQ(w.exit_code, 0) << w.err;
     auto doc = nlohmann::json::parse(w.out);
@@ -95,7 +67,7 @@ TEST(CliParameterArea, W342_5_3_7_WriteToAWholeAreaRewritesItWhole) {
 }
 
 TEST(CliParameterArea, W342_5_3_8_IoTableInRunModeExits4With2206) {
-    FinsdChild d({"--mode", "run"});
+    Finsd d({"--mode", "run"});
     auto w = d.fins({"param-clear", "io-table", "--json"});
     EXPECT_EQ(w.exit_code, 4);
     EXPECT_EQ(nlohmann::json::parse(w.out)["error"]["end_code"], "2206");
@@ -105,7 +77,7 @@ TEST(CliParameterArea, W342_5_3_8_IoTableInRunModeExits4With2206) {
 }
 
 TEST(CliParameterArea, UsageErrorsExit2) {
-    FinsdChild d({});
+    Finsd d({});
     auto area = d.fins({"param-read", "nowhere"});
     EXPECT_EQ(area.exit_code, 2);
     EXPECT_NE(area.err.find("plc-setup (8010)"), std::string::npos) << area.err;
@@ -117,8 +89,8 @@ TEST(CliParameterArea, UsageErrorsExit2) {
 }
 
 TEST(CliProgramArea, W342_5_3_11_WriteReadBackAndClear) {
-    FinsdChild d({"--profile", "cj1m", "--mode", "program"});
-    ASSERT_FALSE(d.port().empty());
+    Finsd d({"--profile", "cj1m", "--mode", "program"});
+    ASSERT_TRUE(d.started()) << d.result().err;
     const auto image = temp_file("image.bin");
     const auto back = temp_file("back.bin");
     std::vector<char> bytes(2000);
@@ -158,7 +130,7 @@ TEST(CliProgramArea, W342_5_3_11_WriteReadBackAndClear) {
 }
 
 TEST(CliProgramArea, HexFilesBothWays) {
-    FinsdChild d({"--profile", "cj1m", "--mode", "program"});
+    Finsd d({"--profile", "cj1m", "--mode", "program"});
     const auto image = temp_file("image.hex");
     const auto back = temp_file("back.hex");
     std::ofstream(image) << "DEADBEEF 01020304\n0A0B0C0D\n";
@@ -175,7 +147,7 @@ TEST(CliProgramArea, HexFilesBothWays) {
 }
 
 TEST(CliProgramArea, W342_5_3_11_RunModeAndUsageErrors) {
-    FinsdChild d({"--profile", "cj1m", "--mode", "run"});
+    Finsd d({"--profile", "cj1m", "--mode", "run"});
     const auto image = temp_file("odd.bin");
     std::ofstream(image, std::ios::binary).write("abcdefgh", 8);
     auto w = d.fins({"program-write", image.string(), "--json"});
@@ -195,7 +167,7 @@ TEST(CliProgramArea, W342_5_3_11_RunModeAndUsageErrors) {
 // loop-read addresses the Inner Board (unit E1): a CPU without one has no such unit
 // (0202), and 02 40 sent to the CPU Unit itself is undefined there (0401).
 TEST(CliLoopControl, Seed001_LoopReadAnswersFromTheInnerBoard) {
-    FinsdChild plain({});
+    Finsd plain({});
     auto none = plain.fins({"loop-read", "1", "6", "--json"});
     EXPECT_EQ(none.exit_code, 4);
     EXPECT_EQ(nlohmann::json::parse(none.out)["error"]["end_code"], "0202");
@@ -204,7 +176,7 @@ TEST(CliLoopControl, Seed001_LoopReadAnswersFromTheInnerBoard) {
     EXPECT_EQ(plain.fins({"loop-read", "1000", "6"}).exit_code, 2);
     EXPECT_EQ(plain.fins({"loop-read", "1", "x"}).exit_code, 2);
 
-    FinsdChild board({"--profile", "cs1h-lcb"});
+    Finsd board({"--profile", "cs1h-lcb"});
     auto r = board.fins({"loop-read", "1", "6", "99", "30", "--json"});
     ASSERT_EQ(r.exit_code, 0) << r.err;
     auto doc = nlohmann::json::parse(r.out);

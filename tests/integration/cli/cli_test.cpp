@@ -6,39 +6,12 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "integration/support/process.hpp"
+#include "integration/support/finsd_process.hpp"
 
 namespace fins::test {
 namespace {
 
-const std::string fins_bin = std::string(FINS_BIN_DIR) + "/fins";
-const std::string finsd_bin = std::string(FINS_BIN_DIR) + "/finsd";
-
-class Cli : public ::testing::Test {
-  protected:
-    void SetUp() override {
-        finsd_ = std::make_unique<Child>(
-            std::vector<std::string>{finsd_bin, "--port", "0", "--log-level", "warn"});
-        const std::string line = finsd_->read_line();
-        ASSERT_EQ(line.rfind("listening ", 0), 0u) << "finsd said: " << line;
-        port_ = line.substr(10);
-    }
-    void TearDown() override {
-        if (!finsd_) return;
-        finsd_->terminate();
-        auto r = finsd_->wait();
-        EXPECT_EQ(r.exit_code, 0) << r.err;  // SIGTERM is a clean shutdown
-    }
-    RunResult fins(std::vector<std::string> args, bool tcp = false) {
-        std::vector<std::string> argv{fins_bin, "--port", port_, "--timeout", "2"};
-        if (tcp) argv.push_back("--tcp");
-        argv.insert(argv.end(), args.begin(), args.end());
-        return run(argv);
-    }
-
-    std::unique_ptr<Child> finsd_;
-    std::string port_;
-};
+class Cli : public FinsdTest {};
 
 TEST_F(Cli, WriteThenReadWordsHumanAndJson) {
     auto w = fins({"write", "D100", "1", "-2", "300", "--as", "int16"});
@@ -125,9 +98,9 @@ TEST_F(Cli, ExitCodesSeparateUsageTransportAndEndCode) {
     EXPECT_EQ(nlohmann::json::parse(json.out)["error"]["end_code"], "2101");
 
     // Nobody listens on the port finsd's own port + 1 is unlikely to be; UDP times out.
-    auto transport = run({fins_bin, "--port", "1", "--timeout", "0.2", "read", "D0"});
+    auto transport = run({fins_path, "--port", "1", "--timeout", "0.2", "read", "D0"});
     EXPECT_EQ(transport.exit_code, 3);
-    auto tcp = run({fins_bin, "--port", "1", "--tcp", "--timeout", "0.5", "read", "D0"});
+    auto tcp = run({fins_path, "--port", "1", "--tcp", "--timeout", "0.5", "read", "D0"});
     EXPECT_EQ(tcp.exit_code, 3);
     // Issue 7 item 3: a transport error names the endpoint.
     EXPECT_NE(tcp.err.find("127.0.0.1:1: "), std::string::npos) << tcp.err;
@@ -185,12 +158,11 @@ TEST_F(Cli, NumbersTheFormatCannotHoldAreRefused) {
 }
 
 TEST(Finsd, RefusesBadOptionsAndBusyPorts) {
-    EXPECT_EQ(run({finsd_bin, "--node", "0"}).exit_code, 2);
-    EXPECT_EQ(run({finsd_bin, "--bind", "not-an-ip", "--port", "0"}).exit_code, 3);
-    Child first({finsd_bin, "--port", "0", "--log-level", "off"});
-    const std::string line = first.read_line();
-    ASSERT_EQ(line.rfind("listening ", 0), 0u);
-    auto busy = run({finsd_bin, "--port", line.substr(10)});
+    EXPECT_EQ(run({finsd_path, "--node", "0"}).exit_code, 2);
+    EXPECT_EQ(run({finsd_path, "--bind", "not-an-ip", "--port", "0"}).exit_code, 3);
+    Finsd first({}, {.log_level = "off"});
+    ASSERT_TRUE(first.started()) << first.result().err;
+    auto busy = run({finsd_path, "--port", std::to_string(first.port())});
     EXPECT_EQ(busy.exit_code, 3);
     EXPECT_NE(busy.err.find("cannot listen"), std::string::npos) << busy.err;
 }

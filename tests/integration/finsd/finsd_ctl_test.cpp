@@ -120,14 +120,12 @@ name = "oven"
 TEST(FinsdCtl, Newcomer6_FinsdAndCtlShareTheDefaultSocket) {
     ScratchDir dir("ctldefault");
     const std::string socket = (dir.path() / "default.sock").string();
-    Child d({"/usr/bin/env", "FINSD_SOCKET=" + socket, finsd_path, "--port", "0", "--log-level",
-             "warn"});
-    ASSERT_EQ(d.read_line().rfind("listening ", 0), 0u);
+    Finsd d({}, {.env = {"FINSD_SOCKET=" + socket}});
+    ASSERT_TRUE(d.started()) << d.result().err;
     const auto r = run({"/usr/bin/env", "FINSD_SOCKET=" + socket, finsd_path, "ctl", "status"});
     EXPECT_EQ(r.exit_code, 0) << r.err;
     EXPECT_TRUE(has(r.out, "\"ok\":true")) << r.out;
-    d.terminate();
-    EXPECT_EQ(d.wait().exit_code, 0);
+    EXPECT_EQ(d.stop().exit_code, 0);
 
     // The rule itself: FINSD_SOCKET, else XDG_RUNTIME_DIR, else /run/finsd (root) or
     // /tmp/finsd-UID.
@@ -160,14 +158,13 @@ TEST(FinsdCtl, Newcomer6_FinsdAndCtlShareTheDefaultSocket) {
 TEST(FinsdCtl, Issue26_8_FinsdAndCtlMeetAtTheDefaultSocketWithoutFlags) {
     ScratchDir dir("ctlxdg");
     const std::string xdg = "XDG_RUNTIME_DIR=" + dir.path().string();
-    Child d({"/usr/bin/env", "-u", "FINSD_SOCKET", xdg, finsd_path, "--port", "0"});
-    ASSERT_EQ(d.read_line().rfind("listening ", 0), 0u);
+    Finsd d({}, {.log_level = "", .env = {"-u", "FINSD_SOCKET", xdg}});
+    ASSERT_TRUE(d.started()) << d.result().err;
     EXPECT_TRUE(std::filesystem::is_socket(dir.path() / "finsd.sock"));
     const auto r = run({"/usr/bin/env", "-u", "FINSD_SOCKET", xdg, finsd_path, "ctl", "status"});
     EXPECT_EQ(r.exit_code, 0) << r.err;
     EXPECT_TRUE(has(r.out, "\"ok\":true")) << r.out;
-    d.terminate();
-    const auto end = d.wait();
+    const auto end = d.stop();
     EXPECT_EQ(end.exit_code, 0);
     EXPECT_TRUE(has(end.err, "control channel on " + (dir.path() / "finsd.sock").string()))
         << end.err;

@@ -13,44 +13,18 @@ namespace {
 
 using namespace std::chrono_literals;
 
-// Lines of finsd's output (its log is on stderr, sent to stdout here) until one contains `text`, at
-// most `timeout`.
-bool wait_for_log(Child& child, const std::string& text, std::vector<std::string>& seen,
-                  std::chrono::seconds timeout) {
-    const auto deadline = std::chrono::steady_clock::now() + timeout;
-    while (std::chrono::steady_clock::now() < deadline) {
-        const auto line = child.read_line(std::chrono::duration_cast<std::chrono::milliseconds>(
-            deadline - std::chrono::steady_clock::now()));
-        if (line.empty()) continue;
-        seen.push_back(line);
-        if (line.find(text) != std::string::npos) return true;
-    }
-    return false;
-}
-
 TEST(TcpAccept, OutOfDescriptorsBacksOffLogsOncePerIntervalAndRecovers) {
     // Log level info: the start-up lines format before descriptors run out. Under UBSan
     // the first check of a dynamic type needs a pipe (to probe the vtable's memory), so
     // a log line whose formatting code had never run would be reported as an "invalid
     // vptr" once no descriptor is left: a sanitizer artifact, not a finsd fault.
-    Child child({"/bin/sh", "-c",
-                 "ulimit -n 24 && exec " + finsd_path +
-                     " --port 0 --log-level info --max-connections 64 --tcp-max-pending 64 2>&1"});
-    std::vector<std::string> log;
-    ASSERT_TRUE(wait_for_log(child, "listening ", log, 20s));
-    const std::string listening = log.back();
-    const auto port = static_cast<std::uint16_t>(std::stoul(listening.substr(10)));
-    auto open_client = [port](bool tcp) {
-        ClientOptions o;
-        o.port = port;
-        o.protocol = tcp ? ClientOptions::Protocol::tcp : ClientOptions::Protocol::udp;
-        o.timeout = 3000ms;
-        auto c = Client::connect(o);
-        EXPECT_TRUE(c.has_value()) << (c ? "" : c.error().message());
-        return c ? std::move(*c) : nullptr;
-    };
-    auto udp = open_client(false);
-    auto tcp = open_client(true);
+    Finsd finsd({"--max-connections", "64", "--tcp-max-pending", "64"},
+                {.log_level = "info", .shell = "ulimit -n 24 && "});
+    ASSERT_TRUE(finsd.started()) << finsd.result().err;
+    const auto port = finsd.port();
+    std::vector<std::string> log;  // its stderr, read up to each event waited for
+    auto udp = finsd.client(false);
+    auto tcp = finsd.client(true);
     ASSERT_TRUE(udp && tcp);
     const Address d0{Area::dm, 0, 0, {}};
 
@@ -63,7 +37,7 @@ TEST(TcpAccept, OutOfDescriptorsBacksOffLogsOncePerIntervalAndRecovers) {
         flood.emplace_back(io, "127.0.0.1", port);
         flood.back().send(handshake);
     }
-    ASSERT_TRUE(wait_for_log(child, "accept failed", log, 20s));
+    ASSERT_TRUE(finsd.child().wait_for_stderr("accept failed", 20s, &log));
     const auto failing_since = std::chrono::steady_clock::now();
 
     // Meanwhile UDP and the open connection are served.
@@ -72,15 +46,14 @@ TEST(TcpAccept, OutOfDescriptorsBacksOffLogsOncePerIntervalAndRecovers) {
 
     // Closing the flood frees descriptors; finsd accepts again without help.
     flood.clear();
-    ASSERT_TRUE(wait_for_log(child, "accepting again", log, 20s));
+    ASSERT_TRUE(finsd.child().wait_for_stderr("accepting again", 20s, &log));
     const auto failing_for = std::chrono::steady_clock::now() - failing_since;
     RawTcp late(io, "127.0.0.1", port);
     EXPECT_EQ(be32(late.handshake(), 12), 0u);
     EXPECT_TRUE(tcp->read_words(d0, 1).has_value());
 
-    child.terminate();
-    const auto rest = child.wait(20s);
-    EXPECT_EQ(rest.exit_code, 0) << rest.out;
+    const auto rest = finsd.stop();
+    EXPECT_EQ(rest.exit_code, 0) << rest.err;
     // Up to the recovery: the first failure, at most one report per 10 s interval, and
     // the recovery line. The spinning loop wrote thousands of lines in that time. (After
     // it, accepting the closed flood can run out of descriptors again: a new episode.)

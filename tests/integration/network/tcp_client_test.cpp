@@ -22,42 +22,19 @@ namespace {
 using Json = nlohmann::json;
 
 // finsd node 5, FINS/TCP only, on `port` (0: a free one).
-class NodeB {
-  public:
-    explicit NodeB(std::uint16_t port)
-        : child_({finsd_path, "--port", std::to_string(port), "--log-level", "warn", "--node", "5",
-                  "--no-udp"}) {
-        const std::string line = child_.read_line(std::chrono::seconds(20));
-        if (line.rfind("listening ", 0) == 0)
-            port_ = static_cast<std::uint16_t>(std::stoul(line.substr(10)));
-    }
-    ~NodeB() { stop(); }
-    NodeB(const NodeB&) = delete;
-    NodeB& operator=(const NodeB&) = delete;
-    [[nodiscard]] std::uint16_t port() const { return port_; }
-    void stop() {
-        if (stopped_) return;
-        stopped_ = true;
-        child_.terminate(SIGTERM);
-        child_.wait(std::chrono::seconds(20));
-    }
-    // A FINS/TCP client of node 5 (it has no FINS/UDP).
-    [[nodiscard]] std::unique_ptr<Client> client() const {
-        ClientOptions o;
-        o.port = port_;
-        o.protocol = ClientOptions::Protocol::tcp;
-        o.destination = {0, 5, 0};
-        o.timeout = std::chrono::milliseconds(3000);
-        auto c = Client::connect(o);
-        EXPECT_TRUE(c.has_value());
-        return c ? std::move(*c) : nullptr;
-    }
+std::unique_ptr<Finsd> node_b(std::uint16_t port) {
+    return std::make_unique<Finsd>(std::vector<std::string>{"--node", "5", "--no-udp"},
+                                   FinsdOptions{.port = port});
+}
 
-  private:
-    Child child_;
-    std::uint16_t port_ = 0;
-    bool stopped_ = false;
-};
+// A FINS/TCP client of node 5 (it has no FINS/UDP).
+std::unique_ptr<Client> client_of_b(const Finsd& b) {
+    ClientOptions o;
+    o.protocol = ClientOptions::Protocol::tcp;
+    o.destination = {0, 5, 0};
+    o.timeout = std::chrono::milliseconds(3000);
+    return b.client(o);
+}
 
 class TcpClientConnection : public ::testing::Test {
   protected:
@@ -100,7 +77,8 @@ class TcpClientConnection : public ::testing::Test {
 };
 
 TEST_F(TcpClientConnection, W596_3_InstructionsGoOverItAndItComesBackAfterTheServerRestarts) {
-    auto b = std::make_unique<NodeB>(0);
+    auto b = node_b(0);
+    ASSERT_TRUE(b->started()) << b->result().err;
     ASSERT_NE(b->port(), 0);
     const auto port = b->port();
     start_a(port);
@@ -108,7 +86,7 @@ TEST_F(TcpClientConnection, W596_3_InstructionsGoOverItAndItComesBackAfterTheSer
     // Until the connection is up a Send ends with 0800 0101 (exit 6).
     EXPECT_EQ(send_until({6}), 0);
     {
-        auto c = b->client();
+        auto c = client_of_b(*b);
         ASSERT_NE(c, nullptr);
         EXPECT_EQ(words_of(*c, "D200", 2), (std::vector<std::uint16_t>{0x1234, 0x5678}));
         ASSERT_TRUE(c->write_words(addr("D210"), std::vector<std::uint16_t>{7, 8}).has_value());
@@ -132,10 +110,10 @@ TEST_F(TcpClientConnection, W596_3_InstructionsGoOverItAndItComesBackAfterTheSer
     EXPECT_EQ(down["result"]["error_id_ex"], "0101");
 
     // Node 5 comes back on the same port: node 1 reconnects by itself.
-    b = std::make_unique<NodeB>(port);
+    b = node_b(port);
     ASSERT_EQ(b->port(), port);
     EXPECT_EQ(send_until({6}), 0);
-    auto c = b->client();
+    auto c = client_of_b(*b);
     ASSERT_NE(c, nullptr);
     EXPECT_EQ(words_of(*c, "D200", 2), (std::vector<std::uint16_t>{0x1234, 0x5678}));
 }

@@ -15,9 +15,9 @@ namespace {
 TEST(PlantExample, ThreeNetworksRunsAsIsAndReachesNode3_5) {
     const auto file = std::filesystem::path(FINS_SOURCE_DIR) / "examples" / "three-networks.toml";
     // As the README runs it: without --port (which would give its units another port).
-    Child d({finsd_path, "--log-level", "warn", "--config", file.string()});
-    ASSERT_EQ(d.read_line(std::chrono::seconds(20)), "listening 9600")
-        << d.wait(std::chrono::seconds(20)).err;
+    Finsd d({"--config", file.string()}, {.port = std::nullopt});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    ASSERT_EQ(d.port(), 9600);
     for (const bool tcp : {false, true}) {
         ClientOptions o;
         o.host = "127.0.1.1";

@@ -125,22 +125,10 @@ std::vector<Unit> units_of(int first, int last, int nodes) {
     return units;
 }
 
-// finsd under `sh -c "ulimit ...; exec finsd --config FILE"`, waiting up to `wait` for
+// finsd under `sh -c "ulimit ... && exec finsd --config FILE"`, waiting up to `wait` for
 // its "listening" line (an ASan build of 10,000 units takes a while to start).
-struct Started {
-    std::unique_ptr<Child> child;
-    bool listening = false;
-    RunResult result;
-};
-Started start_finsd(const std::string& limits, const std::string& config,
-                    std::chrono::seconds wait) {
-    Started s;
-    s.child = std::make_unique<Child>(std::vector<std::string>{
-        "/bin/sh", "-c", limits + "exec " + finsd_path + " --log-level warn --config " + config});
-    const auto line = s.child->read_line(wait);
-    s.listening = line.rfind("listening ", 0) == 0;
-    if (!s.listening) s.result = s.child->wait(std::chrono::seconds(20));
-    return s;
+FinsdOptions limited(const std::string& limits, std::chrono::seconds wait) {
+    return {.port = std::nullopt, .shell = limits, .wait = wait};
 }
 
 TEST(PlantScale, TenThousandCpuUnitsEachAnswer0501WithTheirOwnNode) {
@@ -149,13 +137,12 @@ TEST(PlantScale, TenThousandCpuUnitsEachAnswer0501WithTheirOwnNode) {
     // 40 networks x 250 nodes on 127.0.88-127.x (no other test's addresses), FINS/UDP
     // only: 10,000 descriptors, under this machine's limit of open files.
     const auto config = dir.write("site.toml", plant_config(88, 127, 250, port, false));
-    auto finsd = start_finsd("", config, std::chrono::seconds(90));
-    ASSERT_TRUE(finsd.listening) << finsd.result.err;
+    Finsd finsd({"--config", config}, limited("", std::chrono::seconds(90)));
+    ASSERT_TRUE(finsd.started()) << finsd.result().err;
     const auto units = units_of(88, 127, 250);
     ASSERT_EQ(units.size(), 10'000u);
     EXPECT_EQ(units_answering_0501(units, port), units.size());
-    finsd.child->terminate(SIGTERM);
-    EXPECT_EQ(finsd.child->wait(std::chrono::seconds(60)).exit_code, 0);
+    EXPECT_EQ(finsd.stop(SIGTERM, std::chrono::seconds(60)).exit_code, 0);
 }
 
 TEST(PlantScale, TheOpenFilesLimitIsRaisedForAPlantThatNeedsIt) {
@@ -164,25 +151,24 @@ TEST(PlantScale, TheOpenFilesLimitIsRaisedForAPlantThatNeedsIt) {
     // 150 units with FINS/UDP and FINS/TCP: 300 sockets, over a soft limit of 100, under
     // the hard limit of 500.
     const auto config = dir.write("plant.toml", plant_config(88, 88, 150, port, true));
-    auto finsd =
-        start_finsd("ulimit -S -n 100 && ulimit -H -n 500 && ", config, std::chrono::seconds(30));
-    ASSERT_TRUE(finsd.listening) << finsd.result.err;
+    Finsd finsd({"--config", config},
+                limited("ulimit -S -n 100 && ulimit -H -n 500 && ", std::chrono::seconds(30)));
+    ASSERT_TRUE(finsd.started()) << finsd.result().err;
     EXPECT_EQ(units_answering_0501(units_of(88, 88, 150), port), 150u);
-    finsd.child->terminate(SIGTERM);
-    EXPECT_EQ(finsd.child->wait(std::chrono::seconds(30)).exit_code, 0);
+    EXPECT_EQ(finsd.stop(SIGTERM, std::chrono::seconds(30)).exit_code, 0);
 }
 
 TEST(PlantScale, APlantOverTheHardLimitIsRefusedWithTheCount) {
     ScratchDir dir("plant-scale");
     // 250 units with both transports need 500 sockets; the hard limit is 300.
     const auto config = dir.write("plant.toml", plant_config(88, 88, 250, free_udp_port(), true));
-    auto finsd = start_finsd("ulimit -n 300 && ", config, std::chrono::seconds(30));
-    ASSERT_FALSE(finsd.listening);
-    EXPECT_EQ(finsd.result.exit_code, 3);
-    EXPECT_NE(finsd.result.err.find("the plant needs"), std::string::npos) << finsd.result.err;
-    EXPECT_NE(finsd.result.err.find("500 for its units' sockets"), std::string::npos)
-        << finsd.result.err;
-    EXPECT_NE(finsd.result.err.find("the limit is 300"), std::string::npos) << finsd.result.err;
+    Finsd finsd({"--config", config}, limited("ulimit -n 300 && ", std::chrono::seconds(30)));
+    ASSERT_FALSE(finsd.started());
+    const auto& result = finsd.result();
+    EXPECT_EQ(result.exit_code, 3);
+    EXPECT_NE(result.err.find("the plant needs"), std::string::npos) << result.err;
+    EXPECT_NE(result.err.find("500 for its units' sockets"), std::string::npos) << result.err;
+    EXPECT_NE(result.err.find("the limit is 300"), std::string::npos) << result.err;
 }
 
 }  // namespace

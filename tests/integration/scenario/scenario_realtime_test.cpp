@@ -91,20 +91,22 @@ TEST(ScenarioRealTime, StartLogNamesTheScenarioAndTheSerialPorts) {
     ScratchDir dir("scenario-log");
     PtyPair gateway_line;
     PtyPair host_link_line;
-    Child d({finsd_path, "--port", "0", "--log-level", "info", "--control",
-             (dir.path() / "a.sock").string(), "--scenario", examples + "live.toml", "--serial",
-             "scu1.2=" + gateway_line.a() + ",mode=gateway", "--serial",
-             "cpu=" + host_link_line.a()});
+    Finsd d({"--control", (dir.path() / "a.sock").string(), "--scenario", examples + "live.toml",
+             "--serial", "scu1.2=" + gateway_line.a() + ",mode=gateway", "--serial",
+             "cpu=" + host_link_line.a()},
+            {.log_level = "info"});
+    ASSERT_TRUE(d.started()) << d.result().err;
     // In the order finsd starts them (each wait reads on from the line before).
-    EXPECT_TRUE(d.wait_for_stderr("finsd: serial gateway port scu1.2 on " + gateway_line.a() +
-                                  ", unit address 85"));
-    EXPECT_TRUE(d.wait_for_stderr("finsd: scenario " + examples +
-                                  "live.toml: 6 tags, 0 events, real time x1, tick 100 ms"));
-    EXPECT_TRUE(d.wait_for_stderr("finsd: serial cpu on " + host_link_line.a()));
+    EXPECT_TRUE(d.child().wait_for_stderr("finsd: serial gateway port scu1.2 on " +
+                                          gateway_line.a() + ", unit address 85"));
+    EXPECT_TRUE(d.child().wait_for_stderr(
+        "finsd: scenario " + examples + "live.toml: 6 tags, 0 events, real time x1, tick 100 ms"));
+    EXPECT_TRUE(d.child().wait_for_stderr("finsd: serial cpu on " + host_link_line.a()));
 
-    Child v({finsd_path, "--port", "0", "--log-level", "info", "--control",
-             (dir.path() / "b.sock").string(), "--scenario", examples + "tank.toml"});
-    EXPECT_TRUE(v.wait_for_stderr(
+    Finsd v({"--control", (dir.path() / "b.sock").string(), "--scenario", examples + "tank.toml"},
+            {.log_level = "info"});
+    ASSERT_TRUE(v.started()) << v.result().err;
+    EXPECT_TRUE(v.child().wait_for_stderr(
         "finsd: scenario " + examples +
         "tank.toml: 6 tags, 1 event, virtual time: moves by `finsd ctl scenario advance`, "
         "tick 100 ms"));

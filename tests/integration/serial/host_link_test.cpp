@@ -279,27 +279,22 @@ TEST(HostLinkFinsd, SerialOnlyPlcServesWithUdpAndTcpOff) {
 TEST(HostLinkFinsd, VanishingPortIsLoggedOnceAndEthernetKeepsServing) {
     auto pty = std::make_unique<PtyPair>();
     ASSERT_TRUE(pty->ok());
-    Child finsd({finsd_path, "--port", "0", "--log-level", "warn", "--serial", "cpu=" + pty->a()});
-    const auto line = finsd.read_line(std::chrono::seconds(20));
-    ASSERT_EQ(line.rfind("listening ", 0), 0u) << line;
-    const auto port = static_cast<std::uint16_t>(std::stoul(line.substr(10)));
+    Finsd finsd({"--serial", "cpu=" + pty->a()});
+    ASSERT_TRUE(finsd.started()) << finsd.result().err;
     {
         auto c = Client::connect(serial_options(pty->b()));
         ASSERT_TRUE(c);
         EXPECT_TRUE((*c)->read_words(addr("D0"), 1));
     }
     pty->close();  // socat gone: both devices vanish
-    EXPECT_TRUE(finsd.wait_for_stderr("serial cpu (" + pty->a() + "): lost"));
-    ClientOptions udp;
-    udp.port = port;
+    EXPECT_TRUE(finsd.child().wait_for_stderr("serial cpu (" + pty->a() + "): lost"));
     for (int i = 0; i < 3; ++i) {  // and through a few reopen attempts
-        auto c = Client::connect(udp);
+        auto c = finsd.client(ClientOptions{});
         ASSERT_TRUE(c);
-        EXPECT_TRUE((*c)->read_words(addr("D0"), 1));
+        EXPECT_TRUE(c->read_words(addr("D0"), 1));
         std::this_thread::sleep_for(std::chrono::milliseconds(400));
     }
-    finsd.terminate();
-    auto result = finsd.wait();
+    auto result = finsd.stop();
     EXPECT_EQ(result.exit_code, 0);
     // Logged once: no line per failed reopen.
     EXPECT_EQ(result.err.find("serial cpu"), std::string::npos) << result.err;

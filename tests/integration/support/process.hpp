@@ -73,14 +73,16 @@ class Child {
         return read_line_from(out_fd_, timeout);
     }
     // Reads stderr lines (with a log file: the log's) until one contains `text`; false after
-    // `timeout` or at the end.
+    // `timeout` or at the end. Each line read is added to `seen` when it is given.
     bool wait_for_stderr(const std::string& text,
-                         std::chrono::milliseconds timeout = std::chrono::seconds(20)) {
+                         std::chrono::milliseconds timeout = std::chrono::seconds(20),
+                         std::vector<std::string>* seen = nullptr) {
         const auto deadline = std::chrono::steady_clock::now() + timeout;
         while (std::chrono::steady_clock::now() < deadline) {
             const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
                 deadline - std::chrono::steady_clock::now());
             const auto line = log_.empty() ? read_line_from(err_fd_, left) : read_log_line(left);
+            if (seen != nullptr && !line.empty()) seen->push_back(line);
             if (line.find(text) != std::string::npos) return true;
             if (line.empty() && eof_) return false;
         }
