@@ -148,7 +148,8 @@ TEST(FinsdCtl, Newcomer6_FinsdAndCtlShareTheDefaultSocket) {
     } else {
         const auto first = std::filesystem::path(xdg) / "finsd.sock";
         EXPECT_EQ(finsd::default_control_socket(), first);
-        EXPECT_EQ(finsd::default_control_sockets(), (std::vector<std::filesystem::path>{first, own}));
+        EXPECT_EQ(finsd::default_control_sockets(),
+                  (std::vector<std::filesystem::path>{first, own}));
     }
     if (!before.empty()) ::setenv("FINSD_SOCKET", before.c_str(), 1);
 }

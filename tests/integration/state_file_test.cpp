@@ -186,8 +186,7 @@ TEST(FinsdStateFile, StorageKeysAndFlags) {
     EXPECT_EQ(s.durability, plc::Durability::process);
     ASSERT_TRUE(finsd::load_config_text("[storage]\ndurability = \"power\"\n", "t.toml", s));
     EXPECT_EQ(s.durability, plc::Durability::power);
-    const auto bad =
-        finsd::load_config_text("[storage]\ndurability = \"disk\"\n", "t.toml", s);
+    const auto bad = finsd::load_config_text("[storage]\ndurability = \"disk\"\n", "t.toml", s);
     ASSERT_FALSE(bad);
     EXPECT_EQ(bad.error(), "t.toml:2:1: storage.durability: 'disk' is not process or power");
     const auto unknown = finsd::load_config_text("[storage]\nreset = true\n", "t.toml", s);
