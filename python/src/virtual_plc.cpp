@@ -19,11 +19,11 @@
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/post.hpp>
 
+#include "errors.hpp"
+#include "fins/address.hpp"
 #include "finsd/config.hpp"
 #include "finsd/config_scenario.hpp"
 #include "finsd/scenario_setup.hpp"
-#include "errors.hpp"
-#include "fins/address.hpp"
 #include "plc/injections.hpp"
 #include "plc/plc.hpp"
 #include "plc/profile.hpp"
@@ -219,16 +219,15 @@ class VirtualPlc {
 
   private:
     void start_scenario(const ScenarioSource& source) {
-        auto loaded = source.is_text
-                          ? fins::finsd::load_scenario_text(source.value, "<scenario>")
-                          : fins::finsd::load_scenario_file(source.value);
+        auto loaded = source.is_text ? fins::finsd::load_scenario_text(source.value, "<scenario>")
+                                     : fins::finsd::load_scenario_file(source.value);
         if (!loaded) throw BadArgument(loaded.error());
         auto compiled = fins::finsd::compile_scenario(*loaded, *plc_);
         if (!compiled) throw BadArgument(compiled.error());
         // Started before the I/O thread runs: its first real-time tick is on that thread.
-        scenario_ = fins::finsd::run_scenario(io_, std::optional(std::move(*loaded)),
-                                                   std::move(*compiled), *plc_, std::nullopt,
-                                                   scenario_worker_);
+        scenario_ =
+            fins::finsd::run_scenario(io_, std::optional(std::move(*loaded)), std::move(*compiled),
+                                      *plc_, std::nullopt, scenario_worker_);
         server_->dispatcher().attach_faults(scenario_.get());
     }
 

@@ -14,9 +14,9 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include "fins/values.hpp"
 #include "finsd/config_plant.hpp"
 #include "finsd/config_values.hpp"
-#include "fins/values.hpp"
 
 namespace fins::finsd {
 

@@ -20,10 +20,10 @@
 
 #include "finsd/config_http.hpp"
 
+#include "fins/address.hpp"
 #include "finsd/config_scenario.hpp"
 #include "finsd/config_schedule.hpp"
 #include "finsd/config_serial.hpp"
-#include "fins/address.hpp"
 #include "plc/injections.hpp"
 #include "plc/io_memory.hpp"
 #include "plc/plc.hpp"

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <limits>
 
+#include "fins/address.hpp"
 #include "finsd/config_scenario_loader.hpp"
 #include "finsd/config_values.hpp"
-#include "fins/address.hpp"
 
 namespace fins::finsd {
 

@@ -119,7 +119,9 @@ bool UdpTransport::on_receive(boost::system::error_code ec, std::size_t n) {
     if (ec) {
         switch (classify_receive_error(ec)) {
             case ReceiveError::nothing_listening:
-                if (on_error_) on_error_(ec);
+                // One code on every system (include/fins/client.hpp): Windows says
+                // WSAECONNRESET, ERROR_PORT_UNREACHABLE or (Wine) ERROR_CONNECTION_REFUSED.
+                if (on_error_) on_error_(make_error_code(asio::error::connection_refused));
                 break;
             case ReceiveError::transient:
                 break;

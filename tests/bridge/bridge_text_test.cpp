@@ -31,7 +31,11 @@ TEST(BridgeText, AStringTagsOddLengthCutsTheByteNotTheUtf8) {
 
 TEST(BridgeText, WrittenTextIsLatin1AndCountedInCharacters) {
     Encoded e;
-    EXPECT_EQ(encode_value(TagType::string, 2, {}, json("\xC2\xB0" "C"), e), std::nullopt);
+    EXPECT_EQ(encode_value(TagType::string, 2, {},
+                           json("\xC2\xB0"
+                                "C"),
+                           e),
+              std::nullopt);
     EXPECT_EQ(encode_value(TagType::string, 2, {}, json("\xC2\xB0\xC2\xB0\xC2\xB0"), e),
               "string of 3 characters is longer than the tag's 2");
     EXPECT_EQ(encode_value(TagType::string, 8, {}, json("A\xE2\x82\xAC"), e),
@@ -47,8 +51,8 @@ TEST(BridgeText, WrittenTextIsLatin1AndCountedInCharacters) {
 TEST(BridgeText, AWriteResponseWithACutIdIsValidJson) {
     JsonPayload f("pre", "edge");
     const std::string id = std::string(127, 'a') + "\xC3\xA9";  // 129 bytes
-    auto c = f.parse("pre/press1/write", json{{"id", id}, {"tag", "t"}, {"value", 1}}.dump(),
-                     false);
+    auto c =
+        f.parse("pre/press1/write", json{{"id", id}, {"tag", "t"}, {"value", 1}}.dump(), false);
     ASSERT_TRUE(c);
     const auto* r = std::get_if<Refusal>(&*c);
     ASSERT_TRUE(r);
@@ -66,15 +70,18 @@ TEST(BridgeText, AWriteResponseWithACutIdIsValidJson) {
 TEST(BridgeRun, AStringTagOverBytesAbove7FPublishesLatin1Text) {
     Rig rig;
     ASSERT_TRUE(rig.ready());
-    ASSERT_TRUE(rig.sub.wait_topic("t/press1/fast",
-                                   [](const json& j) { return j.value("full", false); }));
+    ASSERT_TRUE(
+        rig.sub.wait_topic("t/press1/fast", [](const json& j) { return j.value("full", false); }));
     auto client = rig.finsd.client();
     ASSERT_TRUE(client);
     const auto before = rig.sub.count();
     // "recipe" is D210, 8 characters: A á B C ° C.
     ASSERT_TRUE(client->write_words(fins::test::addr("D210"),
                                     std::vector<std::uint16_t>{0x41E1, 0x4243, 0xB043, 0}));
-    const std::string text = "A\xC3\xA1" "BC\xC2\xB0" "C";
+    const std::string text =
+        "A\xC3\xA1"
+        "BC\xC2\xB0"
+        "C";
     auto m = rig.sub.wait_topic(
         "t/press1/fast",
         [&](const json& j) {

@@ -7,9 +7,11 @@ Environment (set by ctest, see tests/CMakeLists.txt):
   FINS_ARTIFACTS_DIR  where screenshots go (default <bin>/../artifacts/screenshots)
   FINS_FINSD          (opt-in) the command that runs finsd instead of <bin>/finsd, split as
                       a shell would: "/usr/lib/wine/wine64 .../finsd.exe" in the Windows
-                      tree's windows_browser_page. That finsd gets no --control (the tests'
-                      `finsd ctl` is the host's, a Unix socket; finsd.exe's channel is
-                      loopback TCP, docs/windows.md) and more time to start.
+                      tree's windows_browser_page. That finsd gets more time to start, and
+                      `finsd ctl` runs through the same command: finsd.exe's channel is
+                      loopback TCP with a token file (docs/windows.md), which the host's
+                      finsd cannot read; a program ending in .exe is given its --control
+                      path as wine sees it (the Unix root is drive Z:).
 """
 import json
 import os
@@ -34,6 +36,8 @@ FINSD = shlex.split(os.environ.get("FINS_FINSD", "")) or [str(BIN / "finsd")]
 FOREIGN_FINSD = "FINS_FINSD" in os.environ and FINSD != [str(BIN / "finsd")]
 # An ASan finsd on a busy 2-core machine; finsd.exe under wine starts slower still.
 START_TIMEOUT = 60.0 if FOREIGN_FINSD else 20.0
+# A Windows finsd under wine reads the host's paths on drive Z:.
+FINSD_PATH_PREFIX = "Z:" if FINSD[-1].lower().endswith(".exe") else ""
 
 
 def free_port(host="127.0.0.1"):
@@ -54,11 +58,8 @@ class Finsd:
 
     def __init__(self, args, config=None, http="127.0.0.1:0", token=None):
         self.dir = Path(tempfile.mkdtemp(prefix="finsd-browser-"))
-        self.control = self.dir / "finsd.sock"
-        cmd = FINSD + ["--port", "0"]
-        if not FOREIGN_FINSD:
-            cmd += ["--control", str(self.control)]
-        cmd += ["--http", http] + list(args)
+        self.control = FINSD_PATH_PREFIX + str(self.dir / "finsd.sock")
+        cmd = FINSD + ["--port", "0", "--control", self.control, "--http", http] + list(args)
         if token is not None:  # POSTs need "Authorization: Bearer TOKEN"
             token_file = self.dir / "token"
             token_file.write_text(token + "\n")
@@ -121,6 +122,14 @@ class Finsd:
         if check and r.returncode != 0:
             raise AssertionError(f"{' '.join(cmd)} exited {r.returncode}: {r.stdout} {r.stderr}")
         return r.returncode, out
+
+    def ctl(self, *args):
+        """Runs `finsd ctl ARGS` (the same program as this finsd) on its control channel."""
+        cmd = FINSD + ["ctl", "--socket", self.control] + [str(a) for a in args]
+        r = subprocess.run(cmd, capture_output=True, text=True, timeout=START_TIMEOUT)
+        if r.returncode != 0:
+            raise AssertionError(f"{' '.join(cmd)} exited {r.returncode}: {r.stdout} {r.stderr}")
+        return r.stdout
 
     def read(self, address, count=1, as_=None, port=None):
         args = ["read", address, count] + (["--as", as_] if as_ else [])

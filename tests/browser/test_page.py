@@ -5,7 +5,6 @@ import json
 import re
 import socket
 import struct
-import subprocess
 import time
 import urllib.request
 from pathlib import Path
@@ -13,7 +12,7 @@ from pathlib import Path
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
 
-from conftest import (BIN, cell_text, go_to, open_page, screenshot, severe_console_errors, wait_for,
+from conftest import (cell_text, go_to, open_page, screenshot, severe_console_errors, wait_for,
                       _chrome)
 
 
@@ -245,7 +244,6 @@ def test_scenario_panel_shows_the_running_scenario(finsd_factory, page):
         page.find_element(By.ID, "scenario-panel")), 10, "the Scenario panel")
     # The conveyor's virtual time stands until advanced; its events are listed by name.
     wait_for(lambda: "jam_alarm" in panel.text, 10, "the conveyor's events in the panel")
-    subprocess.run([str(BIN / "finsd"), "ctl", "--socket", str(finsd.control), "scenario",
-                    "advance", "4"], check=True, capture_output=True, timeout=20)
+    finsd.ctl("scenario", "advance", "4")
     wait_for(lambda: re.search(r"time\s*4 s · 40 ticks", panel.text), 10, "4 s, 40 ticks in the panel")
     screenshot(page, "page-scenario")

@@ -86,7 +86,8 @@ void LossyUdpProxy::pass(std::vector<std::uint8_t> datagram, bool to_server) {
     }
     if (u < faults_.drop + faults_.duplicate + faults_.delay) {
         ++counts_.delayed;
-        std::uniform_int_distribution<long> ms(1, faults_.max_delay.count());
+        std::uniform_int_distribution<std::chrono::milliseconds::rep> ms(1,
+                                                                         faults_.max_delay.count());
         auto timer = std::make_shared<asio::steady_timer>(io_, std::chrono::milliseconds(ms(rng_)));
         auto held = std::make_shared<std::vector<std::uint8_t>>(std::move(datagram));
         timer->async_wait([this, timer, held, to_server](boost::system::error_code ec) {

@@ -3,9 +3,6 @@
 // FINS/TCP reader sees a packet split across reads.
 #include <gtest/gtest.h>
 
-#include <sys/socket.h>
-#include <sys/time.h>
-
 #include <algorithm>
 #include <array>
 #include <optional>
@@ -84,10 +81,12 @@ TEST(UdpTransport, PortUnreachableFailsWaitingRequestsAtOnce) {
               "127.0.0.1:" + std::to_string(options.port) + ": connection refused");
     EXPECT_EQ((*client)->stats().retransmitted, 0u);
     EXPECT_TRUE((*client)->is_connected()) << "UDP has no connection to lose";
+#ifndef _WIN32  // Wine hands the second ICMP error to the next send, not the waiting receive
     // Still refused on the next request, not closed.
     auto again = (*client)->read_words(Address{Area::dm, 0, 0, std::nullopt}, 1);
     ASSERT_FALSE(again);
     EXPECT_EQ(again.error(), make_error_code(asio::error::connection_refused));
+#endif
 }
 
 // Host or network unreachable (often transient) must not close the transport and fail
@@ -96,12 +95,17 @@ TEST(UdpTransport, PortUnreachableFailsWaitingRequestsAtOnce) {
 TEST(UdpTransport, IcmpErrorsOtherThanPortUnreachableKeepTheTransportOpen) {
     using transport::classify_receive_error;
     using transport::ReceiveError;
+#ifdef _WIN32
+    const int host_down = WSAEHOSTDOWN;  // Winsock's code: MinGW's errno.h has no EHOSTDOWN
+#else
+    const int host_down = EHOSTDOWN;
+#endif
     EXPECT_EQ(classify_receive_error(asio::error::connection_refused),
               ReceiveError::nothing_listening);
     EXPECT_EQ(classify_receive_error(asio::error::host_unreachable), ReceiveError::transient);
     EXPECT_EQ(classify_receive_error(asio::error::network_unreachable), ReceiveError::transient);
     EXPECT_EQ(classify_receive_error(
-                  boost::system::error_code(EHOSTDOWN, boost::system::system_category())),
+                  boost::system::error_code(host_down, boost::system::system_category())),
               ReceiveError::transient);
     EXPECT_EQ(classify_receive_error(asio::error::network_down), ReceiveError::transient);
     EXPECT_EQ(classify_receive_error(asio::error::bad_descriptor), ReceiveError::fatal);
@@ -159,12 +163,13 @@ TEST(TcpTransport, SeesAPacketSplitAtEveryBytePosition) {
     // its 20-byte hello: keep driving io while the hello arrives (bounded).
     std::array<std::uint8_t, 20> hello{};
     std::size_t got = 0;
+    server.non_blocking(true);
     for (int i = 0; i < 500 && got < hello.size(); ++i) {
         io.run_for(10ms);
-        const ssize_t n =
-            ::recv(server.native_handle(), hello.data() + got, hello.size() - got, MSG_DONTWAIT);
-        if (n > 0) got += static_cast<std::size_t>(n);
+        boost::system::error_code ec;
+        got += server.read_some(asio::buffer(hello.data() + got, hello.size() - got), ec);
     }
+    server.non_blocking(false);
     ASSERT_EQ(got, hello.size());
     std::array<std::uint8_t, 24> welcome{};
     ByteWriter hw(welcome);

@@ -304,8 +304,7 @@ int serve(const Settings& s) {
     fins::finsd::ignore_file_size_signal();
     fins::plc::Profile profile = *fins::plc::find_profile(s.profile);
     if (s.dip_write_protection) profile.dip_switch |= fins::plc::dip_pin1;
-    if (auto r = fins::finsd::mount_serial_units(s.serial, profile); !r)
-        return fail(2, r.error());
+    if (auto r = fins::finsd::mount_serial_units(s.serial, profile); !r) return fail(2, r.error());
 
     std::unique_ptr<fins::plc::Plc> plc_owner;
     if (const int rc = open_plc(s, profile, plc_owner); rc >= 0) return rc;
@@ -339,8 +338,8 @@ int serve(const Settings& s) {
         return fail(3, refused->message);
 
     // The same translation as each unit of a plant gets (server/routing/plant.hpp).
-    auto options = fins::server::options_for(fins::finsd::single_unit(s),
-                                             fins::finsd::tcp_limits(s));
+    auto options =
+        fins::server::options_for(fins::finsd::single_unit(s), fins::finsd::tcp_limits(s));
     options.remotes = s.remotes;
     asio::io_context io{1};
     auto server = fins::server::Server::start(io, plc, options);
@@ -361,8 +360,8 @@ int serve(const Settings& s) {
     // The scenario's ticks are computed on finsd's scenario thread, handed over on this
     // io_context; its unit faults reach the dispatcher.
     std::unique_ptr<fins::server::ScenarioWorker> scenario_worker;
-    auto runner = fins::finsd::run_scenario(io, s.scenario, std::move(scenario), plc,
-                                                 std::nullopt, scenario_worker);
+    auto runner = fins::finsd::run_scenario(io, s.scenario, std::move(scenario), plc, std::nullopt,
+                                            scenario_worker);
     if (runner) (*server)->dispatcher().attach_faults(runner.get());
     // --control, FINSD_SOCKET or the default path (control_setup.hpp).
     fins::server::ControlTarget target;
