@@ -33,7 +33,7 @@
 #include "bridge/bridge_processes.hpp"
 #include "fins/commands/memory_area.hpp"
 #include "fins/frame.hpp"
-#include "integration/process.hpp"
+#include "integration/support/process.hpp"
 
 namespace {
 

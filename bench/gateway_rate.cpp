@@ -23,8 +23,8 @@
 
 #include "fins/client.hpp"
 #include "fins/compoway_f.hpp"
-#include "integration/process.hpp"
-#include "integration/pty_pair.hpp"
+#include "integration/support/process.hpp"
+#include "integration/support/pty_pair.hpp"
 #include "plc/plc.hpp"
 #include "server/serial/serial_ports.hpp"
 #include "server/sessions/server.hpp"

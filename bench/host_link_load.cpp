@@ -32,7 +32,7 @@
 #include "fins/client.hpp"
 #include "fins/commands/memory_area.hpp"
 #include "fins/host_link.hpp"
-#include "integration/pty_pair.hpp"
+#include "integration/support/pty_pair.hpp"
 #include "plc/plc.hpp"
 #include "plc/profile.hpp"
 #include "server/dispatch/dispatcher.hpp"

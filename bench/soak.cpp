@@ -24,7 +24,7 @@
 #include <fmt/core.h>
 #include <CLI/CLI.hpp>
 
-#include "integration/process.hpp"
+#include "integration/support/process.hpp"
 #include "soak_clients.hpp"
 
 namespace {
@@ -49,7 +49,7 @@ struct Options {
     std::string keep_log;            // finsd's log kept at this path (else a removed temp file)
 };
 
-// finsd as a child (tests/integration/process.hpp's Child): stdout and stderr in a log file
+// finsd as a child (tests/integration/support/process.hpp's Child): stdout and stderr in a log file
 // that is shown when the run fails (a file, not a pipe: finsd logs to stdout, and a full
 // pipe would block its one I/O thread).
 class Finsd {

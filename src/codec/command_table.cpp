@@ -2,7 +2,7 @@
 //
 // Where 5-1-2 disagrees with a command's own "Execution Conditions" table in 5-3, this
 // table follows 5-1-2 and says so next to the row, so a handler can decide knowingly;
-// rows marked "Page decides" follow the command's own page(s) instead (tests/server/
+// rows marked "Page decides" follow the command's own page(s) instead (tests/server/dispatch/
 // execution_matrix_test.cpp lists them).
 #include "fins/command_table.hpp"
 

@@ -15,7 +15,7 @@
 
 #include "bridge/bridge_processes.hpp"
 #include "bridge/mqtt_recorder.hpp"
-#include "integration/finsd_run.hpp"
+#include "integration/support/finsd_process.hpp"
 
 namespace fins::bridge::test {
 

@@ -1,7 +1,7 @@
 // Programs, loopback ports and the mosquitto broker for every bridge test (bridge_fixture.hpp,
 // the cluster and Sparkplug tests in cluster/processes.hpp, bench/bridge_failover.cpp,
-// bench/bridge_load.cpp): one copy. Children are integration/process.hpp's Child, with their
-// stdout and stderr in a log file, so a chatty child never blocks on a full pipe. Every wait
+// bench/bridge_load.cpp): one copy. Children are integration/support/process.hpp's Child, with
+// their stdout and stderr in a log file, so a chatty child never blocks on a full pipe. Every wait
 // is bounded.
 #pragma once
 
@@ -19,8 +19,8 @@
 #include <thread>
 #include <vector>
 
-#include "integration/free_port.hpp"
-#include "integration/process.hpp"
+#include "integration/support/free_port.hpp"
+#include "integration/support/process.hpp"
 
 namespace fins::test::bridge {
 

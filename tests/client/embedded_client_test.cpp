@@ -18,7 +18,7 @@
 #include "client/loopback_servers.hpp"
 #include "fins/client.hpp"
 #include "fins/commands/memory_area.hpp"
-#include "integration/server_fixture.hpp"
+#include "integration/support/server_fixture.hpp"
 #include "transport/asio.hpp"
 
 using namespace fins;

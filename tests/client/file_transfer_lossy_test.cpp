@@ -11,7 +11,7 @@
 #include "client/lossy_proxy.hpp"
 #include "fins/client.hpp"
 #include "fins/commands/file_memory.hpp"
-#include "integration/server_fixture.hpp"
+#include "integration/support/server_fixture.hpp"
 
 using namespace fins;
 using namespace fins::test;

@@ -79,7 +79,7 @@ TEST(CommandTable, ModesAndProtection) {
         EXPECT_EQ(c.conditions.program, v != 0x0620) << c.name;
         EXPECT_EQ(c.conditions.um_read_protected, v != 0x0306) << c.name;
         // 22 0C: "No (note 1)" -- program-to-file still runs, so the row accepts it and
-        // the handler refuses file-to-program (tests/server/file_transfer_test.cpp).
+        // the handler refuses file-to-program (tests/server/handlers/file_transfer_test.cpp).
         const bool dip = v == 0x0202 || v == 0x0203 || v == 0x0307 || v == 0x0308;
         EXPECT_EQ(c.conditions.dip_write_protected, !dip) << c.name;
     }

@@ -14,7 +14,7 @@
 #include <boost/asio/write.hpp>
 
 #ifndef _WIN32
-#include "integration/pty_pair.hpp"
+#include "integration/support/pty_pair.hpp"
 #endif
 #include "transport/asio.hpp"
 #include "transport/serial_options.hpp"

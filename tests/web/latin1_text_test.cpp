@@ -9,8 +9,8 @@
 #include <boost/beast/core/buffers_to_string.hpp>
 #include <boost/beast/websocket.hpp>
 
-#include "integration/finsd_run.hpp"
-#include "integration/free_port.hpp"
+#include "integration/support/finsd_process.hpp"
+#include "integration/support/free_port.hpp"
 #include "plc/plc.hpp"
 #include "web/api.hpp"
 #include "web_server.hpp"
@@ -21,7 +21,9 @@ namespace {
 using Json = nlohmann::json;
 namespace websocket = beast::websocket;
 
-const std::string a_acute_bc = "A\xC3\xA1" "BC";  // words 41E1 4243
+const std::string a_acute_bc =
+    "A\xC3\xA1"
+    "BC";  // words 41E1 4243
 
 // Subscribes to D0 (2 words, as=ascii) over a WebSocket and returns the snapshot.
 Json ascii_snapshot(std::uint16_t port) {
@@ -140,9 +142,9 @@ TEST_F(Latin1Api, WritesTheTextCannotHoldAre400) {
         EXPECT_EQ(j["error"], c.error) << c.body;
     }
     // A JSON number beyond double's range is no JSON the API reads.
-    EXPECT_EQ(call("POST", "/api/write", R"({"address":"D0","values":[1e309],"as":"double"})")
-                  .status,
-              400u);
+    EXPECT_EQ(
+        call("POST", "/api/write", R"({"address":"D0","values":[1e309],"as":"double"})").status,
+        400u);
     EXPECT_EQ(dm(0), 0);
     EXPECT_EQ(dm(1), 0);
 }

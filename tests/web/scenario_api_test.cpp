@@ -5,8 +5,8 @@
 
 #include <string>
 
-#include "integration/finsd_run.hpp"
-#include "integration/free_port.hpp"
+#include "integration/support/finsd_process.hpp"
+#include "integration/support/free_port.hpp"
 #include "web_server.hpp"
 
 namespace fins::test {

@@ -19,8 +19,8 @@
 #include <boost/beast/core/buffers_to_string.hpp>
 #include <boost/beast/websocket.hpp>
 
-#include "integration/finsd_run.hpp"
-#include "integration/free_port.hpp"
+#include "integration/support/finsd_process.hpp"
+#include "integration/support/free_port.hpp"
 #include "web_server.hpp"
 
 namespace fins::test {

@@ -12,7 +12,7 @@
 //                         indices, DM initial values live in the CP1H's built-in flash,
 //                         which finsd does not have: always empty (the header alone).
 // Choices (docs/file-memory.md "Memory Cassette (22 20, CP1H)",
-// tests/server/memory_cassette_test.cpp):
+// tests/server/handlers/memory_cassette_test.cpp):
 //   110C  disk other than 8003, unknown parameter, reserved designation bits (14-08,
 //         01), bit 15 OFF with area bits ON (5-3-43 note), bit 15 ON with none.
 //   2301  no cassette mounted.

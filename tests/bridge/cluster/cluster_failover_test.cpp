@@ -10,7 +10,7 @@
 
 #include "bridge/cluster/processes.hpp"
 #include "bridge/cluster/rendezvous.hpp"
-#include "integration/finsd_run.hpp"
+#include "integration/support/finsd_process.hpp"
 
 namespace tb = fins::test::bridge;
 using namespace std::chrono_literals;

@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "bridge/cluster/processes.hpp"
-#include "integration/finsd_run.hpp"
+#include "integration/support/finsd_process.hpp"
 #include "sparkplug_b.pb.h"
 
 namespace tb = fins::test::bridge;

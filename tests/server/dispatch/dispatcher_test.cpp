@@ -64,7 +64,7 @@ TEST(Dispatcher, W342_5_1_3_WrongNetworkOrNodeIs0201) {
 }
 
 // A unit the profile does not mount, FE included, is 0202 (the CJ2H's unit 10, its
-// built-in EtherNet/IP port, is present: tests/server/configuration_test.cpp).
+// built-in EtherNet/IP port, is present: tests/server/handlers/configuration_test.cpp).
 TEST(Dispatcher, W342_5_1_3_UnitOtherThanCpuIs0202) {
     Harness h;
     for (std::uint8_t unit : std::array<std::uint8_t, 4>{0x01, 0x11, 0xE1, 0xFE}) {
