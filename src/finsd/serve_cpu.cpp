@@ -46,6 +46,7 @@ Expected<void> check_cpu_schedule(const ServedCpu& cpu) {
     Settings check;
     check.schedule = *cpu.setup.schedule;
     check.remotes = *cpu.setup.remotes;
+    check.max_connections = cpu.config->ports.front().max_connections;
     for (const auto& unit : cpu.config->ports)
         check.max_connections = std::min(check.max_connections, unit.max_connections);
     return check_schedule(check, cpu.plc->memory());
