@@ -4,8 +4,8 @@
 //
 //   open the CPU Units: each one's state file (or the heap) -> Plc -> operating mode ->
 //     file memory -> its Ethernet units bound (serve_single.cpp, serve_plant.cpp)
-//   each CPU Unit: [memory] -> [protection], [inject] -> scenario -> serial ports ->
-//     [[schedule]] (serve_cpu.cpp)
+//   each CPU Unit: [memory] -> [protection], [inject] -> Serial Gateway ports ->
+//     scenario -> Host Link ports -> [[schedule]] (serve_cpu.cpp)
 //   the web front (--http) -> the control channel -> SIGINT/SIGTERM handled ->
 //   "listening <port>" on stdout -> every state file checked once a second -> run
 //

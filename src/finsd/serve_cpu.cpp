@@ -78,6 +78,14 @@ int set_up_cpu(asio::io_context& io, const Served& served, std::size_t i, CpuUni
             "finsd: plc \"{}\": {} memory entries written", cpu.name, written);
     apply_cpu_options(*setup.options, plc);  // [protection], [inject]
 
+    // Serial Gateway ports (scuN.P / board.P in mode gateway) answer on every unit of the
+    // CPU Unit. (The start's log lines come in this order: gateway ports, scenario, Host
+    // Link ports.)
+    auto gateways = std::make_unique<server::SerialPorts>();
+    open_gateway_ports(io, *setup.serial, *gateways);
+    for (auto* unit : cpu.units)
+        unit->attach_serial_ports(gateways.get());
+    extras.gateways.push_back(std::move(gateways));
     // [scenario]: compiled against this CPU Unit, its ticks handed over between the
     // io_context and finsd's scenario thread, its unit faults on every unit of the CPU
     // Unit. A plant's ticks spread over the period in groups (ScenarioRunner::phase_of).
@@ -96,14 +104,8 @@ int set_up_cpu(asio::io_context& io, const Served& served, std::size_t i, CpuUni
         for (auto* unit : cpu.units)
             unit->dispatcher().attach_faults(extras.scenarios.back().get());
 
-    // Serial Gateway ports (scuN.P / board.P in mode gateway) answer on every unit of the
-    // CPU Unit; the Host Link slave ports talk to the CPU Unit through its first unit
-    // (frames for other networks are routed from there, as from any unit).
-    auto gateways = std::make_unique<server::SerialPorts>();
-    open_gateway_ports(io, *setup.serial, *gateways);
-    for (auto* unit : cpu.units)
-        unit->attach_serial_ports(gateways.get());
-    extras.gateways.push_back(std::move(gateways));
+    // The Host Link slave ports talk to the CPU Unit through its first unit (frames for
+    // other networks are routed from there, as from any unit).
     extras.host_link.emplace_back();
     if (auto r = start_serial_ports(io, cpu.units.front()->dispatcher(), *setup.serial,
                                     extras.host_link.back());
