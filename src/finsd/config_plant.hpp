@@ -30,11 +30,3 @@ Expected<void> load_plant(const toml::key& key, const toml::node& node, std::str
                           Settings& settings);
 
 }  // namespace fins::finsd
-
-namespace fins::finsd {
-
-// Runs the plant of settings.plant until SIGINT/SIGTERM: prints "listening <port>" (the
-// first unit's port) once every unit is bound. Exit codes as finsd's (main.cpp).
-int serve_plant(const Settings& settings);
-
-}  // namespace fins::finsd

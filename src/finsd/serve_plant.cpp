@@ -1,50 +1,25 @@
-// finsd with [[plc]] tables: the plant (server/routing/plant.hpp) on one I/O thread, and
-// what each CPU Unit has beyond its units: memory table, protections, injections, serial
-// ports and scheduled network instructions, set up as finsd sets them up for one node.
+// finsd with [[plc]] tables opened (contract in serve_units.hpp): the plant
+// (server/routing/plant.hpp) of settings.plant on finsd's one I/O thread, every CPU Unit
+// on its state file with its units bound. What each CPU Unit has beyond its units is set
+// up as for a single node (serve_cpu.cpp).
 #ifndef _WIN32
 #include <sys/resource.h>
 #endif
 
 #include <algorithm>
-#include <chrono>
-#include <csignal>
-#include <cstdio>
-#include <memory>
 #include <string>
-#include <vector>
 
 #include <spdlog/spdlog.h>
-#include <boost/asio/io_context.hpp>
-#include <boost/asio/signal_set.hpp>
 
 #include "finsd/config_plant.hpp"
-#include "finsd/control_setup.hpp"
-#include "finsd/process_os.hpp"
-#include "finsd/scenario_setup.hpp"
 #include "finsd/serial_gateway_setup.hpp"
-#include "finsd/serial_ports.hpp"
-#include "finsd/web_setup.hpp"
-#include "plc/injections.hpp"
+#include "finsd/serve_units.hpp"
 #include "plc/profile.hpp"
-#include "server/control/control.hpp"
-#include "server/instructions/instruction_schedule.hpp"
 #include "server/routing/router.hpp"
-#include "server/serial/serial_ports.hpp"
-#include "server/sessions/server.hpp"
-#include "transport/asio.hpp"
 
 namespace fins::finsd {
 
 namespace {
-
-int fail(int code, const std::string& message) {
-    std::fprintf(stderr, "finsd: %s\n", message.c_str());
-    return code;
-}
-
-// Above this many units (CPU Units) the lines for each ("unit N is FINS node ...", "N
-// memory entries written") are logged at debug level.
-constexpr std::size_t units_logged_at_info = 64;
 
 // The plant keeps a socket or two per unit open (server::plant_descriptors): the soft
 // limit on open files goes up to the hard one when the plant needs more than it allows
@@ -130,175 +105,31 @@ std::string plant_config(const Settings& s, server::PlantConfig& config) {
     return {};
 }
 
-// What runs beside the plant for its CPU Units; stopped before the plant.
-struct CpuUnitExtras {
-    // finsd's scenario thread (declared first: it outlives the runners).
-    std::unique_ptr<server::ScenarioWorker> scenario_worker;
-    std::vector<std::unique_ptr<server::SerialPorts>> gateways;
-    std::vector<SerialPorts> host_link;
-    std::vector<std::unique_ptr<server::InstructionSchedule>> schedules;
-    std::vector<std::unique_ptr<server::ScenarioRunner>> scenarios;  // per CPU Unit, or null
-
-    void stop() {
-        for (auto& scenario : scenarios)
-            if (scenario) scenario->stop();
-        for (auto& schedule : schedules)
-            schedule->stop();
-        for (auto& gateway : gateways)
-            gateway->close_all();
-        for (auto& ports : host_link)
-            ports.stop();
-    }
-};
-
-// CPU Unit `i` of the plant gets its memory table, options, serial ports and schedule.
-// -1, or finsd's exit code.
-int set_up_cpu(asio::io_context& io, const Settings& s, server::Plant& plant, std::size_t i,
-               CpuUnitExtras& extras) {
-    auto& plc = plant.plc(i);
-    const auto& cpu = s.plant_cpu[i];
-    const auto& config = s.plant.cpus[i];
-    // The memory table as [memory] is for a single node: checked against that CPU Unit's
-    // model; retained memory is left alone when its state came from data_dir.
-    if (auto r = check_initial_memory(cpu.memory, plc.memory()); !r) return fail(2, r.error());
-    Settings scheduled;
-    scheduled.schedule = cpu.schedule;
-    if (auto r = check_schedule(scheduled, plc.memory()); !r)
-        return fail(2, in_plant(r.error(), plc_path(i)));
-    const auto written = apply_initial_memory(cpu.memory, plc.memory(), plc.storage().restored());
-    // A line per CPU Unit at info for a plant a person reads; a site's go to debug.
-    if (!cpu.memory.empty())
-        spdlog::log(
-            plant.cpu_count() <= units_logged_at_info ? spdlog::level::info : spdlog::level::debug,
-            "finsd: plc \"{}\": {} memory entries written", config.name, written);
-    apply_cpu_options(cpu, plc);  // [plc.protection], [plc.inject]
-    // [plc.scenario]: compiled against this CPU Unit, its ticks handed over between the
-    // io_context and the plant's scenario thread, its unit faults on every unit of the
-    // CPU Unit.
-    std::unique_ptr<scenario::Scenario> compiled;
-    if (cpu.scenario) {
-        auto c = compile_scenario(*cpu.scenario, plc);
-        if (!c) return fail(2, c.error());
-        compiled = std::move(*c);
-    }
-    // The plant's ticks spread over the period in groups (ScenarioRunner::phase_of).
-    extras.scenarios.push_back(run_scenario(io, cpu.scenario, std::move(compiled), plc,
-                                            server::ScenarioRunner::phase_of(i),
-                                            extras.scenario_worker));
-    for (std::size_t k = 0; k < config.ports.size() && extras.scenarios.back(); ++k)
-        plant.server(i, k).dispatcher().attach_faults(extras.scenarios.back().get());
-
-    // Serial Gateway ports answer on every unit of the CPU Unit; the Host Link slave
-    // ports talk to the CPU Unit through its first unit (frames for other networks are
-    // routed from there, as from any unit).
-    auto gateways = std::make_unique<server::SerialPorts>();
-    open_gateway_ports(io, cpu.serial, *gateways);
-    for (std::size_t k = 0; k < config.ports.size(); ++k)
-        plant.server(i, k).attach_serial_ports(gateways.get());
-    extras.gateways.push_back(std::move(gateways));
-    extras.host_link.emplace_back();
-    if (auto r = start_serial_ports(io, plant.server(i, 0).dispatcher(), cpu.serial,
-                                    extras.host_link.back());
-        !r)
-        return fail(2, in_plant(r.error(), plc_path(i)));
-
-    // Each scheduled instruction leaves through the unit its destination network is
-    // reached by (the CPU Unit's routing tables).
-    std::vector<std::vector<server::ScheduledInstruction>> by_unit(config.ports.size());
-    for (const auto& e : cpu.schedule)
-        by_unit[server::unit_toward(config, e.scheduled.request.destination.network)].push_back(
-            e.scheduled);
-    for (std::size_t k = 0; k < by_unit.size(); ++k) {
-        if (by_unit[k].empty()) continue;
-        extras.schedules.push_back(std::make_unique<server::InstructionSchedule>(
-            io.get_executor(), plant.server(i, k).instructions(), std::move(by_unit[k])));
-        extras.schedules.back()->start();
-    }
-    return -1;
-}
-
 }  // namespace
 
-int serve_plant(const Settings& s) {
-    spdlog::set_level(spdlog::level::from_str(s.log_level));
-    ignore_file_size_signal();
-    server::PlantConfig config;
-    if (const auto problem = plant_config(s, config); !problem.empty()) return fail(2, problem);
+int open_plant(asio::io_context& io, const Settings& s, Served& served) {
+    if (const auto problem = plant_config(s, served.config); !problem.empty())
+        return report_failure(2, problem);
     warn_single_node_keys(s);
-    raise_descriptor_limit(server::plant_descriptors(config));
-    asio::io_context io{1};
-    auto plant = server::Plant::start(io, config);
-    if (!plant) return fail(3, "cannot start the plant: " + plant.error().message());
-    CpuUnitExtras extras;
-    for (std::size_t i = 0; i < s.plant_cpu.size() && i < (*plant)->cpu_count(); ++i)
-        if (const int rc = set_up_cpu(io, s, **plant, i, extras); rc >= 0) {
-            extras.stop();
-            return rc;
-        }
-    // The control channel (`finsd ctl --plc NAME|NET.NODE`) drives every [[plc]]; the
-    // first without --plc (control_setup.hpp).
-    std::vector<server::ControlTarget> targets((*plant)->cpu_count());
-    for (std::size_t i = 0; i < targets.size(); ++i) {
-        targets[i].plc = &(*plant)->plc(i);
-        targets[i].name = s.plant.cpus[i].name;
-        // send / recv / sendcmd leave through the CPU Unit's first unit.
-        targets[i].instructions = &(*plant)->server(i, 0).instructions();
-        if (i < extras.scenarios.size()) targets[i].scenario = extras.scenarios[i].get();
+    raise_descriptor_limit(server::plant_descriptors(served.config));
+    auto plant = server::Plant::start(io, served.config);
+    if (!plant) return report_failure(3, "cannot start the plant: " + plant.error().message());
+    served.plant = std::move(*plant);
+    auto& p = *served.plant;
+    served.cpus.resize(p.cpu_count());
+    static const Settings::PlantCpuSettings none;  // (the loader gives each [[plc]] one)
+    for (std::size_t i = 0; i < served.cpus.size(); ++i) {
+        auto& cpu = served.cpus[i];
+        const auto& extra = i < s.plant_cpu.size() ? s.plant_cpu[i] : none;
+        cpu.plc = &p.plc(i);
+        cpu.name = served.config.cpus[i].name;
+        cpu.config = &served.config.cpus[i];
+        for (std::size_t k = 0; k < cpu.config->ports.size(); ++k)
+            cpu.units.push_back(&p.server(i, k));
+        cpu.setup = {&extra,          &extra.memory,   &extra.serial,
+                     &extra.schedule, &extra.scenario, &cpu.config->remotes};
     }
-    for (std::size_t i = 0; i < (*plant)->router().port_count(); ++i) {
-        const auto& p = (*plant)->router().port(i);
-        targets[p.cpu].addresses.emplace_back(p.address.network, p.address.node);
-    }
-    // --http (docs/web.md): every CPU Unit, each with its first unit's server.
-    std::vector<const server::Server*> first_units;
-    for (std::size_t i = 0; i < targets.size(); ++i)
-        first_units.push_back(&(*plant)->server(i, 0));
-    auto web = start_web(io, s.http, targets, first_units, plant->get());
-    if (web.exit_code >= 0) {
-        extras.stop();
-        std::fprintf(stderr, "finsd: %s\n", web.error.c_str());
-        return web.exit_code;
-    }
-    auto control_start = start_control(io, std::move(targets), s.control_socket);
-    if (control_start.exit_code >= 0) {
-        extras.stop();
-        std::fprintf(stderr, "finsd: %s\n", control_start.error.c_str());
-        return control_start.exit_code;
-    }
-    auto& control = control_start.server;
-    asio::signal_set signals{io, SIGINT, SIGTERM};
-    auto& router = (*plant)->router();
-    // A line per unit at info for a plant a person reads; a site's 10,000 go to debug.
-    const auto unit_level =
-        router.port_count() <= units_logged_at_info ? spdlog::level::info : spdlog::level::debug;
-    if (spdlog::should_log(unit_level))
-        for (std::size_t i = 0; i < config.cpus.size(); ++i)
-            for (std::size_t k = 0; k < config.cpus[i].ports.size(); ++k) {
-                auto& server = (*plant)->server(i, k);
-                const auto self = server.address();
-                spdlog::log(unit_level,
-                            "finsd: plc \"{}\" unit {} is FINS node {}.{} on {} port {}",
-                            config.cpus[i].name, config.cpus[i].ports[k].unit_number, self.network,
-                            self.node, config.cpus[i].ports[k].bind,
-                            server.tcp_port() != 0 ? server.tcp_port() : server.udp_port());
-            }
-    auto& first = (*plant)->server(0, 0);
-    const unsigned port = first.tcp_port() != 0 ? first.tcp_port() : first.udp_port();
-    spdlog::info("finsd: plant of {} CPU Units, {} units{}", (*plant)->cpu_count(),
-                 router.port_count(),
-                 unit_level == spdlog::level::info ? "" : " (a line per unit at debug level)");
-    std::printf("listening %u\n", port);
-    std::fflush(stdout);
-    signals.async_wait([&](std::error_code, int signal) {
-        spdlog::info("finsd: signal {}, shutting down", signal);
-        extras.stop();
-        (*plant)->stop();
-        if (control) control->stop();
-        if (web.server) web.server->stop();
-        io.stop();
-    });
-    io.run();
-    return 0;
+    return -1;
 }
 
 }  // namespace fins::finsd

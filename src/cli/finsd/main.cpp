@@ -4,20 +4,12 @@
 //   finsd [--config FILE] [flags]   serve; flags override the file (config.hpp)
 //   finsd ctl ...                   the control channel's client (ctl.hpp)
 //
-// Start-up: settings -> Storage (the data directory's state file, or the heap) -> Plc
-// -> seal the storage -> [memory] initial values -> protections, mode, [inject] ->
-// Server -> control channel -> "listening <port>" on stdout.
-//
-// Exit codes: 0 clean shutdown (SIGINT/SIGTERM: the state file is closed cleanly, with
-// checksums), 2 usage or configuration error, 3 start-up failure (cannot bind, state
-// file refused, in use or without room on disk, control socket), 4 the state file shrank
-// while finsd ran (truncated from outside: plc/storage/storage_guard.hpp).
-#include <chrono>
-#include <csignal>
+// This file is the command line only: flags and the file become Settings (configure),
+// then fins::finsd::serve (src/finsd/serve.hpp) starts the single node or the plant,
+// serves it, and gives the exit code: 0 clean shutdown, 2 usage or configuration error,
+// 3 start-up failure, 4 a state file shrank while finsd ran.
 #include <cstdio>
-#include <fstream>
-#include <functional>
-#include <iterator>
+#include <exception>
 #include <memory>
 #include <optional>
 #include <string>
@@ -27,30 +19,12 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
-#include <boost/asio/io_context.hpp>
-#include <boost/asio/signal_set.hpp>
-#include <boost/asio/steady_timer.hpp>
 
 #include "finsd/config.hpp"
-#include "finsd/config_plant.hpp"
-#include "finsd/control_setup.hpp"
 #include "finsd/ctl.hpp"
-#include "finsd/process_os.hpp"
 #include "finsd/scenario_setup.hpp"
-#include "finsd/serial_gateway_setup.hpp"
-#include "finsd/serial_ports.hpp"
-#include "finsd/web_setup.hpp"
-#include "plc/plc.hpp"
+#include "finsd/serve.hpp"
 #include "plc/profile.hpp"
-#include "plc/storage/storage.hpp"
-#include "plc/storage/storage_format.hpp"
-#include "plc/storage/storage_guard.hpp"
-#include "scenario/scenario.hpp"
-#include "server/control/control.hpp"
-#include "server/instructions/instruction_schedule.hpp"
-#include "server/serial/serial_ports.hpp"
-#include "server/sessions/server.hpp"
-#include "transport/asio.hpp"
 
 namespace {
 
@@ -65,20 +39,6 @@ void take(CLI::Option* option, const T& value, std::optional<T>& out) {
 int fail(int code, const std::string& message) {
     std::fprintf(stderr, "finsd: %s\n", message.c_str());
     return code;
-}
-
-// The profile a foreign state file was written for, to name it in the refusal: the
-// header holds the profile name NUL-terminated (plc/storage/storage.cpp), so look for each known
-// name there rather than depend on the header's offsets.
-std::string state_file_profile(const std::filesystem::path& dir) {
-    std::ifstream f(dir / "finsd.state", std::ios::binary);
-    std::string head(4096, '\0');
-    f.read(head.data(), static_cast<std::streamsize>(head.size()));
-    head.resize(static_cast<std::size_t>(f.gcount()));
-    for (const auto& p : fins::plc::profiles())
-        if (head.find(std::string(1, '\0') + p.name + std::string(1, '\0')) != std::string::npos)
-            return p.name;
-    return "unknown";
 }
 
 void list_profiles() {
@@ -264,170 +224,6 @@ int configure(int argc, char** argv, Settings& settings) {
     return -1;
 }
 
-// The PLC on its state file (or the heap) into `plc` (plc::open_plc); -1, or the exit
-// code. A state file refused for its content stops finsd unless --reset-state.
-int open_plc(const Settings& s, const fins::plc::Profile& profile,
-             std::unique_ptr<fins::plc::Plc>& plc) {
-    using fins::plc::Storage;
-    auto opened = fins::plc::open_plc(profile, s.data_dir, {s.durability}, s.reset_state);
-    const std::string file =
-        s.data_dir ? (*s.data_dir / "finsd.state").string() : std::string("(heap)");
-    if (!opened) {
-        const std::error_code error = opened.error().error;
-        if (opened.error().setting_aside)
-            return fail(3, file + ": cannot move it aside: " + error.message());
-        const bool refused = Storage::is_refusal(error);
-        std::string why = error.message();
-        if (error == fins::plc::state_file::make_error(fins::plc::state_file::Error::other_profile))
-            why += fmt::format(": the file is for profile '{}', this finsd runs '{}'",
-                               state_file_profile(*s.data_dir), profile.name);
-        return fail(3, file + ": " + why +
-                           (refused ? "; finsd never replaces it by itself: start with "
-                                      "--reset-state to move it aside and begin with "
-                                      "empty retained memory"
-                                    : ""));
-    }
-    // Warnings about the operator's data go to stderr with the refusals, whatever the log
-    // level (stdout's first line stays "listening <port>" at warn).
-    if (opened->moved_aside)
-        std::fprintf(stderr,
-                     "finsd: warning: %s: %s; --reset-state moved it to %s: retained memory "
-                     "starts empty\n",
-                     file.c_str(), opened->refusal.message().c_str(),
-                     opened->moved_aside->string().c_str());
-    plc = std::move(opened->plc);
-    return -1;
-}
-
-int serve(const Settings& s) {
-    spdlog::set_level(spdlog::level::from_str(s.log_level));
-    fins::finsd::ignore_file_size_signal();
-    fins::plc::Profile profile = *fins::plc::find_profile(s.profile);
-    if (s.dip_write_protection) profile.dip_switch |= fins::plc::dip_pin1;
-    if (auto r = fins::finsd::mount_serial_units(s.serial, profile); !r) return fail(2, r.error());
-
-    std::unique_ptr<fins::plc::Plc> plc_owner;
-    if (const int rc = open_plc(s, profile, plc_owner); rc >= 0) return rc;
-    fins::plc::Plc& plc = *plc_owner;
-    const bool restored = plc.storage().restored();
-    if (s.data_dir && restored && !plc.storage().checksums_verified())
-        std::fprintf(stderr,
-                     "finsd: warning: %s was not stopped cleanly (SIGKILL, crash or power "
-                     "loss; or it was just converted from an earlier format): its header and "
-                     "section table are intact; its data has no valid checksums to check\n",
-                     plc.storage().path().string().c_str());
-    if (s.data_dir)
-        spdlog::info("finsd: {} state file {}", restored ? "restored" : "new",
-                     plc.storage().path().string());
-
-    if (auto r = check_initial_memory(s.memory, plc.memory()); !r) return fail(2, r.error());
-    if (auto r = check_schedule(s, plc.memory()); !r) return fail(2, r.error());
-    const auto written = apply_initial_memory(s.memory, plc.memory(), restored);
-    if (!s.memory.empty()) spdlog::info("finsd: {} [memory] entries written", written);
-    plc.change_mode(s.mode, std::chrono::system_clock::now());
-    fins::finsd::apply_cpu_options(s, plc);
-    // [scenario], --scenario: compiled against this CPU Unit; every error is a start error.
-    std::unique_ptr<fins::scenario::Scenario> scenario;
-    if (s.scenario) {
-        auto compiled = fins::finsd::compile_scenario(*s.scenario, plc);
-        if (!compiled) return fail(2, compiled.error());
-        scenario = std::move(*compiled);
-    }
-    // File memory (22 xx): <data_dir>/card and <data_dir>/em; else a temp dir removed at exit.
-    if (const auto refused = fins::server::set_up_file_memory(plc, s, s.data_dir, ""))
-        return fail(3, refused->message);
-
-    // The same translation as each unit of a plant gets (server/routing/plant.hpp).
-    auto options =
-        fins::server::options_for(fins::finsd::single_unit(s), fins::finsd::tcp_limits(s));
-    options.remotes = s.remotes;
-    asio::io_context io{1};
-    auto server = fins::server::Server::start(io, plc, options);
-    if (!server)
-        return fail(3, "cannot listen on " + s.bind + " port " + std::to_string(s.port) + ": " +
-                           server.error().message());
-    // [[schedule]]: this node's own Send/Rcv/SendCmd at fixed periods.
-    std::vector<fins::server::ScheduledInstruction> scheduled;
-    for (const auto& e : s.schedule)
-        scheduled.push_back(e.scheduled);
-    fins::server::InstructionSchedule schedule(io.get_executor(), (*server)->instructions(),
-                                               std::move(scheduled));
-    schedule.start();
-    // Serial Gateway ports (scuN.P / board.P in mode gateway): serial_gateway_setup.hpp.
-    fins::server::SerialPorts gateway_ports;
-    fins::finsd::open_gateway_ports(io, s.serial, gateway_ports);
-    (*server)->attach_serial_ports(&gateway_ports);
-    // The scenario's ticks are computed on finsd's scenario thread, handed over on this
-    // io_context; its unit faults reach the dispatcher.
-    std::unique_ptr<fins::server::ScenarioWorker> scenario_worker;
-    auto runner = fins::finsd::run_scenario(io, s.scenario, std::move(scenario), plc, std::nullopt,
-                                            scenario_worker);
-    if (runner) (*server)->dispatcher().attach_faults(runner.get());
-    // --control, FINSD_SOCKET or the default path (control_setup.hpp).
-    fins::server::ControlTarget target;
-    target.scenario = runner.get();
-    target.plc = &plc;
-    target.addresses = {{(*server)->address().network, (*server)->address().node}};
-    target.instructions = &(*server)->instructions();
-    target.schedule = &schedule;
-    // --http (docs/web.md): the same CPU Unit, on this io_context.
-    auto web = fins::finsd::start_web(io, s.http, {target}, {server->get()});
-    if (web.exit_code >= 0) return fail(web.exit_code, web.error);
-    auto control_start = fins::finsd::start_control(io, {std::move(target)}, s.control_socket);
-    if (control_start.exit_code >= 0) return fail(control_start.exit_code, control_start.error);
-    auto& control = control_start.server;
-    fins::finsd::SerialPorts serial;
-    if (auto r = start_serial_ports(io, (*server)->dispatcher(), s.serial, serial); !r)
-        return fail(2, r.error());
-    // Before "listening": a SIGTERM right after that line still stops finsd cleanly.
-    asio::signal_set signals{io, SIGINT, SIGTERM};
-    const auto self = (*server)->address();
-    const unsigned port =
-        (*server)->tcp_port() != 0 ? (*server)->tcp_port() : (*server)->udp_port();
-    spdlog::info("finsd: {} ({}) on {} port {} (UDP {}, TCP {}), FINS address {}.{}.{}",
-                 plc.profile().model, plc.profile().name, s.bind, port, s.udp ? "on" : "off",
-                 s.tcp ? "on" : "off", self.network, self.node, self.unit);
-    // A line on stdout that scripts and tests can wait for: "listening <port>".
-    std::printf("listening %u\n", port);
-    std::fflush(stdout);
-
-    const auto shut_down = [&] {
-        schedule.stop();
-        if (runner) runner->stop();
-        (*server)->stop();
-        gateway_ports.close_all();
-        if (control) control->stop();
-        if (web.server) web.server->stop();
-        serial.stop();
-        plc.storage().flush();
-        io.stop();
-    };
-    signals.async_wait([&](std::error_code, int signal) {
-        spdlog::info("finsd: signal {}, shutting down", signal);
-        shut_down();
-    });
-    // A state file truncated from outside is caught by the SIGBUS guard at the next
-    // access; this look once a second also catches it while nothing touches the file.
-    asio::steady_timer file_check{io};
-    std::function<void()> check_file = [&] {
-        file_check.expires_after(std::chrono::seconds(1));
-        file_check.async_wait([&](std::error_code ec) {
-            if (ec) return;
-            if (!plc.storage().intact()) return shut_down();
-            check_file();
-        });
-    };
-    if (s.data_dir) check_file();
-    io.run();
-    if (!plc.storage().intact()) {
-        std::fputs(fins::plc::state_file_lost_message(plc.storage().path().string()).c_str(),
-                   stderr);
-        return fins::plc::state_file_lost_exit_code;
-    }
-    plc.storage().close();  // sections on disk, then their checksums and "stopped cleanly"
-    return 0;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -439,8 +235,7 @@ int main(int argc, char** argv) {
     Settings settings;
     if (const int rc = configure(argc, argv, settings); rc >= 0) return rc;
     try {
-        if (!settings.plant.cpus.empty()) return fins::finsd::serve_plant(settings);
-        return serve(settings);
+        return fins::finsd::serve(settings);
     } catch (const std::exception& e) {
         return fail(3, e.what());
     }

@@ -180,6 +180,63 @@ TEST(FinsdStateFile, TruncatedThenStoppedExits4AndWritesNothing) {
     EXPECT_EQ(fs::file_size(file), 0u);
 }
 
+// Issue 27: a plant's CPU Unit is held to the same rule. Its state file truncated while
+// finsd runs, with nothing touching it, is found by the check once a second over every
+// CPU Unit's file: exit 4 and the guard's line naming that file, no seal written over
+// it; the other CPU Unit's file is closed cleanly (a later start finds its checksums).
+std::string two_cpu_plant(const ScratchDir& dir, const fs::path& data) {
+    return dir.write("plant.toml", R"(
+[[plc]]
+name = "a"
+data_dir = ")" + (data / "a").string() +
+                                       R"("
+  [[plc.ethernet]]
+  network = 1
+  bind = "127.0.0.1"
+[[plc]]
+name = "b"
+data_dir = ")" + (data / "b").string() +
+                                       R"("
+  [[plc.ethernet]]
+  network = 2
+  bind = "127.0.0.1"
+)");
+}
+
+TEST(FinsdStateFile, PlantUnitTruncatedWhileRunningExits4NamingItsFile) {
+    ScratchDir dir("planttrunc");
+    const fs::path data = dir.path() / "data";
+    const fs::path lost = data / "b" / "finsd.state";
+    const fs::path kept = data / "a" / "finsd.state";
+    Finsd d({"--config", two_cpu_plant(dir, data)});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    std::ofstream(lost, std::ios::binary | std::ios::trunc).close();  // : > b/finsd.state
+    const auto ended = d.stop(0);  // signal 0: only waits (20 s at most)
+    EXPECT_EQ(ended.exit_code, plc::state_file_lost_exit_code) << ended.err;
+    EXPECT_TRUE(has(ended.err, plc::state_file_lost_message(lost.string()))) << ended.err;
+    EXPECT_FALSE(has(ended.err, kept.string())) << ended.err;
+    EXPECT_EQ(fs::file_size(lost), 0u);
+    Finsd again({"--data-dir", kept.parent_path().string()});
+    ASSERT_TRUE(again.started()) << again.result().err;
+    const auto stopped = again.stop();
+    EXPECT_EQ(stopped.exit_code, 0);
+    EXPECT_FALSE(has(stopped.err, "not stopped cleanly")) << stopped.err;
+}
+
+// Truncated, then SIGTERM before anything looks: exit 4 too, as for a single node.
+TEST(FinsdStateFile, PlantUnitTruncatedThenStoppedExits4) {
+    ScratchDir dir("planttrunc");
+    const fs::path data = dir.path() / "data";
+    const fs::path lost = data / "a" / "finsd.state";
+    Finsd d({"--config", two_cpu_plant(dir, data)});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    std::ofstream(lost, std::ios::binary | std::ios::trunc).close();
+    const auto ended = d.stop(SIGTERM);
+    EXPECT_EQ(ended.exit_code, plc::state_file_lost_exit_code) << ended.err;
+    EXPECT_TRUE(has(ended.err, plc::state_file_lost_message(lost.string()))) << ended.err;
+    EXPECT_EQ(fs::file_size(lost), 0u);
+}
+
 TEST(FinsdStateFile, StorageKeysAndFlags) {
     using finsd::Settings;
     Settings s;

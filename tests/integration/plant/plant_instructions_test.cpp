@@ -14,6 +14,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "fins/address.hpp"
 #include "integration/support/finsd_process.hpp"
@@ -75,7 +76,8 @@ TEST(PlantInstructions, W596_3_EachCpuUnitRunsItsOwnSchedule) {
   remote = "D200"
   count = 2
 )";
-    Finsd d({"--config", dir.write("plant.toml", plant(schedule, ""))});
+    const std::string socket = (dir.path() / "ctl.sock").string();
+    Finsd d({"--config", dir.write("plant.toml", plant(schedule, "")), "--control", socket});
     ASSERT_TRUE(d.started()) << d.result().err;
     std::vector<std::uint16_t> got;
     for (int i = 0; i < 100 && got != std::vector<std::uint16_t>{7, 8}; ++i) {
@@ -85,6 +87,45 @@ TEST(PlantInstructions, W596_3_EachCpuUnitRunsItsOwnSchedule) {
     }
     EXPECT_EQ(got, (std::vector<std::uint16_t>{7, 8}));
     EXPECT_EQ(words_at(1, "D200"), (std::vector<std::uint16_t>{0, 0}));
+    // Issue 27: `finsd ctl --plc NAME instructions` lists that CPU Unit's schedule, as a
+    // single node's lists its [[schedule]] (it used to list none in a plant).
+    const auto a =
+        nlohmann::json::parse(ctl(socket, {"--plc", "line-a", "instructions"}).out, nullptr, false);
+    ASSERT_EQ(a["schedule"].size(), 1u) << a.dump();
+    EXPECT_GE(a["schedule"][0]["done"].get<int>(), 1) << a.dump();
+    const auto b =
+        nlohmann::json::parse(ctl(socket, {"--plc", "line-b", "instructions"}).out, nullptr, false);
+    EXPECT_EQ(b["schedule"].size(), 0u) << b.dump();
+}
+
+// Issue 27, W596 1-4: a unit's FINS/TCP connections count its [[plc.remote]] clients, as
+// a single node's count its [[remote]]s: more than max_connections is a start error.
+TEST(PlantInstructions, W596_1_4_TcpRemotesCountAgainstTheUnitsConnections) {
+    ScratchDir dir("plant-remote-limit");
+    // `remotes` FINS/TCP [[plc.remote]]s (nothing listens: they only retry) on a unit
+    // allowing `limit` connections.
+    const auto config = [&](int remotes, int limit) {
+        std::string text = "[[plc]]\nname = \"line-a\"\n";
+        for (int node = 1; node <= remotes; ++node)
+            text += "  [[plc.remote]]\n  network = 1\n  node = " + std::to_string(node + 100) +
+                    "\n  address = \"127.0.0.1:9\"\n  transport = \"tcp\"\n";
+        text +=
+            "  [[plc.ethernet]]\n  network = 1\n  bind = \"127.0.0.1\"\n"
+            "  max_connections = " +
+            std::to_string(limit) + "\n";
+        return dir.write("plant-" + std::to_string(limit) + ".toml", text);
+    };
+    Finsd refused({"--config", config(2, 1)});
+    ASSERT_FALSE(refused.started());
+    EXPECT_EQ(refused.result().exit_code, 2) << refused.result().err;
+    EXPECT_NE(refused.result().err.find("plc[0]: 2 [[remote]] entries with transport = "
+                                        "\"tcp\", but max_connections is 1"),
+              std::string::npos)
+        << refused.result().err;
+    // Within the unit's own limit, above the default 16: served.
+    Finsd served({"--config", config(17, 20)});
+    ASSERT_TRUE(served.started()) << served.result().err;
+    EXPECT_EQ(served.stop().exit_code, 0);
 }
 
 // A datagram socket standing for a remote node.
