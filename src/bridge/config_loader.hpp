@@ -12,11 +12,13 @@
 #include <set>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
 #include "bridge/config.hpp"
+#include "config/schema.hpp"
 #include "fins/commands/memory_area.hpp"
 #include "fins/node_address.hpp"
 #include "plc/profile.hpp"
@@ -39,12 +41,13 @@ class Loader {
         fail(n.source(), message);
     }
 
-    // Every key of `t` must be one of `known`; the first other one is the error.
+    // Every key of `t` must be one of `known`; the first other one in the file is the error,
+    // worded as every loader's (config/schema.hpp).
     void only(const toml::table& t, std::string_view where,
               std::initializer_list<std::string_view> known) const {
-        for (auto&& [k, v] : t)
-            if (std::find(known.begin(), known.end(), k.str()) == known.end())
-                fail(k.source(), fmt::format("unknown key '{}' in {}", k.str(), where));
+        const std::vector<config::Key> keys(known.begin(), known.end());
+        if (auto r = config::read_table(t, {source_, "", config::At::value, where}, keys); !r)
+            throw Failure{r.error()};
     }
 
     const toml::table& table(const toml::node& n, std::string_view what) const {

@@ -2,6 +2,7 @@
 // address strings, and the raw bytes the CLI and the control channel take.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string_view>
@@ -44,6 +45,28 @@ inline std::optional<std::vector<std::uint8_t>> parse_bytes(std::string_view tex
     }
     if (high >= 0) return std::nullopt;
     return out;
+}
+
+// Whether a number may be written with a "0x" (or "0X") before its digits.
+enum class Prefix { none, optional };
+
+// A number in hex digits alone ("1a"), or after "0x" where `prefix` allows ("0x1A"): its
+// value, when there are 1 to `max_digits` (at most 16) digits. Nothing for "", "0x", a sign,
+// a space or any other character.
+constexpr std::optional<std::uint64_t> parse_number(std::string_view text,
+                                                    std::size_t max_digits = 16,
+                                                    Prefix prefix = Prefix::optional) noexcept {
+    if (prefix == Prefix::optional && text.size() > 2 && text[0] == '0' &&
+        (text[1] == 'x' || text[1] == 'X'))
+        text.remove_prefix(2);
+    if (text.empty() || text.size() > max_digits || text.size() > 16) return std::nullopt;
+    std::uint64_t value = 0;
+    for (const char c : text) {
+        const int d = digit_value(c);
+        if (d < 0) return std::nullopt;
+        value = value * 16 + static_cast<std::uint64_t>(d);
+    }
+    return value;
 }
 
 }  // namespace fins::hex

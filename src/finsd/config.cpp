@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include "config/schema.hpp"
 #include "fins/values.hpp"
 #include "finsd/config_plant.hpp"
 #include "finsd/config_values.hpp"
@@ -22,116 +23,70 @@ namespace fins::finsd {
 
 namespace {
 
+using config::At;
+using config::Entry;
+using config::Key;
+using config::Type;
+using Fail = tl::unexpected<Error>;
+
 class Loader {
   public:
     Loader(std::string_view source, Settings& settings) : source_(source), s_(settings) {}
 
+    // Every problem at its key (the line names the key; the value may span lines).
     Expected<void> load(const toml::table& root) {
-        for (const auto& [key_ptr, node_ptr] : in_file_order(root)) {
-            const toml::key& key = *key_ptr;
-            const toml::node& node = *node_ptr;
-            const std::string k(key.str());
-            Expected<void> r;
-            if (k == "profile")
-                r = text(key, node, k, s_.profile);
-            else if (k == "mode")
-                r = mode(key, node);
-            else if (k == "data_dir")
-                r = path(key, node, k, s_.data_dir);
-            else if (k == "control")
-                r = path(key, node, k, s_.control_socket);
-            else if (k == "log_level")
-                r = text(key, node, k, s_.log_level);
-            else if (k == "network")
-                r = section(key, node, k, &Loader::network);
-            else if (k == "protection")
-                r = section(key, node, k, &Loader::protection);
-            else if (k == "memory")
-                r = section(key, node, k, &Loader::memory);
-            else if (k == "storage")
-                r = section(key, node, k, &Loader::storage);
-            else if (k == "inject")
-                r = section(key, node, k, &Loader::inject);
-            else if (k == "files")
-                r = section(key, node, k, &Loader::files);
-            else if (k == "serial")
-                r = load_serial_table(node, source_, s_.serial);
-            else if (k == "plc")
-                r = load_plant(key, node, source_, s_);
-            else if (k == "remote")
-                r = load_remotes(key, node, source_, s_);
-            else if (k == "schedule")
-                r = load_schedule(key, node, source_, s_);
-            else if (k == "http")
-                r = load_http_table(node, source_, s_.http);
+        return config::read_table(
+            root, {source_, "", At::key},
+            {config::text_key("profile", s_.profile),
+             {"mode", Type::string, [this](const Entry& e) { return mode(e); }},
+             path_key("data_dir", s_.data_dir),
+             path_key("control", s_.control_socket),
+             config::text_key("log_level", s_.log_level),
+             section("network", &Loader::network),
+             section("protection", &Loader::protection),
+             section("memory", &Loader::memory),
+             section("storage", &Loader::storage),
+             section("inject", &Loader::inject),
+             section("files", &Loader::files),
+             {"serial", Type::any,
+              [this](const Entry& e) { return load_serial_table(e.node, source_, s_.serial); }},
+             {"plc", Type::any,
+              [this](const Entry& e) { return load_plant(e.key, e.node, source_, s_); }},
+             {"remote", Type::any,
+              [this](const Entry& e) { return load_remotes(e.key, e.node, source_, s_); }},
+             {"schedule", Type::any,
+              [this](const Entry& e) { return load_schedule(e.key, e.node, source_, s_); }},
+             {"http", Type::any,
+              [this](const Entry& e) { return load_http_table(e.node, source_, s_.http); }},
+             {"scenario", Type::any, [this](const Entry& e) { return scenario(e.node); }}});
+    }
 
-            else if (k == "scenario")
-                r = scenario(node);
-            else
-                r = fail(key, k, "unknown key");
-            if (!r) return r;
-        }
-        return {};
+    // A [[plc]]'s own [protection], [inject], [storage] or [files] table.
+    Expected<void> cpu_section(const toml::key& key, const toml::node& node, const std::string& p) {
+        const config::Table how(source_, "", At::key);
+        const Entry e{key, node, p, how};
+        if (!node.is_table()) return e.fail("must be a table");
+        if (key.str() == "protection") return protection(e);
+        if (key.str() == "inject") return inject(e);
+        if (key.str() == "storage") return storage(e);
+        if (key.str() == "files") return files(e);
+        return e.fail("unknown key");
     }
 
   private:
-    using Handler = Expected<void> (Loader::*)(const toml::key&, const toml::node&,
-                                               const std::string&);
-
+    Key section(std::string_view name, Expected<void> (Loader::*read)(const Entry&)) {
+        return {name, Type::table, [this, read](const Entry& e) { return (this->*read)(e); }};
+    }
+    static Key path_key(std::string_view name, std::optional<std::filesystem::path>& out) {
+        return {name, Type::string, [&out](const Entry& e) -> Expected<void> {
+                    if (e.text().empty()) return e.fail("must not be empty");
+                    out = e.text();
+                    return {};
+                }};
+    }
     tl::unexpected<Error> fail(const toml::key& key, std::string_view path,
                                std::string_view message) const {
-        return fail_at(key.source(), path, message);
-    }
-    tl::unexpected<Error> fail_at(const toml::source_region& where, std::string_view path,
-                                  std::string_view message) const {
-        return tl::unexpected<Error>(fmt::format("{}:{}:{}: {}: {}", source_, where.begin.line,
-                                                 where.begin.column, path, message));
-    }
-    std::string position(const toml::key& key) const {
-        return fmt::format("{}:{}:{}", source_, key.source().begin.line, key.source().begin.column);
-    }
-
-    Expected<void> section(const toml::key& key, const toml::node& node, const std::string& path,
-                           Handler handler) {
-        const auto* table = node.as_table();
-        if (table == nullptr) return fail(key, path, "must be a table");
-        for (const auto& [k, v] : in_file_order(*table)) {
-            const std::string child = path + "." + std::string(k->str());
-            if (auto r = (this->*handler)(*k, *v, child); !r) return r;
-        }
-        return {};
-    }
-
-    Expected<void> text(const toml::key& key, const toml::node& node, const std::string& path,
-                        std::string& out) const {
-        const auto* v = node.as_string();
-        if (v == nullptr) return fail(key, path, "must be a string");
-        out = v->get();
-        return {};
-    }
-    Expected<void> path(const toml::key& key, const toml::node& node, const std::string& p,
-                        std::optional<std::filesystem::path>& out) const {
-        std::string value;
-        if (auto r = text(key, node, p, value); !r) return r;
-        if (value.empty()) return fail(key, p, "must not be empty");
-        out = value;
-        return {};
-    }
-    Expected<void> flag(const toml::key& key, const toml::node& node, const std::string& path,
-                        bool& out) const {
-        const auto* v = node.as_boolean();
-        if (v == nullptr) return fail(key, path, "must be true or false");
-        out = v->get();
-        return {};
-    }
-    Expected<std::int64_t> integer(const toml::key& key, const toml::node& node,
-                                   const std::string& path, std::int64_t lo,
-                                   std::int64_t hi) const {
-        const auto* v = node.as_integer();
-        if (v == nullptr) return fail(key, path, "must be an integer");
-        if (v->get() < lo || v->get() > hi)
-            return fail(key, path, fmt::format("{} is not {}-{}", v->get(), lo, hi));
-        return v->get();
+        return config::fail_at(source_, key.source(), path, message);
     }
 
     Expected<void> scenario(const toml::node& node) {
@@ -141,148 +96,110 @@ class Loader {
         return {};
     }
 
-    Expected<void> mode(const toml::key& key, const toml::node& node) {
-        std::string value;
-        if (auto r = text(key, node, "mode", value); !r) return r;
-        const auto m = parse_mode(value);
-        if (!m) return fail(key, "mode", fmt::format("'{}' is not program, monitor or run", value));
+    Expected<void> mode(const Entry& e) {
+        const auto m = parse_mode(e.text());
+        if (!m) return e.fail(fmt::format("'{}' is not program, monitor or run", e.text()));
         s_.mode = *m;
         return {};
     }
 
-    Expected<void> network(const toml::key& key, const toml::node& node, const std::string& p) {
-        const std::string_view k = key.str();
-        if (k == "bind") return text(key, node, p, s_.bind);
-        if (k == "udp") return flag(key, node, p, s_.udp);
-        if (k == "tcp") return flag(key, node, p, s_.tcp);
-        std::int64_t lo = 0;
-        std::int64_t hi = 0;
-        if (k == "node")
-            hi = 254;
-        else if (k == "network")
-            hi = 127;
-        else if (k == "port")
-            hi = 65535;
-        else if (k == "max_connections") {
-            lo = 1;
-            hi = 254;
-        } else if (k == "tcp_handshake_timeout" || k == "tcp_frame_timeout") {
-            lo = 1;
-            hi = 3600;
-        } else if (k == "tcp_idle_timeout")
-            hi = 86400;
-        else if (k == "tcp_keepalive")
-            hi = 7200;
-        else if (k == "tcp_max_pending") {
-            lo = 1;
-            hi = 1024;
-        } else
-            return fail(key, p, "unknown key");
-        const auto v = integer(key, node, p, lo, hi);
-        if (!v) return tl::unexpected<Error>(v.error());
-        if (k == "node") s_.node = static_cast<std::uint8_t>(*v);
-        if (k == "network") s_.network = static_cast<std::uint8_t>(*v);
-        if (k == "port") s_.port = static_cast<std::uint16_t>(*v);
-        if (k == "max_connections") s_.max_connections = static_cast<std::size_t>(*v);
-        if (k == "tcp_handshake_timeout") s_.tcp_handshake_timeout = static_cast<unsigned>(*v);
-        if (k == "tcp_frame_timeout") s_.tcp_frame_timeout = static_cast<unsigned>(*v);
-        if (k == "tcp_idle_timeout") s_.tcp_idle_timeout = static_cast<unsigned>(*v);
-        if (k == "tcp_keepalive") s_.tcp_keepalive = static_cast<unsigned>(*v);
-        if (k == "tcp_max_pending") s_.tcp_max_pending = static_cast<std::size_t>(*v);
-        return {};
+    Expected<void> network(const Entry& e) {
+        return config::read_table(
+            e, {config::text_key("bind", s_.bind), config::flag_key("udp", s_.udp),
+                config::flag_key("tcp", s_.tcp), config::integer_key("node", s_.node, 0, 254),
+                config::integer_key("network", s_.network, 0, 127),
+                config::integer_key("port", s_.port, 0, 65535),
+                config::integer_key("max_connections", s_.max_connections, 1, 254),
+                config::integer_key("tcp_handshake_timeout", s_.tcp_handshake_timeout, 1, 3600),
+                config::integer_key("tcp_frame_timeout", s_.tcp_frame_timeout, 1, 3600),
+                config::integer_key("tcp_idle_timeout", s_.tcp_idle_timeout, 0, 86400),
+                config::integer_key("tcp_keepalive", s_.tcp_keepalive, 0, 7200),
+                config::integer_key("tcp_max_pending", s_.tcp_max_pending, 1, 1024)});
     }
 
     // [files] card = true/false, card_kbytes = 1-4194303, em_file_bank = 0-24,
     // cassette = true/false.
-    Expected<void> files(const toml::key& key, const toml::node& node, const std::string& p) {
-        const std::string_view k = key.str();
-        if (k == "card") {
-            bool inserted = true;
-            if (auto r = flag(key, node, p, inserted); !r) return r;
-            if (!inserted)
-                s_.card_kbytes = 0;
-            else if (s_.card_kbytes == 0u)
-                s_.card_kbytes.reset();
-            return {};
-        }
-        if (k == "card_kbytes") {
-            const auto v = integer(key, node, p, 1, 4194303);
-            if (!v) return tl::unexpected(v.error());
-            if (s_.card_kbytes != 0u) s_.card_kbytes = static_cast<std::uint32_t>(*v);
-            return {};
-        }
-        if (k == "cassette") {
-            bool mounted = true;
-            if (auto r = flag(key, node, p, mounted); !r) return r;
-            s_.cassette = mounted;
-            return {};
-        }
-        if (k == "em_file_bank") {
-            const auto v = integer(key, node, p, 0, 24);
-            if (!v) return tl::unexpected(v.error());
-            s_.em_file_bank = static_cast<std::uint8_t>(*v);
-            return {};
-        }
-        return fail(key, p, "unknown key");
+    Expected<void> files(const Entry& e) {
+        return config::read_table(e, {{"card", Type::boolean,
+                                       [this](const Entry& k) -> Expected<void> {
+                                           if (!k.flag())
+                                               s_.card_kbytes = 0;
+                                           else if (s_.card_kbytes == 0u)
+                                               s_.card_kbytes.reset();
+                                           return {};
+                                       }},
+                                      {"card_kbytes", Type::integer,
+                                       [this](const Entry& k) -> Expected<void> {
+                                           const auto v = k.integer(1, 4194303);
+                                           if (!v) return Fail(v.error());
+                                           if (s_.card_kbytes != 0u)
+                                               s_.card_kbytes = static_cast<std::uint32_t>(*v);
+                                           return {};
+                                       }},
+                                      config::flag_key("cassette", s_.cassette),
+                                      config::integer_key("em_file_bank", s_.em_file_bank, 0, 24)});
     }
 
-    Expected<void> protection(const toml::key& key, const toml::node& node, const std::string& p) {
-        const std::string_view k = key.str();
-        if (k == "um_read") return flag(key, node, p, s_.um_read_protection);
-        if (k == "dip_write") return flag(key, node, p, s_.dip_write_protection);
-        if (k == "password") {
-            std::string value;
-            if (auto r = text(key, node, p, value); !r) return r;
-            // CJ2 CPU Units take 16 characters (CS/CJ 8); printable ASCII.
-            const bool printable = std::all_of(value.begin(), value.end(),
-                                               [](char c) { return c >= 0x20 && c < 0x7F; });
-            if (value.empty() || value.size() > 16 || !printable)
-                return fail(key, p, "must be 1-16 printable ASCII characters");
-            s_.um_password = value;
-            return {};
-        }
-        if (k == "network_write") {
-            std::string value;
-            if (auto r = text(key, node, p, value); !r) return r;
-            const auto mode = parse_protection(value);
-            if (!mode)
-                return fail(
-                    key, p,
-                    fmt::format("'{}' is not off, all, listed or all-except-listed", value));
-            s_.network_write_protection.mode = *mode;
-            return {};
-        }
-        if (k != "nodes") return fail(key, p, "unknown key");
-        const auto* list = node.as_array();
-        if (list == nullptr) return fail(key, p, "must be an array of \"network.node\" strings");
+    Expected<void> protection(const Entry& e) {
+        return config::read_table(
+            e, {config::flag_key("um_read", s_.um_read_protection),
+                config::flag_key("dip_write", s_.dip_write_protection),
+                {"password", Type::string,
+                 [this](const Entry& k) -> Expected<void> {
+                     // CJ2 CPU Units take 16 characters (CS/CJ 8); printable ASCII.
+                     const std::string& value = k.text();
+                     const bool printable = std::all_of(
+                         value.begin(), value.end(), [](char c) { return c >= 0x20 && c < 0x7F; });
+                     if (value.empty() || value.size() > 16 || !printable)
+                         return k.fail("must be 1-16 printable ASCII characters");
+                     s_.um_password = value;
+                     return {};
+                 }},
+                {"network_write", Type::string,
+                 [this](const Entry& k) -> Expected<void> {
+                     const auto mode = parse_protection(k.text());
+                     if (!mode)
+                         return k.fail(fmt::format(
+                             "'{}' is not off, all, listed or all-except-listed", k.text()));
+                     s_.network_write_protection.mode = *mode;
+                     return {};
+                 }},
+                {"nodes", Type::any, [this](const Entry& k) { return protected_nodes(k); }}});
+    }
+
+    Expected<void> protected_nodes(const Entry& e) {
+        const auto* list = e.node.as_array();
+        if (list == nullptr) return e.fail("must be an array of \"network.node\" strings");
         if (list->size() > plc::max_protection_nodes)
-            return fail(key, p, fmt::format("more than {} nodes", plc::max_protection_nodes));
+            return e.fail(fmt::format("more than {} nodes", plc::max_protection_nodes));
         s_.network_write_protection.nodes.clear();
         for (std::size_t i = 0; i < list->size(); ++i) {
             const auto* item = (*list)[i].as_string();
             const auto n = item != nullptr ? parse_node(item->get()) : std::nullopt;
             if (!n)
-                return fail(key, fmt::format("{}[{}]", p, i),
+                return fail(e.key, fmt::format("{}[{}]", e.path, i),
                             "must be \"network.node\" (network 0-127, node 1-254 or *)");
             s_.network_write_protection.nodes.push_back(*n);
         }
         return {};
     }
 
-    Expected<void> storage(const toml::key& key, const toml::node& node, const std::string& p) {
-        if (key.str() != "durability") return fail(key, p, "unknown key");
-        std::string value;
-        if (auto r = text(key, node, p, value); !r) return r;
-        const auto d = parse_durability(value);
-        if (!d) return fail(key, p, fmt::format("'{}' is not process or power", value));
-        s_.durability = *d;
-        return {};
+    Expected<void> storage(const Entry& e) {
+        return config::read_table(
+            e, {{"durability", Type::string, [this](const Entry& k) -> Expected<void> {
+                     const auto d = parse_durability(k.text());
+                     if (!d) return k.fail(fmt::format("'{}' is not process or power", k.text()));
+                     s_.durability = *d;
+                     return {};
+                 }}});
     }
 
-    Expected<void> memory(const toml::key& key, const toml::node& node, const std::string&) {
-        auto entry = memory_entry(key, node, source_, "memory");
-        if (!entry) return tl::unexpected<Error>(entry.error());
-        s_.memory.push_back(std::move(*entry));
+    Expected<void> memory(const Entry& e) {
+        for (const auto& [key, node] : config::in_file_order(*e.node.as_table())) {
+            auto entry = memory_entry(*key, *node, source_, "memory");
+            if (!entry) return tl::unexpected<Error>(entry.error());
+            s_.memory.push_back(std::move(*entry));
+        }
         return {};
     }
 
@@ -291,90 +208,88 @@ class Loader {
         const auto* t = node.as_table();
         if (t == nullptr) return fail(key, p, "must be { number = 1-511, message = \"...\" }");
         plc::FalInjection f;
-        for (const auto& [key_ptr, node_ptr] : in_file_order(*t)) {
-            const toml::key& k = *key_ptr;
-            const toml::node& v = *node_ptr;
-            const std::string child = p + "." + std::string(k.str());
-            if (k.str() == "number") {
-                const auto n = integer(k, v, child, 1, 511);
-                if (!n) return tl::unexpected<Error>(n.error());
-                f.number = static_cast<std::uint16_t>(*n);
-            } else if (k.str() == "message") {
-                if (auto r = text(k, v, child, f.message); !r) return tl::unexpected(r.error());
-            } else {
-                return fail(k, child, "unknown key");
-            }
-        }
+        if (auto r = config::read_table(*t, {source_, p, At::key},
+                                        {config::integer_key("number", f.number, 1, 511),
+                                         config::text_key("message", f.message)});
+            !r)
+            return Fail(r.error());
         if (f.number == 0) return fail(key, p + ".number", "missing");
         return f;
     }
 
-    Expected<void> inject(const toml::key& key, const toml::node& node, const std::string& p) {
-        const std::string_view k = key.str();
+    Expected<void> inject(const Entry& e) {
         auto& in = s_.inject;
-        if (k == "battery_error") return flag(key, node, p, in.battery_error);
-        if (k == "fals") {
-            const auto f = fal(key, node, p);
-            if (!f) return tl::unexpected<Error>(f.error());
-            in.fals = *f;
-        } else if (k == "fal") {
-            const auto* list = node.as_array();
-            if (list == nullptr) return fail(key, p, "must be an array of { number, message }");
-            in.fal.clear();
-            for (std::size_t i = 0; i < list->size(); ++i) {
-                const auto f = fal(key, (*list)[i], fmt::format("{}[{}]", p, i));
-                if (!f) return tl::unexpected<Error>(f.error());
-                in.fal.push_back(*f);
-            }
-        } else if (k == "messages") {
-            const auto* t = node.as_table();
-            if (t == nullptr) return fail(key, p, "must be a table { 0 = \"text\", ... }");
-            for (const auto& [key_ptr, node_ptr] : in_file_order(*t)) {
-                const toml::key& n = *key_ptr;
-                const toml::node& v = *node_ptr;
-                const std::string child = p + "." + std::string(n.str());
-                const std::string_view digit = n.str();
-                if (digit.size() != 1 || digit[0] < '0' || digit[0] > '7')
-                    return fail(n, child, "message numbers are 0-7");
-                std::string value;
-                if (auto r = text(n, v, child, value); !r) return r;
-                in.messages[static_cast<std::size_t>(digit[0] - '0')] = value;
-            }
-        } else if (k == "errors") {
-            const auto* list = node.as_array();
-            if (list == nullptr) return fail(key, p, "must be an array of error codes");
-            in.errors.clear();
-            for (std::size_t i = 0; i < list->size(); ++i) {
-                const auto v = integer(key, (*list)[i], fmt::format("{}[{}]", p, i), 0, 0xFFFF);
-                if (!v) return tl::unexpected<Error>(v.error());
-                in.errors.push_back(static_cast<std::uint16_t>(*v));
-            }
-        } else {
-            return fail(key, p, "unknown key");
-        }
-        // The injections' own rules (plc/injections.hpp): "fal[0].message: longer than
-        // 16 characters" becomes "inject.fal[0].message: longer than 16 characters".
-        if (const auto e = plc::validate(in); !e.empty()) {
-            const auto colon = std::min(e.find(": "), e.size());
-            // "inject." or "plc[N].inject.": the path up to this key.
-            const std::string section = p.substr(0, p.rfind('.') + 1);
-            return fail(key, section + e.substr(0, colon),
-                        colon < e.size() ? std::string_view(e).substr(colon + 2) : "invalid");
+        // Each injection, once read, against the injections' own rules.
+        const auto checked = [this](config::Reader read) -> config::Reader {
+            return [this, read](const Entry& k) -> Expected<void> {
+                if (auto r = read(k); !r) return r;
+                return check_injections(k);
+            };
+        };
+        return config::read_table(
+            e, {config::flag_key("battery_error", in.battery_error),
+                {"fals", Type::any, checked([this, &in](const Entry& k) -> Expected<void> {
+                     const auto f = fal(k.key, k.node, k.path);
+                     if (!f) return Fail(f.error());
+                     in.fals = *f;
+                     return {};
+                 })},
+                {"fal", Type::any, checked([this, &in](const Entry& k) -> Expected<void> {
+                     const auto* list = k.node.as_array();
+                     if (list == nullptr) return k.fail("must be an array of { number, message }");
+                     in.fal.clear();
+                     for (std::size_t i = 0; i < list->size(); ++i) {
+                         const auto f = fal(k.key, (*list)[i], fmt::format("{}[{}]", k.path, i));
+                         if (!f) return Fail(f.error());
+                         in.fal.push_back(*f);
+                     }
+                     return {};
+                 })},
+                {"messages", Type::any, checked([this](const Entry& k) { return messages(k); })},
+                {"errors", Type::any, checked([this, &in](const Entry& k) -> Expected<void> {
+                     const auto* list = k.node.as_array();
+                     if (list == nullptr) return k.fail("must be an array of error codes");
+                     in.errors.clear();
+                     for (std::size_t i = 0; i < list->size(); ++i) {
+                         const std::string item = fmt::format("{}[{}]", k.path, i);
+                         const auto* v = (*list)[i].as_integer();
+                         if (v == nullptr) return fail(k.key, item, "must be an integer");
+                         if (v->get() < 0 || v->get() > 0xFFFF)
+                             return fail(k.key, item, fmt::format("{} is not 0-65535", v->get()));
+                         in.errors.push_back(static_cast<std::uint16_t>(v->get()));
+                     }
+                     return {};
+                 })}});
+    }
+
+    Expected<void> messages(const Entry& e) {
+        const auto* t = e.node.as_table();
+        if (t == nullptr) return e.fail("must be a table { 0 = \"text\", ... }");
+        for (const auto& [key_ptr, node_ptr] : config::in_file_order(*t)) {
+            const toml::key& n = *key_ptr;
+            const std::string child = e.path + "." + std::string(n.str());
+            const std::string_view digit = n.str();
+            if (digit.size() != 1 || digit[0] < '0' || digit[0] > '7')
+                return fail(n, child, "message numbers are 0-7");
+            const auto* text = node_ptr->as_string();
+            if (text == nullptr) return fail(n, child, "must be a string");
+            s_.inject.messages[static_cast<std::size_t>(digit[0] - '0')] = text->get();
         }
         return {};
     }
 
-  public:
-    // A [[plc]]'s own [protection], [inject], [storage] or [files] table.
-    Expected<void> cpu_section(const toml::key& key, const toml::node& node, const std::string& p) {
-        if (key.str() == "protection") return section(key, node, p, &Loader::protection);
-        if (key.str() == "inject") return section(key, node, p, &Loader::inject);
-        if (key.str() == "storage") return section(key, node, p, &Loader::storage);
-        if (key.str() == "files") return section(key, node, p, &Loader::files);
-        return fail(key, p, "unknown key");
+    // The injections' own rules (plc/injections.hpp): "fal[0].message: longer than
+    // 16 characters" becomes "inject.fal[0].message: longer than 16 characters".
+    Expected<void> check_injections(const Entry& e) const {
+        const auto error = plc::validate(s_.inject);
+        if (error.empty()) return {};
+        const auto colon = std::min(error.find(": "), error.size());
+        // "inject." or "plc[N].inject.": the path up to this key.
+        const std::string section = e.path.substr(0, e.path.rfind('.') + 1);
+        return fail(e.key, section + error.substr(0, colon),
+                    colon < error.size() ? std::string_view(error).substr(colon + 2) : "invalid");
     }
 
-  private:
     std::string_view source_;
     Settings& s_;
 };

@@ -4,6 +4,9 @@
 #include "transport/socket_headers.hpp"
 
 #include <charconv>
+#include <vector>
+
+#include "config/schema.hpp"
 
 #include <fmt/core.h>
 #include <toml++/toml.h>
@@ -13,10 +16,6 @@ namespace fins::finsd {
 namespace {
 
 using Fail = tl::unexpected<std::string>;
-
-std::string at(const toml::source_region& where, std::string_view source) {
-    return fmt::format("{}:{}:{}", source, where.begin.line, where.begin.column);
-}
 
 }  // namespace
 
@@ -62,67 +61,69 @@ tl::expected<void, std::string> load_http_table(const toml::node& node, std::str
                                                 HttpSettings& http) {
     const auto* table = node.as_table();
     if (table == nullptr) return Fail(fmt::format("{}: http: must be a table", source));
-    for (auto&& [key, value] : *table) {
-        const std::string k(key.str());
-        const auto fail = [&](std::string_view why) {
-            return Fail(fmt::format("{}: http.{}: {}", at(key.source(), source), k, why));
-        };
-        if (k == "listen") {
-            const auto* s = value.as_string();
-            if (s == nullptr) return fail("must be a string ADDRESS:PORT");
-            if (auto r = parse_http_listen(s->get()); !r) return fail(r.error());
-            http.listen = s->get();
-        } else if (k == "control") {
-            const auto* b = value.as_boolean();
-            if (b == nullptr) return fail("must be true or false");
-            http.control = b->get();
-        } else if (k == "token_file") {
-            const auto* s = value.as_string();
-            if (s == nullptr || s->get().empty()) return fail("must be a file name");
-            http.token_file = s->get();
-        } else if (k == "allowed_hosts") {
-            const auto* a = value.as_array();
-            if (a == nullptr) return fail("must be an array of host names");
-            http.allowed_hosts.clear();
-            for (const auto& h : *a) {
-                const auto* s = h.as_string();
-                if (s == nullptr || s->get().empty()) return fail("must be an array of host names");
-                http.allowed_hosts.push_back(s->get());
-            }
-        } else if (k == "allowed_origins") {
-            // Whole origins, as a browser sends them: scheme://host[:port], no path.
-            const auto* a = value.as_array();
-            const auto bad = [&] {
-                return fail("must be an array of origins like \"https://scada.lan\"");
-            };
-            if (a == nullptr) return bad();
-            http.allowed_origins.clear();
-            for (const auto& o : *a) {
-                const auto* s = o.as_string();
-                if (s == nullptr) return bad();
-                const std::string_view v = s->get();
-                const auto scheme = v.find("://");
-                if (scheme == std::string_view::npos || scheme == 0 || v.size() == scheme + 3 ||
-                    v.find('/', scheme + 3) != std::string_view::npos)
-                    return bad();
-                http.allowed_origins.push_back(s->get());
-            }
-        } else if (k == "max_connections") {
-            const auto* i = value.as_integer();
-            if (i == nullptr || i->get() < 1 || i->get() > 1024) return fail("must be 1-1024");
-            http.max_connections = static_cast<std::size_t>(i->get());
-        } else if (k == "websocket_idle_timeout") {
-            // Seconds, a decimal allowed: 0.2 s (tests) to an hour.
-            const auto seconds = value.value<double>();
-            if (!seconds || !(*seconds >= 0.2 && *seconds <= 3600))
-                return fail("must be a number of seconds 0.2-3600");
-            http.websocket_idle_timeout = std::chrono::milliseconds(
-                static_cast<std::chrono::milliseconds::rep>(*seconds * 1000 + 0.5));
-        } else {
-            return fail("unknown key");
-        }
-    }
-    return {};
+    using config::Entry;
+    using config::Type;
+    using Done = tl::expected<void, std::string>;
+    // A list of strings each `ok` takes, or the complaint `why`.
+    const auto list = [](std::string_view name, std::string_view why, auto ok,
+                         std::vector<std::string>& out) -> config::Key {
+        return {name, Type::any, [why, ok, &out](const Entry& e) -> Done {
+                    const auto* a = e.node.as_array();
+                    if (a == nullptr) return e.fail(why);
+                    out.clear();
+                    for (const auto& item : *a) {
+                        const auto* s = item.as_string();
+                        if (s == nullptr || !ok(s->get())) return e.fail(why);
+                        out.push_back(s->get());
+                    }
+                    return {};
+                }};
+    };
+    // Whole origins, as a browser sends them: scheme://host[:port], no path.
+    const auto origin = [](std::string_view v) {
+        const auto scheme = v.find("://");
+        return scheme != std::string_view::npos && scheme != 0 && v.size() != scheme + 3 &&
+               v.find('/', scheme + 3) == std::string_view::npos;
+    };
+    return config::read_table(
+        *table, {source, "http", config::At::key},
+        {{"listen", Type::any,
+          [&](const Entry& e) -> Done {
+              const auto* s = e.node.as_string();
+              if (s == nullptr) return e.fail("must be a string ADDRESS:PORT");
+              if (auto r = parse_http_listen(s->get()); !r) return e.fail(r.error());
+              http.listen = s->get();
+              return {};
+          }},
+         config::flag_key("control", http.control),
+         {"token_file", Type::any,
+          [&](const Entry& e) -> Done {
+              const auto* s = e.node.as_string();
+              if (s == nullptr || s->get().empty()) return e.fail("must be a file name");
+              http.token_file = s->get();
+              return {};
+          }},
+         list(
+             "allowed_hosts", "must be an array of host names",
+             [](const std::string& h) { return !h.empty(); }, http.allowed_hosts),
+         list("allowed_origins", "must be an array of origins like \"https://scada.lan\"", origin,
+              http.allowed_origins),
+         {"max_connections", Type::any,
+          [&](const Entry& e) -> Done {
+              const auto* i = e.node.as_integer();
+              if (i == nullptr || i->get() < 1 || i->get() > 1024) return e.fail("must be 1-1024");
+              http.max_connections = static_cast<std::size_t>(i->get());
+              return {};
+          }},
+         {"websocket_idle_timeout", Type::any, [&](const Entry& e) -> Done {
+              // Seconds, a decimal allowed: 0.2 s (tests) to an hour.
+              const auto seconds = e.node.value<double>();
+              if (!seconds || !(*seconds >= 0.2 && *seconds <= 3600))
+                  return e.fail("must be a number of seconds 0.2-3600");
+              http.websocket_idle_timeout = std::chrono::milliseconds(
+                  static_cast<std::chrono::milliseconds::rep>(*seconds * 1000 + 0.5));
+              return {};
+          }}});
 }
 
 void add_http_flags(CLI::App& app, HttpFlags& flags) {

@@ -20,6 +20,9 @@ namespace fins::finsd {
 
 namespace detail {
 
+using config::Entry;
+using config::Key;
+using config::Type;
 using server::PlantCpuConfig;
 using server::PlantPortConfig;
 
@@ -58,14 +61,19 @@ Expected<void> PlantLoader::load_repeated(const toml::table& t, const toml::node
         return fail(repeat.source(), rp,
                     "must be a table: { networks = \"20-59\", nodes = \"1-250\" }");
     std::optional<std::pair<int, int>> networks, nodes;
-    for (auto&& [k, v] : *r) {
-        const std::string key(k.str());
-        const std::string p = rp + "." + key;
-        if (key != "networks" && key != "nodes") return fail(k.source(), p, "unknown key");
-        auto range = span_of(v, p, 1, key == "networks" ? 127 : 254);
-        if (!range) return tl::unexpected(range.error());
-        (key == "networks" ? networks : nodes) = *range;
-    }
+    const auto range = [this](std::optional<std::pair<int, int>>& out, int hi) -> config::Reader {
+        return [this, &out, hi](const Entry& e) -> Expected<void> {
+            auto span = span_of(e.node, e.path, 1, hi);
+            if (!span) return tl::unexpected(span.error());
+            out = *span;
+            return {};
+        };
+    };
+    if (auto read = config::read_table(*r, {source_, rp},
+                                       {{"networks", Type::any, range(networks, 127)},
+                                        {"nodes", Type::any, range(nodes, 254)}});
+        !read)
+        return read;
     if (!networks || !nodes) return fail(repeat.source(), rp, "needs networks and nodes");
     // Each CPU Unit needs a name of its own.
     const auto name = t.get_as<std::string>("name");
@@ -124,109 +132,108 @@ Expected<std::pair<int, int>> PlantLoader::span_of(const toml::node& v, const st
 Expected<void> PlantLoader::load_cpu(const toml::table& t, const std::string& path,
                                      PlantCpuConfig& cpu, Settings::PlantCpuSettings& extra) {
     std::optional<toml::source_region> storage_at, files_at;
-    for (auto&& [k, v] : t) {
-        const std::string key(k.str());
-        if (key == "repeat") continue;  // load_repeated's
-        const std::string p = path + "." + key;
-        Expected<void> r;
-        if (key == "name") {
-            auto s = text(v, p);
-            if (!s) return tl::unexpected(s.error());
-            cpu.name = *s;
-        } else if (key == "profile") {
-            auto s = text(v, p);
-            if (!s) return tl::unexpected(s.error());
-            cpu.profile = *s;
-        } else if (key == "mode") {
-            auto s = text(v, p);
-            if (!s) return tl::unexpected(s.error());
-            const auto m = parse_mode(*s);
-            if (!m)
-                return fail(v.source(), p, fmt::format("'{}' is not program, monitor or run", *s));
-            cpu.mode = *m;
-        } else if (key == "data_dir") {
-            auto s = text(v, p);
-            if (!s) return tl::unexpected(s.error());
-            if (s->empty()) return fail(v.source(), p, "must not be empty");
-            cpu.data_dir = *s;
-        } else if (key == "gateway_count") {
-            auto g = integer(v, p, 2, 7);
-            if (!g) return tl::unexpected(g.error());
-            if (*g != 2 && *g != 7) return fail(v.source(), p, "must be 2 or 7");
-            cpu.gateway_count = static_cast<std::uint8_t>(*g);
-        } else if (key == "routing_tables") {
-            auto s = text(v, p);
-            if (!s) return tl::unexpected(s.error());
-            if (*s != "config" && *s != "keep")
-                return fail(v.source(), p, fmt::format("'{}' is not config or keep", *s));
-            cpu.write_routing_tables = *s == "config";
-        } else if (key == "ethernet") {
-            r = tables(v, p, [&](const toml::table& e, const std::string& ep) {
-                PlantPortConfig port;
-                if (auto rr = load_port(e, ep, port); !rr) return rr;
-                cpu.ports.push_back(std::move(port));
-                extra.port_given.push_back(e.contains("port"));
-                return Expected<void>{};
-            });
-        } else if (key == "memory") {
-            // As the top-level [memory]: entries written in file order.
-            const auto* table = v.as_table();
-            if (table == nullptr)
-                return fail(v.source(), p, "must be a table of ADDRESS = value(s)");
-            for (const auto& [ek, ev] : in_file_order(*table)) {
-                auto entry = memory_entry(*ek, *ev, source_, p);
-                if (!entry) return tl::unexpected(entry.error());
-                extra.memory.push_back(std::move(*entry));
-            }
-        } else if (key == "protection" || key == "inject") {
-            // Parsed as the single node's tables, onto a scratch Settings.
-            Settings scratch;
-            static_cast<CpuUnitOptions&>(scratch) = extra;
-            if (auto rr = load_cpu_section(k, v, source_, p, scratch); !rr) return rr;
-            static_cast<CpuUnitOptions&>(extra) = scratch;
-            if (key == "protection" &&
-                extra.network_write_protection.mode == plc::NetworkWriteProtection::listed &&
-                extra.network_write_protection.nodes.empty())
-                return fail(v.source(), p,
-                            "nodes: empty, so network_write = \"listed\" protects nothing");
-        } else if (key == "storage") {
-            Settings scratch;
-            if (auto rr = load_cpu_section(k, v, source_, p, scratch); !rr) return rr;
-            cpu.durability = scratch.durability;
-            storage_at = v.source();
-        } else if (key == "files") {
-            // As the top-level [files]: this CPU Unit's card, EM file bank, cassette.
-            Settings scratch;
-            if (auto rr = load_cpu_section(k, v, source_, p, scratch); !rr) return rr;
-            cpu.files = static_cast<const server::FileMemoryOptions&>(scratch);
-            files_at = v.source();
-        } else if (key == "serial") {
-            // As the top-level [serial]: Host Link slave and Serial Gateway ports.
-            if (auto rr = load_serial_table(v, source_, extra.serial); !rr)
-                return tl::unexpected(in_plant(rr.error(), path));
-        } else if (key == "remote" || key == "schedule") {
-            // As the top-level [[remote]] / [[schedule]], for this CPU Unit.
-            Settings scratch;
-            auto rr = key == "remote" ? load_remotes(k, v, source_, scratch)
-                                      : load_schedule(k, v, source_, scratch);
-            if (!rr) return tl::unexpected(in_plant(rr.error(), path));
-            for (auto& remote : scratch.remotes)
-                cpu.remotes.push_back(std::move(remote));
-            for (auto& entry : scratch.schedule)
-                extra.schedule.push_back(std::move(entry));
-        } else if (key == "scenario") {
-            auto config = load_scenario_table(v, source_, p);
-            if (!config) return tl::unexpected(config.error());
-            extra.scenario = std::move(*config);
-        } else if (key == "relay") {
-            r = tables(v, p, [&](const toml::table& e, const std::string& ep) {
-                return load_relay(e, ep, cpu);
-            });
-        } else {
-            return fail(k.source(), p, "unknown key");
-        }
-        if (!r) return r;
-    }
+    // A scratch single node's settings: the top-level loaders read a [[plc]]'s tables.
+    const auto single = [this](const Entry& e, Settings& scratch) {
+        return load_cpu_section(e.key, e.node, source_, e.path, scratch);
+    };
+    auto read = config::read_table(
+        t, {source_, path},
+        {{"repeat"},  // load_repeated's
+         text_into("name", cpu.name),
+         text_into("profile", cpu.profile),
+         {"mode", Type::string,
+          [&](const Entry& e) -> Expected<void> {
+              const std::string s = substituted(e.text());
+              const auto m = parse_mode(s);
+              if (!m) return e.fail(fmt::format("'{}' is not program, monitor or run", s));
+              cpu.mode = *m;
+              return {};
+          }},
+         {"data_dir", Type::string,
+          [&](const Entry& e) -> Expected<void> {
+              if (e.text().empty()) return e.fail("must not be empty");
+              cpu.data_dir = substituted(e.text());
+              return {};
+          }},
+         {"gateway_count", Type::integer,
+          [&](const Entry& e) -> Expected<void> {
+              const auto g = e.integer(2, 7);
+              if (!g) return tl::unexpected(g.error());
+              if (*g != 2 && *g != 7) return e.fail("must be 2 or 7");
+              cpu.gateway_count = static_cast<std::uint8_t>(*g);
+              return {};
+          }},
+         {"routing_tables", Type::string,
+          [&](const Entry& e) -> Expected<void> {
+              const std::string s = substituted(e.text());
+              if (s != "config" && s != "keep")
+                  return e.fail(fmt::format("'{}' is not config or keep", s));
+              cpu.write_routing_tables = s == "config";
+              return {};
+          }},
+         {"ethernet", Type::any,
+          [&](const Entry& e) {
+              return tables(e.node, e.path, [&](const toml::table& u, const std::string& up) {
+                  PlantPortConfig port;
+                  if (auto rr = load_port(u, up, port); !rr) return rr;
+                  cpu.ports.push_back(std::move(port));
+                  extra.port_given.push_back(u.contains("port"));
+                  return Expected<void>{};
+              });
+          }},
+         {"memory", Type::any,
+          [&](const Entry& e) -> Expected<void> {
+              // As the top-level [memory]: entries written in file order.
+              const auto* table = e.node.as_table();
+              if (table == nullptr) return e.fail("must be a table of ADDRESS = value(s)");
+              for (const auto& [ek, ev] : config::in_file_order(*table)) {
+                  auto entry = memory_entry(*ek, *ev, source_, e.path);
+                  if (!entry) return tl::unexpected(entry.error());
+                  extra.memory.push_back(std::move(*entry));
+              }
+              return {};
+          }},
+         {"protection", Type::any, [&](const Entry& e) { return cpu_options(e, extra); }},
+         {"inject", Type::any, [&](const Entry& e) { return cpu_options(e, extra); }},
+         {"storage", Type::any,
+          [&](const Entry& e) -> Expected<void> {
+              Settings scratch;
+              if (auto rr = single(e, scratch); !rr) return rr;
+              cpu.durability = scratch.durability;
+              storage_at = e.node.source();
+              return {};
+          }},
+         {"files", Type::any,
+          [&](const Entry& e) -> Expected<void> {
+              // As the top-level [files]: this CPU Unit's card, EM file bank, cassette.
+              Settings scratch;
+              if (auto rr = single(e, scratch); !rr) return rr;
+              cpu.files = static_cast<const server::FileMemoryOptions&>(scratch);
+              files_at = e.node.source();
+              return {};
+          }},
+         {"serial", Type::any,
+          [&](const Entry& e) -> Expected<void> {
+              // As the top-level [serial]: Host Link slave and Serial Gateway ports.
+              if (auto rr = load_serial_table(e.node, source_, extra.serial); !rr)
+                  return tl::unexpected(in_plant(rr.error(), path));
+              return {};
+          }},
+         {"remote", Type::any, [&](const Entry& e) { return remotes(e, path, cpu, extra); }},
+         {"schedule", Type::any, [&](const Entry& e) { return remotes(e, path, cpu, extra); }},
+         {"scenario", Type::any,
+          [&](const Entry& e) -> Expected<void> {
+              auto config = load_scenario_table(e.node, source_, e.path);
+              if (!config) return tl::unexpected(config.error());
+              extra.scenario = std::move(*config);
+              return {};
+          }},
+         {"relay", Type::any, [&](const Entry& e) {
+              return tables(e.node, e.path, [&](const toml::table& u, const std::string& up) {
+                  return load_relay(u, up, cpu);
+              });
+          }}});
+    if (!read) return read;
     if (cpu.name.empty()) return fail(t.source(), path, "name: missing");
     if (extra.scenario) extra.scenario->plc = cpu.name;  // reload finds it by name
     if (cpu.durability == plc::Durability::power && !cpu.data_dir)
@@ -239,6 +246,34 @@ Expected<void> PlantLoader::load_cpu(const toml::table& t, const std::string& pa
             return tl::unexpected(fmt::format("{}:{}:{}: {}", source_, files_at->begin.line,
                                               files_at->begin.column, r.error()));
     return check_serial(path, cpu, extra);
+}
+
+// A [[plc]]'s [protection] or [inject], parsed as the single node's tables onto a scratch
+// Settings.
+Expected<void> PlantLoader::cpu_options(const Entry& e, Settings::PlantCpuSettings& extra) {
+    Settings scratch;
+    static_cast<CpuUnitOptions&>(scratch) = extra;
+    if (auto r = load_cpu_section(e.key, e.node, source_, e.path, scratch); !r) return r;
+    static_cast<CpuUnitOptions&>(extra) = scratch;
+    if (e.key.str() == "protection" &&
+        extra.network_write_protection.mode == plc::NetworkWriteProtection::listed &&
+        extra.network_write_protection.nodes.empty())
+        return e.fail("nodes: empty, so network_write = \"listed\" protects nothing");
+    return {};
+}
+
+// A [[plc]]'s [[plc.remote]] or [[plc.schedule]], as the top-level ones for this CPU Unit.
+Expected<void> PlantLoader::remotes(const Entry& e, const std::string& path, PlantCpuConfig& cpu,
+                                    Settings::PlantCpuSettings& extra) {
+    Settings scratch;
+    auto r = e.key.str() == "remote" ? load_remotes(e.key, e.node, source_, scratch)
+                                     : load_schedule(e.key, e.node, source_, scratch);
+    if (!r) return tl::unexpected(in_plant(r.error(), path));
+    for (auto& remote : scratch.remotes)
+        cpu.remotes.push_back(std::move(remote));
+    for (auto& entry : scratch.schedule)
+        extra.schedule.push_back(std::move(entry));
+    return {};
 }
 
 // The single node's serial checks, and what a plant adds: a gateway port's network

@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include "config/schema.hpp"
 #include "finsd/config.hpp"
 
 namespace fins::finsd::detail {
@@ -39,6 +40,9 @@ class PlantLoader {
                                  server::PlantPortConfig& port);
     Expected<void> load_relay(const toml::table& t, const std::string& path,
                               server::PlantCpuConfig& cpu);
+    Expected<void> cpu_options(const config::Entry& e, Settings::PlantCpuSettings& extra);
+    Expected<void> remotes(const config::Entry& e, const std::string& path,
+                           server::PlantCpuConfig& cpu, Settings::PlantCpuSettings& extra);
 
     // The placeholders of the CPU Unit a repeated [[plc]] is being loaded for.
     struct Substitution {
@@ -63,27 +67,15 @@ class PlantLoader {
 
     tl::unexpected<Error> fail(const toml::source_region& where, std::string_view path,
                                std::string_view message) const {
-        return tl::unexpected<Error>(fmt::format("{}:{}:{}: {}: {}", source_, where.begin.line,
-                                                 where.begin.column, path, message));
+        return config::fail_at(source_, where, path, message);
     }
 
-    Expected<std::int64_t> integer(const toml::node& v, const std::string& path, std::int64_t lo,
-                                   std::int64_t hi) const {
-        const auto* i = v.as_integer();
-        if (i == nullptr) return fail(v.source(), path, "must be an integer");
-        if (i->get() < lo || i->get() > hi)
-            return fail(v.source(), path, fmt::format("{} is not {}-{}", i->get(), lo, hi));
-        return i->get();
-    }
-    Expected<std::string> text(const toml::node& v, const std::string& path) const {
-        const auto* s = v.as_string();
-        if (s == nullptr) return fail(v.source(), path, "must be a string");
-        return substituted(s->get());
-    }
-    Expected<bool> flag(const toml::node& v, const std::string& path) const {
-        const auto* b = v.as_boolean();
-        if (b == nullptr) return fail(v.source(), path, "must be true or false");
-        return b->get();
+    // A string key, its {network}, {node} and {index} substituted.
+    config::Key text_into(std::string_view name, std::string& out) const {
+        return {name, config::Type::string, [this, &out](const config::Entry& e) -> Expected<void> {
+                    out = substituted(e.text());
+                    return {};
+                }};
     }
     template <class F>
     Expected<void> tables(const toml::node& v, const std::string& path, F&& each) const {

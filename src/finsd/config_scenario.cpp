@@ -38,64 +38,70 @@ tl::expected<void, std::string> ScenarioLoader::table(const toml::node& node,
         ScenarioLoader nested(out_, p.string());
         if (auto r = nested.table(*inner, "scenario", false); !r) return r;
     }
-    for (const auto& [key_ptr, node_ptr] : in_file_order(*t)) {
-        const std::string k(key_ptr->str());
-        const toml::node& v = *node_ptr;
-        const std::string p = path + "." + k;
-        tl::expected<void, std::string> r;
-        auto& def = out_.def;
-        if (k == "file") {
-            continue;
-        } else if (k == "seed") {
-            auto n = integer(v, p, 0, std::numeric_limits<std::int64_t>::max());
-            if (!n) return tl::unexpected(n.error());
-            def.seed = static_cast<std::uint64_t>(*n);
-        } else if (k == "tick_ms") {
-            auto n = integer(v, p, 1, 3'600'000);
-            if (!n) return tl::unexpected(n.error());
-            def.tick_s = static_cast<double>(*n) / 1000.0;
-        } else if (k == "time") {
-            auto s = text(v, p);
-            if (!s) return tl::unexpected(s.error());
-            if (*s != "real" && *s != "virtual")
-                return fail(v, p, fmt::format("'{}' is not real or virtual", *s));
-            def.virtual_time = *s == "virtual";
-        } else if (k == "compute") {
-            auto s = text(v, p);
-            if (!s) return tl::unexpected(s.error());
-            if (*s != "auto" && *s != "io" && *s != "thread")
-                return fail(v, p, fmt::format("'{}' is not auto, io or thread", *s));
-            out_.compute = *s == "io"       ? ComputeOn::io_thread
-                           : *s == "thread" ? ComputeOn::scenario_thread
-                                            : ComputeOn::automatic;
-        } else if (k == "time_scale") {
-            auto d = number(v, p);
-            if (!d) return tl::unexpected(d.error());
-            if (!(*d > 0 && *d <= 1000)) return fail(v, p, "must be above 0 and at most 1000");
-            def.time_scale = *d;
-        } else if (k == "signal" || k == "link" || k == "input" || k == "event" || k == "loop") {
-            const auto* list = v.as_array();
-            if (list == nullptr)
-                return fail(v, p, fmt::format("must be an array of tables ([[{}]])", p));
-            for (std::size_t i = 0; i < list->size(); ++i) {
-                const auto& item = (*list)[i];
-                const std::string ip = fmt::format("{}[{}]", p, i);
-                if (!item.is_table()) return fail(item, ip, "must be a table");
-                if (k == "event")
-                    r = event(*item.as_table(), ip);
-                else if (k == "loop")
-                    r = loop_item(*item.as_table(), ip);
-                else if (k == "input")
-                    r = input(*item.as_table(), ip);
-                else
-                    r = tag(*item.as_table(), ip, k == "link");
-                if (!r) return r;
-            }
-        } else {
-            return fail(*key_ptr, p, "unknown key");
-        }
-    }
-    return {};
+    using config::Entry;
+    using config::Type;
+    using Done = tl::expected<void, std::string>;
+    auto& def = out_.def;
+    // [[scenario.signal]], [[scenario.link]], ...: an array of tables, each read by `read`.
+    const auto entries = [this](std::string_view name, auto read) -> config::Key {
+        return {name, Type::any, [this, read](const Entry& e) -> Done {
+                    const auto* list = e.node.as_array();
+                    if (list == nullptr)
+                        return e.fail(fmt::format("must be an array of tables ([[{}]])", e.path));
+                    for (std::size_t i = 0; i < list->size(); ++i) {
+                        const auto& item = (*list)[i];
+                        const std::string ip = fmt::format("{}[{}]", e.path, i);
+                        if (!item.is_table()) return fail(item, ip, "must be a table");
+                        if (auto r = read(*item.as_table(), ip); !r) return r;
+                    }
+                    return {};
+                }};
+    };
+    return config::read_table(
+        *t, {source_, path},
+        {{"file"},  // read above
+         config::integer_key("seed", def.seed, 0, std::numeric_limits<std::int64_t>::max()),
+         {"tick_ms", Type::integer,
+          [&](const Entry& e) -> Done {
+              auto n = e.integer(1, 3'600'000);
+              if (!n) return tl::unexpected(n.error());
+              def.tick_s = static_cast<double>(*n) / 1000.0;
+              return {};
+          }},
+         {"time", Type::string,
+          [&](const Entry& e) -> Done {
+              if (e.text() != "real" && e.text() != "virtual")
+                  return e.fail(fmt::format("'{}' is not real or virtual", e.text()));
+              def.virtual_time = e.text() == "virtual";
+              return {};
+          }},
+         {"compute", Type::string,
+          [&](const Entry& e) -> Done {
+              const std::string& s = e.text();
+              if (s != "auto" && s != "io" && s != "thread")
+                  return e.fail(fmt::format("'{}' is not auto, io or thread", s));
+              out_.compute = s == "io"       ? ComputeOn::io_thread
+                             : s == "thread" ? ComputeOn::scenario_thread
+                                             : ComputeOn::automatic;
+              return {};
+          }},
+         number_key("time_scale",
+                    [&](const Entry& e, double d) -> Done {
+                        if (!(d > 0 && d <= 1000))
+                            return e.fail("must be above 0 and at most 1000");
+                        def.time_scale = d;
+                        return {};
+                    }),
+         entries("signal",
+                 [this](const toml::table& e, const std::string& p) { return tag(e, p, false); }),
+         entries("link",
+                 [this](const toml::table& e, const std::string& p) { return tag(e, p, true); }),
+         entries("input",
+                 [this](const toml::table& e, const std::string& p) { return input(e, p); }),
+         entries("event",
+                 [this](const toml::table& e, const std::string& p) { return event(e, p); }),
+         entries("loop",
+                 [this](const toml::table& e, const std::string& p) { return loop_item(e, p); })});
 }
 
 namespace {
@@ -176,13 +182,17 @@ tl::expected<ScenarioConfig, std::string> load_scenario_file(const std::filesyst
     const auto* node = root->get("scenario");
     if (node == nullptr)
         return tl::unexpected(fmt::format("{}: no [scenario] table", file.string()));
-    for (const auto& [key, value] : *root)
-        if (key.str() != "scenario")
-            return tl::unexpected(fmt::format(
-                "{}:{}:{}: {}: unknown key (a scenario file holds "
-                "a [scenario] table)",
-                file.string(), key.source().begin.line, key.source().begin.column, key.str()));
-    return load_scenario_table(*node, file.string(), "scenario");
+    const std::string source = file.string();
+    if (auto r = config::read_table(*root,
+                                    {source,
+                                     "",
+                                     config::At::key,
+                                     {},
+                                     "unknown key (a scenario file holds a [scenario] table)"},
+                                    {{"scenario"}});
+        !r)
+        return tl::unexpected(r.error());
+    return load_scenario_table(*node, source, "scenario");
 }
 
 tl::expected<ScenarioConfig, std::string> load_scenario_text(std::string_view text,
@@ -196,12 +206,12 @@ tl::expected<ScenarioConfig, std::string> load_scenario_text(std::string_view te
     }
     const auto* node = root.get("scenario");
     if (node == nullptr) return Unexpected(fmt::format("{}: no [scenario] table", source));
-    for (const auto& [key, value] : root)
-        if (key.str() != "scenario")
-            return Unexpected(
-                fmt::format("{}:{}:{}: {}: unknown key (a scenario holds a "
-                            "[scenario] table)",
-                            source, key.source().begin.line, key.source().begin.column, key.str()));
+    if (auto r = config::read_table(
+            root,
+            {source, "", config::At::key, {}, "unknown key (a scenario holds a [scenario] table)"},
+            {{"scenario"}});
+        !r)
+        return tl::unexpected(r.error());
     ScenarioConfig config;
     ScenarioLoader loader(config, source, text);
     if (auto r = loader.table(*node, "scenario", true); !r) return tl::unexpected(r.error());

@@ -46,6 +46,11 @@ std::vector<std::string_view> kind_keys(SignalKind kind) {
 
 }  // namespace
 
+using config::Entry;
+using config::Key;
+using config::Type;
+using Done = tl::expected<void, std::string>;
+
 tl::expected<void, std::string> ScenarioLoader::tag(const toml::table& t, const std::string& path,
                                                     bool is_link) {
     scenario::TagDef d;
@@ -65,92 +70,63 @@ tl::expected<void, std::string> ScenarioLoader::tag(const toml::table& t, const 
                                     *s));
         d.kind = *k;
     }
-    const auto allowed = kind_keys(d.kind);
     bool type_given = false;
-    for (const auto& [key_ptr, node_ptr] : in_file_order(t)) {
-        const std::string k(key_ptr->str());
-        const toml::node& v = *node_ptr;
-        const std::string p = path + "." + k;
-        if (k == "kind" && !is_link) continue;
-        if (k == "address") {
-            auto a = located_text(v, p);
-            if (!a) return tl::unexpected(a.error());
-            d.address = *a;
-        } else if (k == "type") {
-            auto type = value_type(v, p);
-            if (!type) return tl::unexpected(type.error());
-            d.type = *type;
-            type_given = true;
-        } else if (k == "when") {
-            auto e = located_text(v, p);
-            if (!e) return tl::unexpected(e.error());
-            d.when = *e;
-        } else if (std::find(allowed.begin(), allowed.end(), k) == allowed.end()) {
-            return fail(*key_ptr, p,
-                        is_link ? std::string("unknown key")
-                                : fmt::format("unknown key for kind = \"{}\"",
-                                              scenario::signal_kind_name(d.kind)));
-        } else if (k == "expr" || k == "input" || k == "setpoint") {
-            auto e = located_text(v, p);
-            if (!e) return tl::unexpected(e.error());
-            d.input = *e;
-        } else if (k == "repeat") {
-            const auto* b = v.as_boolean();
-            if (b == nullptr) return fail(v, p, "must be true or false");
-            d.repeat = b->get();
-        } else if (k == "steps") {
-            const auto* list = v.as_array();
-            if (list == nullptr || list->empty()) return fail(v, p, "must be [[t, value], ...]");
-            for (std::size_t i = 0; i < list->size(); ++i) {
-                const auto* pair = (*list)[i].as_array();
-                const std::string sp = fmt::format("{}[{}]", p, i);
-                if (pair == nullptr || pair->size() != 2)
-                    return fail((*list)[i], sp, "must be [t, value]");
-                auto at = number((*pair)[0], sp);
-                if (!at) return tl::unexpected(at.error());
-                auto value = number((*pair)[1], sp);
-                if (!value) return tl::unexpected(value.error());
-                d.steps.emplace_back(*at, *value);
-            }
-        } else {
-            auto n = number(v, p);
-            if (!n) return tl::unexpected(n.error());
-            if (k == "value")
-                d.value = *n;
-            else if (k == "min")
-                d.min = *n;
-            else if (k == "max")
-                d.max = *n;
-            else if (k == "period_s")
-                d.period_s = *n;
-            else if (k == "phase_s")
-                d.phase_s = *n;
-            else if (k == "duty") {
-                // The fraction of each period at max: 0 (always min) to 1 (always max).
-                if (!(*n >= 0 && *n <= 1))
-                    return fail(v, p, fmt::format("{} is not a fraction 0-1", *n));
-                d.duty = *n;
-            } else if (k == "step")
-                d.step = *n;
-            else if (k == "rate")
-                d.rate = *n;
-            else if (k == "tau_s")
-                d.tau_s = *n;
-            else if (k == "noise")
-                d.noise = *n;
-            else if (k == "on_above")
-                d.on_above = *n;
-            else if (k == "off_below")
-                d.off_below = *n;
-            else if (k == "delay_s")
-                d.delay_s = *n;
-            else if (k == "initial")
-                d.initial = *n;
-            else if (k == "repeat_s")
-                d.repeat_s = *n;
-        }
+    std::vector<Key> keys{located_key("address", d.address, true),
+                          {"type", Type::any,
+                           [&](const Entry& e) -> Done {
+                               auto type = value_type(e.node, e.path);
+                               if (!type) return tl::unexpected(type.error());
+                               d.type = *type;
+                               type_given = true;
+                               return {};
+                           }},
+                          located_key("when", d.when)};
+    if (!is_link) keys.emplace_back("kind");  // read above
+    // Keys a signal of this kind takes; any other is refused as unknown for the kind.
+    const std::pair<std::string_view, double*> numbers[] = {{"value", &d.value},
+                                                            {"min", &d.min},
+                                                            {"max", &d.max},
+                                                            {"period_s", &d.period_s},
+                                                            {"phase_s", &d.phase_s},
+                                                            {"step", &d.step},
+                                                            {"rate", &d.rate},
+                                                            {"tau_s", &d.tau_s},
+                                                            {"noise", &d.noise},
+                                                            {"on_above", &d.on_above},
+                                                            {"off_below", &d.off_below},
+                                                            {"delay_s", &d.delay_s},
+                                                            {"repeat_s", &d.repeat_s}};
+    for (const std::string_view name : kind_keys(d.kind)) {
+        if (name == "expr" || name == "input" || name == "setpoint")
+            keys.push_back(located_key(name, d.input));
+        else if (name == "repeat")
+            keys.push_back(config::flag_key(name, d.repeat));
+        else if (name == "steps")
+            keys.emplace_back(name, Type::any, [&](const Entry& e) { return steps(e, d); });
+        else if (name == "initial")
+            keys.push_back(number_key(name, [&](const Entry&, double n) {
+                d.initial = n;
+                return Done{};
+            }));
+        else if (name == "duty")
+            // The fraction of each period at max: 0 (always min) to 1 (always max).
+            keys.push_back(number_key(name, [&](const Entry& e, double n) -> Done {
+                if (!(n >= 0 && n <= 1)) return e.fail(fmt::format("{} is not a fraction 0-1", n));
+                d.duty = n;
+                return {};
+            }));
+        for (const auto& [number, field] : numbers)
+            if (number == name)
+                keys.push_back(number_key(name, [field = field](const Entry&, double n) {
+                    *field = n;
+                    return Done{};
+                }));
     }
-    if (d.address.text.empty()) return fail_at(t.source(), path, "address: missing");
+    const std::string unknown =
+        is_link ? std::string("unknown key")
+                : fmt::format("unknown key for kind = \"{}\"", scenario::signal_kind_name(d.kind));
+    if (auto r = config::read_table(t, {source_, path, config::At::value, {}, unknown}, keys); !r)
+        return r;
     if (!type_given) {
         // A bit address is a bool; a word defaults to int16, as the example.
         auto a = parse_address(d.address.text);
@@ -160,26 +136,37 @@ tl::expected<void, std::string> ScenarioLoader::tag(const toml::table& t, const 
     return {};
 }
 
+// A steps signal's [[t, value], ...].
+tl::expected<void, std::string> ScenarioLoader::steps(const Entry& e, scenario::TagDef& d) const {
+    const auto* list = e.node.as_array();
+    if (list == nullptr || list->empty()) return fail(e.node, e.path, "must be [[t, value], ...]");
+    for (std::size_t i = 0; i < list->size(); ++i) {
+        const auto* pair = (*list)[i].as_array();
+        const std::string sp = fmt::format("{}[{}]", e.path, i);
+        if (pair == nullptr || pair->size() != 2) return fail((*list)[i], sp, "must be [t, value]");
+        auto at = number((*pair)[0], sp);
+        if (!at) return tl::unexpected(at.error());
+        auto value = number((*pair)[1], sp);
+        if (!value) return tl::unexpected(value.error());
+        d.steps.emplace_back(*at, *value);
+    }
+    return {};
+}
+
 tl::expected<void, std::string> ScenarioLoader::input(const toml::table& t,
                                                       const std::string& path) {
     scenario::InputDef d;
     d.pos = pos(t.source());
-    for (const auto& [key_ptr, node_ptr] : in_file_order(t)) {
-        const std::string k(key_ptr->str());
-        const std::string p = path + "." + k;
-        if (k == "address") {
-            auto a = located_text(*node_ptr, p);
-            if (!a) return tl::unexpected(a.error());
-            d.address = *a;
-        } else if (k == "type") {
-            auto type = value_type(*node_ptr, p);
-            if (!type) return tl::unexpected(type.error());
-            d.type = *type;
-        } else {
-            return fail(*key_ptr, p, "unknown key");
-        }
-    }
-    if (d.address.text.empty()) return fail_at(t.source(), path, "address: missing");
+    auto r = config::read_table(
+        t, {source_, path},
+        {located_key("address", d.address, true), {"type", Type::any, [&](const Entry& e) -> Done {
+                                                       auto type = value_type(e.node, e.path);
+                                                       if (!type)
+                                                           return tl::unexpected(type.error());
+                                                       d.type = *type;
+                                                       return {};
+                                                   }}});
+    if (!r) return r;
     out_.def.inputs.push_back(std::move(d));
     return {};
 }
@@ -188,68 +175,64 @@ tl::expected<void, std::string> ScenarioLoader::event(const toml::table& t,
                                                       const std::string& path) {
     scenario::EventDef e;
     e.pos = pos(t.source());
-    bool fault_given = false;
-    for (const auto& [key_ptr, node_ptr] : in_file_order(t)) {
-        const std::string k(key_ptr->str());
-        const toml::node& v = *node_ptr;
-        const std::string p = path + "." + k;
-        if (k == "name" || k == "message" || k == "fault" || k == "mode") {
-            auto s = text(v, p);
-            if (!s) return tl::unexpected(s.error());
-            if (k == "name") {
-                if (s->empty()) return fail(v, p, "must not be empty");
-                e.name = *s;
-            } else if (k == "message") {
-                e.message = *s;
-            } else if (k == "fault") {
-                auto f = scenario::parse_fault_kind(*s);
-                if (!f)
-                    return fail(v, p,
-                                fmt::format("'{}' is not stuck, drift, spike, set, noise, fal, "
-                                            "fals, battery, mode, end_code, offline, latency, "
-                                            "drop or clock_jump",
-                                            *s));
-                e.fault = *f;
-                fault_given = true;
-            } else {
-                if (*s == "program" || *s == "stop")
-                    e.mode = scenario::Mode::program;
-                else if (*s == "monitor")
-                    e.mode = scenario::Mode::monitor;
-                else if (*s == "run")
-                    e.mode = scenario::Mode::run;
-                else
-                    return fail(v, p, fmt::format("'{}' is not program, monitor or run", *s));
-            }
-        } else if (k == "address") {
-            auto a = located_text(v, p);
-            if (!a) return tl::unexpected(a.error());
-            e.address = *a;
-        } else if (k == "number") {
-            auto n = integer(v, p, 1, 511);
-            if (!n) return tl::unexpected(n.error());
-            e.number = static_cast<std::uint16_t>(*n);
-        } else if (k == "end_code") {
-            auto n = integer(v, p, 1, 0xFFFF);
-            if (!n) return tl::unexpected(n.error());
-            e.end_code = static_cast<std::uint16_t>(*n);
-        } else if (k == "at_s" || k == "every_s" || k == "duration_s" || k == "value") {
-            auto n = number(v, p);
-            if (!n) return tl::unexpected(n.error());
-            if (k != "value" && *n < 0) return fail(v, p, "must not be negative");
-            if (k == "at_s")
-                e.at_s = *n;
-            else if (k == "every_s")
-                e.every_s = *n;
-            else if (k == "duration_s")
-                e.duration_s = *n;
-            else
-                e.value = *n;
-        } else {
-            return fail(*key_ptr, p, "unknown key");
-        }
-    }
-    if (!fault_given) return fail_at(t.source(), path, "fault: missing");
+    const auto not_negative = [](std::optional<double>& out) {
+        return [&out](const Entry& k, double n) -> Done {
+            if (n < 0) return k.fail("must not be negative");
+            out = n;
+            return {};
+        };
+    };
+    auto r = config::read_table(
+        t, {source_, path},
+        {{"name", Type::string,
+          [&](const Entry& k) -> Done {
+              if (k.text().empty()) return k.fail("must not be empty");
+              e.name = k.text();
+              return {};
+          }},
+         config::text_key("message", e.message),
+         {"fault", Type::string,
+          [&](const Entry& k) -> Done {
+              auto f = scenario::parse_fault_kind(k.text());
+              if (!f)
+                  return k.fail(
+                      fmt::format("'{}' is not stuck, drift, spike, set, noise, fal, "
+                                  "fals, battery, mode, end_code, offline, latency, "
+                                  "drop or clock_jump",
+                                  k.text()));
+              e.fault = *f;
+              return {};
+          },
+          true},
+         {"mode", Type::string,
+          [&](const Entry& k) -> Done {
+              const std::string& s = k.text();
+              if (s == "program" || s == "stop")
+                  e.mode = scenario::Mode::program;
+              else if (s == "monitor")
+                  e.mode = scenario::Mode::monitor;
+              else if (s == "run")
+                  e.mode = scenario::Mode::run;
+              else
+                  return k.fail(fmt::format("'{}' is not program, monitor or run", s));
+              return {};
+          }},
+         located_key("address", e.address),
+         config::integer_key("number", e.number, 1, 511),
+         config::integer_key("end_code", e.end_code, 1, 0xFFFF),
+         number_key("at_s", not_negative(e.at_s)),
+         number_key("every_s", not_negative(e.every_s)),
+         number_key("duration_s",
+                    [&](const Entry& k, double n) -> Done {
+                        if (n < 0) return k.fail("must not be negative");
+                        e.duration_s = n;
+                        return {};
+                    }),
+         number_key("value", [&](const Entry&, double n) {
+             e.value = n;
+             return Done{};
+         })});
+    if (!r) return r;
     out_.def.events.push_back(std::move(e));
     return {};
 }
@@ -258,24 +241,12 @@ tl::expected<void, std::string> ScenarioLoader::loop_item(const toml::table& t,
                                                           const std::string& path) {
     scenario::LoopItemDef d;
     d.pos = pos(t.source());
-    for (const auto& [key_ptr, node_ptr] : in_file_order(t)) {
-        const std::string k(key_ptr->str());
-        const std::string p = path + "." + k;
-        if (k == "address") {
-            auto a = located_text(*node_ptr, p);
-            if (!a) return tl::unexpected(a.error());
-            d.address = *a;
-        } else if (k == "block" || k == "item") {
-            auto n = integer(*node_ptr, p, 0, 999);
-            if (!n) return tl::unexpected(n.error());
-            (k == "block" ? d.block : d.item) = *n;
-        } else {
-            return fail(*key_ptr, p, "unknown key");
-        }
-    }
-    if (d.block < 0) return fail_at(t.source(), path, "block: missing");
-    if (d.item < 0) return fail_at(t.source(), path, "item: missing");
-    if (d.address.text.empty()) return fail_at(t.source(), path, "address: missing");
+    auto r = config::read_table(
+        t, {source_, path},
+        {Key("block", Type::integer, config::integer_key("block", d.block, 0, 999).read, true),
+         Key("item", Type::integer, config::integer_key("item", d.item, 0, 999).read, true),
+         located_key("address", d.address, true)});
+    if (!r) return r;
     out_.def.loop_items.push_back(std::move(d));
     return {};
 }

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -15,6 +16,7 @@
 #include <toml++/toml.h>
 #include <tl/expected.hpp>
 
+#include "config/schema.hpp"
 #include "finsd/config_scenario.hpp"
 
 namespace fins::finsd {
@@ -99,6 +101,30 @@ class ScenarioLoader {
                                     *s));
         return *type;
     }
+
+    // A key holding a finite number (an integer or a float), handed to `take`.
+    using Take = std::function<tl::expected<void, std::string>(const config::Entry&, double)>;
+    static config::Key number_key(std::string_view name, Take take) {
+        return {
+            name, config::Type::number,
+            [take = std::move(take)](const config::Entry& e) -> tl::expected<void, std::string> {
+                if (!std::isfinite(e.number())) return e.fail("must be a finite number");
+                return take(e, e.number());
+            }};
+    }
+    // A key holding a non-empty string, kept with its position for the scenario's messages.
+    config::Key located_key(std::string_view name, scenario::Text& out,
+                            bool required = false) const {
+        return {name, config::Type::any,
+                [this, &out](const config::Entry& e) -> tl::expected<void, std::string> {
+                    auto s = located_text(e.node, e.path);
+                    if (!s) return tl::unexpected(s.error());
+                    out = *s;
+                    return {};
+                },
+                required};
+    }
+    tl::expected<void, std::string> steps(const config::Entry& e, scenario::TagDef& d) const;
 
     // [[scenario.signal]] and [[scenario.link]] (config_scenario_entries.cpp).
     tl::expected<void, std::string> tag(const toml::table& t, const std::string& path,

@@ -4,11 +4,12 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
-#include <cstdio>
 
 #include <fmt/format.h>
 #include <boost/asio/ip/address.hpp>
 
+#include "codec/hex.hpp"
+#include "config/schema.hpp"
 #include "finsd/config.hpp"
 #include "transport/asio.hpp"
 
@@ -17,14 +18,13 @@ namespace fins::finsd {
 namespace {
 
 using Fail = tl::unexpected<std::string>;
+using Done = tl::expected<void, std::string>;
+using config::Entry;
+using config::Key;
+using config::Type;
 
 std::string at(std::string_view source, const toml::source_region& where) {
     return fmt::format("{}:{}:{}", source, where.begin.line, where.begin.column);
-}
-
-Fail fail(std::string_view source, const toml::node& node, const std::string& path,
-          std::string_view message) {
-    return Fail(fmt::format("{}: {}: {}", at(source, node.source()), path, message));
 }
 
 // The entries of an array of tables, or why not.
@@ -96,44 +96,42 @@ tl::expected<void, std::string> load_remotes(const toml::key& key, const toml::n
         const auto& t = *(**list)[i].as_table();
         const std::string p = fmt::format("remote[{}]", i);
         server::RemoteNode r;
-        bool has_node = false, has_address = false, has_client_node = false;
-        for (auto&& [k, v] : t) {
-            const std::string path = p + "." + std::string(k.str());
-            if (k == "transport") {
-                const auto* s = v.as_string();
-                if (s == nullptr || (s->get() != "udp" && s->get() != "tcp"))
-                    return fail(source, v, path, "must be \"udp\" or \"tcp\"");
-                r.tcp = s->get() == "tcp";
-            } else if (k == "client_node") {
-                const auto* n = v.as_integer();
-                if (n == nullptr || n->get() < 0 || n->get() > 254)
-                    return fail(source, v, path,
-                                "must be an integer 0-254 (0: the server allocates one)");
-                r.client_node = static_cast<std::uint8_t>(n->get());
-                has_client_node = true;
-            } else if (k == "node" || k == "network") {
-                const auto* n = v.as_integer();
-                const std::int64_t hi = k == "node" ? 254 : 127;
-                const std::int64_t lo = k == "node" ? 1 : 0;
-                if (n == nullptr || n->get() < lo || n->get() > hi)
-                    return fail(source, v, path, fmt::format("must be an integer {}-{}", lo, hi));
-                (k == "node" ? r.node : r.network) = static_cast<std::uint8_t>(n->get());
-                has_node = has_node || k == "node";
-            } else if (k == "address") {
-                const auto* s = v.as_string();
-                const auto hp = s != nullptr ? parse_host_port(s->get()) : std::nullopt;
-                if (!hp)
-                    return fail(
-                        source, v, path,
-                        "must be \"IP:PORT\" (\"127.0.1.5:9600\", \"[::1]:9600\") or an IP");
-                const auto& [host, port] = *hp;
-                r.host = host;
-                r.port = port;
-                has_address = true;
-            } else {
-                return fail(source, v, path, "unknown key");
-            }
-        }
+        const auto integer = [&](std::string_view name, std::int64_t lo, std::int64_t hi,
+                                 std::string_view why, std::uint8_t& out) -> Key {
+            return {name, Type::any, [lo, hi, why, &out](const Entry& e) -> Done {
+                        const auto* n = e.node.as_integer();
+                        if (n == nullptr || n->get() < lo || n->get() > hi) return e.fail(why);
+                        out = static_cast<std::uint8_t>(n->get());
+                        return {};
+                    }};
+        };
+        auto read = config::read_table(
+            t, {source, p},
+            {{"transport", Type::any,
+              [&](const Entry& e) -> Done {
+                  const auto* s = e.node.as_string();
+                  if (s == nullptr || (s->get() != "udp" && s->get() != "tcp"))
+                      return e.fail("must be \"udp\" or \"tcp\"");
+                  r.tcp = s->get() == "tcp";
+                  return {};
+              }},
+             integer("client_node", 0, 254,
+                     "must be an integer 0-254 (0: the server allocates one)", r.client_node),
+             integer("node", 1, 254, "must be an integer 1-254", r.node),
+             integer("network", 0, 127, "must be an integer 0-127", r.network),
+             {"address", Type::any, [&](const Entry& e) -> Done {
+                  const auto* s = e.node.as_string();
+                  const auto hp = s != nullptr ? parse_host_port(s->get()) : std::nullopt;
+                  if (!hp)
+                      return e.fail(
+                          "must be \"IP:PORT\" (\"127.0.1.5:9600\", \"[::1]:9600\") or an IP");
+                  r.host = hp->first;
+                  r.port = hp->second;
+                  return {};
+              }}});
+        if (!read) return read;
+        const bool has_node = t.contains("node"), has_address = t.contains("address");
+        const bool has_client_node = t.contains("client_node");
         if (!has_node || !has_address)
             return Fail(fmt::format("{}: {}: needs node and address", at(source, t.source()), p));
         if (has_client_node && !r.tcp)
@@ -165,76 +163,71 @@ tl::expected<void, std::string> load_schedule(const toml::key& key, const toml::
         ScheduleEntry e;
         e.where = at(source, t.source());
         auto& r = e.scheduled.request;
-        bool has_every = false, has_kind = false, has_dest = false, has_local = false,
-             has_remote = false, has_command = false;
-        for (auto&& [k, v] : t) {
-            const std::string path = p + "." + std::string(k.str());
-            const auto* s = v.as_string();
-            const auto* n = v.as_integer();
-            const toml::node& value = v;  // clang 14 cannot capture a structured binding
-            const auto integer = [&](std::int64_t hi) -> tl::expected<std::int64_t, std::string> {
-                if (n == nullptr || n->get() < 0 || n->get() > hi)
-                    return fail(source, value, path, fmt::format("must be an integer 0-{}", hi));
-                return n->get();
+        // A string the parser `parse` takes, or the complaint `why`.
+        const auto parsed = [](std::string_view name, std::string_view why, auto parse) -> Key {
+            return {name, Type::any, [why, parse](const Entry& k) -> Done {
+                        const auto* s = k.node.as_string();
+                        if (s == nullptr || !parse(s->get())) return k.fail(why);
+                        return {};
+                    }};
+        };
+        const auto count = [](std::string_view name, std::int64_t hi, auto set) -> Key {
+            return {name, Type::any, [hi, set](const Entry& k) -> Done {
+                        const auto* n = k.node.as_integer();
+                        if (n == nullptr || n->get() < 0 || n->get() > hi)
+                            return k.fail(fmt::format("must be an integer 0-{}", hi));
+                        set(n->get());
+                        return {};
+                    }};
+        };
+        const auto word_address = [&](Address& out) {
+            return [&out](const std::string& s) {
+                auto a = parse_address(s);
+                if (a) out = *a;
+                return a.has_value();
             };
-            if (k == "every") {
-                const auto period = s ? parse_period(s->get()) : std::nullopt;
-                if (!period || *period < server::min_schedule_period)
-                    return fail(source, v, path,
-                                "must be a period of 10ms or more: \"250ms\", \"1s\", \"1min\"");
-                e.scheduled.every = *period;
-                has_every = true;
-            } else if (k == "instruction") {
-                const auto kind = s ? server::parse_instruction_kind(s->get()) : std::nullopt;
-                if (!kind) return fail(source, v, path, "must be send, recv or sendcmd");
-                r.kind = *kind;
-                has_kind = true;
-            } else if (k == "dest") {
-                const auto d = s ? server::parse_destination(s->get()) : std::nullopt;
-                if (!d) return fail(source, v, path, "must be NET.NODE.UNIT (network 0-127)");
-                r.destination = *d;
-                has_dest = true;
-            } else if (k == "local" || k == "remote") {
-                auto a =
-                    s ? parse_address(s->get()) : Result<Address>{Unexpected(std::error_code{})};
-                if (!a) return fail(source, v, path, "must be a word address such as D100");
-                (k == "local" ? r.local : r.remote) = *a;
-                (k == "local" ? has_local : has_remote) = true;
-            } else if (k == "command") {
-                std::string hex = s ? s->get() : "x";
-                std::erase(hex, ' ');
-                std::vector<std::uint8_t> bytes;
-                bool ok = hex.size() % 2 == 0 && hex.size() >= 4;
-                for (std::size_t b = 0; ok && b < hex.size(); b += 2) {
-                    unsigned x = 0;
-                    ok = std::sscanf(hex.substr(b, 2).c_str(), "%2x", &x) == 1 &&
-                         std::isxdigit(static_cast<unsigned char>(hex[b])) != 0 &&
-                         std::isxdigit(static_cast<unsigned char>(hex[b + 1])) != 0;
-                    bytes.push_back(static_cast<std::uint8_t>(x));
-                }
-                if (!ok) return fail(source, v, path, "must be hex bytes: MRC SRC parameters");
-                r.command = std::move(bytes);
-                has_command = true;
-            } else if (k == "count") {
-                const auto c = integer(server::max_instruction_words);
-                if (!c) return Fail(c.error());
-                r.count = static_cast<std::uint16_t>(*c);
-            } else if (k == "timeout") {
-                const auto c = integer(65535);
-                if (!c) return Fail(c.error());
-                r.options.timeout = static_cast<std::uint16_t>(*c);
-            } else if (k == "retries") {
-                const auto c = integer(server::max_instruction_retries);
-                if (!c) return Fail(c.error());
-                r.options.retries = static_cast<unsigned>(*c);
-            } else if (k == "no_response") {
-                const auto* b = v.as_boolean();
-                if (b == nullptr) return fail(source, v, path, "must be true or false");
-                r.options.no_response = b->get();
-            } else {
-                return fail(source, v, path, "unknown key");
-            }
-        }
+        };
+        auto read = config::read_table(
+            t, {source, p},
+            {parsed("every", "must be a period of 10ms or more: \"250ms\", \"1s\", \"1min\"",
+                    [&](const std::string& s) {
+                        const auto period = parse_period(s);
+                        if (!period || *period < server::min_schedule_period) return false;
+                        e.scheduled.every = *period;
+                        return true;
+                    }),
+             parsed("instruction", "must be send, recv or sendcmd",
+                    [&](const std::string& s) {
+                        const auto kind = server::parse_instruction_kind(s);
+                        if (kind) r.kind = *kind;
+                        return kind.has_value();
+                    }),
+             parsed("dest", "must be NET.NODE.UNIT (network 0-127)",
+                    [&](const std::string& s) {
+                        const auto d = server::parse_destination(s);
+                        if (d) r.destination = *d;
+                        return d.has_value();
+                    }),
+             parsed("local", "must be a word address such as D100", word_address(r.local)),
+             parsed("remote", "must be a word address such as D100", word_address(r.remote)),
+             parsed("command", "must be hex bytes: MRC SRC parameters",
+                    [&](const std::string& s) {
+                        auto bytes = hex::parse_bytes(s, " ");
+                        if (!bytes || bytes->size() < 2) return false;
+                        r.command = std::move(*bytes);
+                        return true;
+                    }),
+             count("count", server::max_instruction_words,
+                   [&](std::int64_t c) { r.count = static_cast<std::uint16_t>(c); }),
+             count("timeout", 65535,
+                   [&](std::int64_t c) { r.options.timeout = static_cast<std::uint16_t>(c); }),
+             count("retries", server::max_instruction_retries,
+                   [&](std::int64_t c) { r.options.retries = static_cast<unsigned>(c); }),
+             config::flag_key("no_response", r.options.no_response)});
+        if (!read) return read;
+        const bool has_every = t.contains("every"), has_kind = t.contains("instruction"),
+                   has_dest = t.contains("dest"), has_local = t.contains("local"),
+                   has_remote = t.contains("remote"), has_command = t.contains("command");
         if (!has_every || !has_kind || !has_dest)
             return Fail(fmt::format("{}: {}: needs every, instruction and dest", e.where, p));
         const bool words = r.kind != server::InstructionKind::sendcmd;

@@ -1,9 +1,8 @@
 #include "finsd/config_serial.hpp"
 
-#include <charconv>
-
 #include <fmt/format.h>
 
+#include "codec/hex.hpp"
 #include "transport/serial_options.hpp"
 
 namespace fins::finsd {
@@ -67,12 +66,11 @@ tl::expected<SerialPortConfig, std::string> parse_serial_name(std::string_view n
     }
     if (head.size() < 4 || head.substr(0, 3) != "scu") return bad();
     const auto digits = head.substr(3);
-    unsigned n = 0;
-    const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), n, 16);
-    if (ec != std::errc{} || end != digits.data() + digits.size()) return bad();
-    if (n > 15) return Fail(fmt::format("port name '{}': unit number {} is over F", name, digits));
+    const auto n = hex::parse_number(digits, 16, hex::Prefix::none);
+    if (!n) return bad();
+    if (*n > 15) return Fail(fmt::format("port name '{}': unit number {} is over F", name, digits));
     p.kind = SerialPortConfig::Kind::scu;
-    p.unit_number = n;
+    p.unit_number = static_cast<unsigned>(*n);
     return p;
 }
 

@@ -95,18 +95,6 @@ tl::expected<WordList, TypedValueError> typed_words(const toml::table& t) {
     return out;
 }
 
-std::vector<std::pair<const toml::key*, const toml::node*>> in_file_order(const toml::table& t) {
-    std::vector<std::pair<const toml::key*, const toml::node*>> entries;
-    for (auto&& [k, v] : t)
-        entries.emplace_back(&k, &v);
-    std::stable_sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
-        const auto& x = a.first->source().begin;
-        const auto& y = b.first->source().begin;
-        return x.line != y.line ? x.line < y.line : x.column < y.column;
-    });
-    return entries;
-}
-
 Expected<MemoryInit> memory_entry(const toml::key& key, const toml::node& node,
                                   std::string_view source, std::string_view prefix) {
     const std::string p = fmt::format("{}.\"{}\"", prefix, key.str());

@@ -15,6 +15,7 @@
 #include <toml++/toml.h>
 #include <tl/expected.hpp>
 
+#include "config/schema.hpp"
 #include "finsd/config.hpp"
 
 namespace fins::finsd {
@@ -26,10 +27,9 @@ struct TypedValueError {
 
 tl::expected<std::vector<std::uint32_t>, TypedValueError> typed_words(const toml::table& t);
 
-// A table's entries in file order (toml::table iterates in key order): the first
-// problem reported is the first in the file, and [memory] entries are written in the
-// order they are written down (later ones win where they overlap).
-std::vector<std::pair<const toml::key*, const toml::node*>> in_file_order(const toml::table& t);
+// A table's entries in file order: [memory] entries are written in the order they are
+// written down (later ones win where they overlap).
+using config::in_file_order;
 
 // One entry of a [memory] table (or of a [[plc]]'s memory table): `key` the address,
 // `node` a value, an array of values or a { TYPE = ... } table. Errors read

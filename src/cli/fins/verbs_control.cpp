@@ -19,6 +19,7 @@
 #include <fmt/core.h>
 
 #include "cli/fins/commands.hpp"
+#include "codec/hex.hpp"
 #include "fins/commands/clock.hpp"
 #include "fins/commands/configuration.hpp"
 #include "fins/commands/operating_mode.hpp"
@@ -130,13 +131,9 @@ int run_cpu_data(const GlobalOptions& g, Output& out, const std::string& section
 }
 
 std::optional<std::uint8_t> parse_unit_address(const std::string& s) {
-    std::string_view v = s;
-    if (v.size() > 2 && v[0] == '0' && (v[1] == 'x' || v[1] == 'X')) v.remove_prefix(2);
-    unsigned value = 0;
-    const auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), value, 16);
-    if (v.empty() || ec != std::errc{} || p != v.data() + v.size() || value > 0xFF)
-        return std::nullopt;
-    return static_cast<std::uint8_t>(value);
+    const auto value = hex::parse_number(s);
+    if (!value || *value > 0xFF) return std::nullopt;
+    return static_cast<std::uint8_t>(*value);
 }
 
 int run_connections(const GlobalOptions& g, Output& out, const ControlArgs& a) {

@@ -13,7 +13,6 @@
 // Exit codes and --json as everywhere else (commands.hpp Output). An ERROR LOG READ
 // that answers 1104 (fewer records stored than asked for, 5-3-28) is a success here.
 #include <array>
-#include <charconv>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -24,6 +23,7 @@
 #include <fmt/core.h>
 
 #include "cli/fins/commands.hpp"
+#include "codec/hex.hpp"
 #include "fins/address.hpp"
 #include "fins/command_table.hpp"
 #include "fins/commands/access_right.hpp"
@@ -265,13 +265,9 @@ int run_access(const GlobalOptions& g, Output& out, const std::string& action) {
 std::optional<std::uint16_t> clear_code(const std::string& s) {
     if (s == "all") return clear_all_errors;
     if (s == "current") return clear_current_error;
-    std::string_view v = s;
-    if (v.size() > 2 && v[0] == '0' && (v[1] == 'x' || v[1] == 'X')) v.remove_prefix(2);
-    unsigned value = 0;
-    const auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), value, 16);
-    if (v.empty() || v.size() > 4 || ec != std::errc{} || p != v.data() + v.size())
-        return std::nullopt;
-    return static_cast<std::uint16_t>(value);
+    const auto value = hex::parse_number(s, 4);
+    if (!value) return std::nullopt;
+    return static_cast<std::uint16_t>(*value);
 }
 
 int run_error_clear(const GlobalOptions& g, Output& out, const std::string& code_text) {

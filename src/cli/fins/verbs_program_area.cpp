@@ -5,7 +5,6 @@
 // Numbers are decimal or 0x-prefixed hex. Exit codes as every verb: 0, 2, 3, 4.
 #include <algorithm>
 #include <array>
-#include <cctype>
 #include <fstream>
 #include <iterator>
 #include <memory>
@@ -17,6 +16,7 @@
 
 #include "cli/fins/commands.hpp"
 #include "cli/fins/verb_support.hpp"
+#include "codec/hex.hpp"
 #include "fins/commands/program_area.hpp"
 
 namespace fins::cli {
@@ -113,17 +113,8 @@ std::optional<std::vector<std::uint8_t>> load_program(const ProgramArgs& a) {
     if (!f) return std::nullopt;
     std::string raw{std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
     if (!a.hex) return std::vector<std::uint8_t>(raw.begin(), raw.end());
-    std::string digits;
-    for (char c : raw)
-        if (!std::isspace(static_cast<unsigned char>(c))) digits += c;
-    if (digits.size() % 2 != 0) return std::nullopt;
-    std::vector<std::uint8_t> data(digits.size() / 2);
-    for (std::size_t i = 0; i < data.size(); ++i) {
-        const char* first = digits.data() + 2 * i;
-        const auto [end, ec] = std::from_chars(first, first + 2, data[i], 16);
-        if (ec != std::errc{} || end != first + 2) return std::nullopt;
-    }
-    return data;
+    // Pairs of hex digits; white space anywhere.
+    return hex::parse_bytes(raw, " \t\n\r\v\f");
 }
 
 int run_program_write(const GlobalOptions& g, const ProgramArgs& a, Output& out) {

@@ -4,10 +4,9 @@
 // Server side (decode): errors are the end codes the CPU Unit answers, 1002 for a
 // command shorter than its fixed part and 1001 for one longer than it.
 // Client side (decode_response): any length or echo mismatch is malformed_response.
-#include "codec/command_codec.hpp"
 #include "fins/commands/parameter_area.hpp"
-
-#include <charconv>
+#include "codec/command_codec.hpp"
+#include "codec/hex.hpp"
 
 namespace fins {
 
@@ -59,10 +58,8 @@ const ParameterAreaInfo* find_parameter_area(std::string_view text) noexcept {
     if (text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X'))
         text.remove_prefix(2);
     if (text.size() != 4) return nullptr;
-    std::uint16_t code = 0;
-    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), code, 16);
-    if (ec != std::errc{} || end != text.data() + text.size()) return nullptr;
-    return find_parameter_area(code);
+    const auto code = hex::parse_number(text, 4, hex::Prefix::none);
+    return code ? find_parameter_area(static_cast<std::uint16_t>(*code)) : nullptr;
 }
 
 void ParameterAreaReadResponse::encode(ByteWriter& w) const noexcept {
