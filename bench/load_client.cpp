@@ -9,6 +9,8 @@
 #include <functional>
 #include <vector>
 
+#include <time.h>
+
 #include <fmt/core.h>
 
 #include "fins/client.hpp"
@@ -18,11 +20,21 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// CPU time of the calling thread, in microseconds: the generator and the client both run
+// on this thread (finsd on its own), so their CPU per request compares them on a host too
+// busy for their rates to mean much.
+double thread_cpu_us() {
+    timespec t{};
+    ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) * 1e6 + static_cast<double>(t.tv_nsec) / 1e3;
+}
+
 struct ClientStatsLine {
     double rate = 0;
     double p50_us = 0;
     double p99_us = 0;
     std::size_t errors = 0;
+    std::size_t count = 0;
 };
 
 // Keeps `depth` 1-word reads of D0 in flight for `seconds`; each completion issues the
@@ -74,6 +86,7 @@ ClientStatsLine drive_client(bool tcp, std::uint16_t port, unsigned depth, doubl
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
     ClientStatsLine s;
     s.errors = p.errors;
+    s.count = p.latencies.size();
     if (p.latencies.empty()) return s;
     std::sort(p.latencies.begin(), p.latencies.end());
     s.rate = static_cast<double>(p.latencies.size()) / elapsed;
@@ -90,21 +103,34 @@ int run_client_mode(std::uint16_t port, double seconds, bool json,
                     const std::function<double(bool tcp, unsigned depth)>& raw_rate) {
     constexpr unsigned depth = 32;
     for (const bool tcp : {false, true}) {
+        const double cpu0 = thread_cpu_us();
         const double raw = raw_rate(tcp, depth);
+        const double cpu1 = thread_cpu_us();
         const auto client = drive_client(tcp, port, depth, seconds);
+        const double cpu2 = thread_cpu_us();
         const double ratio = raw > 0 ? client.rate / raw : 0;
+        // The raw generator's count from its rate over the case's length (its last answers
+        // take microseconds more).
+        const double raw_count = raw * seconds;
+        const double raw_cpu = raw_count > 0 ? (cpu1 - cpu0) / raw_count : 0;
+        const double client_cpu =
+            client.count > 0 ? (cpu2 - cpu1) / static_cast<double>(client.count) : 0;
         const char* proto = tcp ? "tcp" : "udp";
         if (json) {
             fmt::print(
                 "{{\"mode\":\"client\",\"transport\":\"{}\",\"in_flight\":{},\"client_rps\":{:.0f},"
                 "\"client_p50_us\":{:.1f},\"client_p99_us\":{:.1f},\"client_errors\":{},"
-                "\"raw_rps\":{:.0f},\"ratio\":{:.2f}}}\n",
-                proto, depth, client.rate, client.p50_us, client.p99_us, client.errors, raw, ratio);
+                "\"raw_rps\":{:.0f},\"ratio\":{:.2f},\"client_cpu_us\":{:.2f},\"raw_cpu_us\":{:.2f}"
+                "}}\n",
+                proto, depth, client.rate, client.p50_us, client.p99_us, client.errors, raw, ratio,
+                client_cpu, raw_cpu);
         } else {
             fmt::print(
                 "{} in-flight {:>2}: fins::Client {:>8.0f} req/s p50 {:>6.1f} us p99 {:>6.1f} us "
-                "errors {} | raw generator {:>8.0f} req/s | ratio {:.2f}\n",
-                proto, depth, client.rate, client.p50_us, client.p99_us, client.errors, raw, ratio);
+                "errors {} | raw generator {:>8.0f} req/s | ratio {:.2f} | CPU per request: client "
+                "{:.2f} us, raw {:.2f} us\n",
+                proto, depth, client.rate, client.p50_us, client.p99_us, client.errors, raw, ratio,
+                client_cpu, raw_cpu);
         }
         std::fflush(stdout);
         if (client.rate <= 0 || raw <= 0) return 1;

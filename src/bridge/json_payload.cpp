@@ -1,5 +1,8 @@
 #include "bridge/json_payload.hpp"
 
+#include <array>
+#include <charconv>
+
 #include <fmt/format.h>
 
 #include "fins/error.hpp"
@@ -24,6 +27,28 @@ nlohmann::json error_json(std::error_code ec) {
     return j;
 }
 
+namespace {
+
+// append_json() with the 16-bit integers written by std::to_chars (the same text: the
+// decimal number), the hot path of a poll cycle; the other types go to append_json().
+void append_value(std::string& b, TagType type, const TagValue& v) {
+    std::array<char, 16> digits{};
+    const auto put = [&](auto n) {
+        const auto r = std::to_chars(digits.data(), digits.data() + digits.size(), n);
+        b.append(digits.data(), r.ptr);
+    };
+    switch (type) {
+        case TagType::int16:
+            return put(static_cast<std::int16_t>(v.words[0]));
+        case TagType::uint16:
+            return put(v.words[0]);
+        default:
+            return append_json(b, type, v);
+    }
+}
+
+}  // namespace
+
 void JsonPayload::values(const GroupSample& s, const Sink& out) {
     std::string& b = buffer_;
     b.clear();
@@ -42,7 +67,7 @@ void JsonPayload::values(const GroupSample& s, const Sink& out) {
         if (t.error)
             b += error_json(t.error).dump();
         else
-            append_json(b, tag.type, t.value);
+            append_value(b, tag.type, t.value);
     }
     if (first && !s.full) return;  // nothing changed: no message
     b += s.full ? "},\"full\":true}" : "}}";

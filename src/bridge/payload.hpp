@@ -49,7 +49,7 @@ using Sink = std::function<void(Message&&)>;
 struct TagSample {
     TagValue value;
     std::error_code error;  // empty: value is fresh
-    bool changed = false;   // publish it in change mode
+    bool changed = false;   // publish it in change mode (not set in `always` groups)
 };
 
 // A completed poll cycle of one group.

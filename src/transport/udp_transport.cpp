@@ -1,7 +1,13 @@
 #include "transport/udp_transport.hpp"
 
-#include <cerrno>
+#ifdef __linux__
+#include <sys/socket.h>
+#include <sys/uio.h>
+#endif
 
+#include <algorithm>
+#include <array>
+#include <cerrno>
 #include <string>
 #include <utility>
 
@@ -93,27 +99,145 @@ ReceiveError classify_receive_error(boost::system::error_code ec) noexcept {
     return ReceiveError::fatal;
 }
 
+#ifdef __linux__
+namespace {
+
+// recvmmsg's buffers, shared by the thread's UDP transports (see udp_transport.hpp).
+struct ReceiveBatch {
+    static constexpr unsigned size = 16;
+    std::array<std::array<std::uint8_t, max_frame_size + 1>, size> buffers;
+    std::array<mmsghdr, size> messages;
+    std::array<iovec, size> vectors;
+    bool busy = false;
+};
+
+ReceiveBatch& receive_batch() {
+    thread_local ReceiveBatch batch{};
+    return batch;
+}
+
+boost::system::error_code last_error() {
+    return {errno, boost::system::system_category()};
+}
+
+}  // namespace
+
+void UdpTransport::receive() {
+    auto gen = generation_;
+    std::weak_ptr<int> life = life_;
+    socket_.async_wait(udp::socket::wait_read, [this, life, gen](boost::system::error_code ec) {
+        if (life.expired() || gen != generation_) return;
+        if (ec && !on_receive(ec, {})) return;
+        // Frames the handlers send meanwhile leave together once every answer is read.
+        holding_ = true;
+        if (!drain()) return;
+        holding_ = false;
+        flush();
+        receive();
+    });
+}
+
+bool UdpTransport::drain() {
+    auto& batch = receive_batch();
+    const bool shared = !batch.busy;
+    batch.busy = true;
+    struct Release {
+        ReceiveBatch& batch;
+        bool shared;
+        ~Release() {
+            if (shared) batch.busy = false;
+        }
+    } release{batch, shared};
+    const unsigned size = shared ? ReceiveBatch::size : 1;
+    // Bounded, so that one busy socket cannot hold the others up: 64 datagrams, then the
+    // reactor again.
+    for (int round = 0; round < 4; ++round) {
+        for (unsigned i = 0; i < size; ++i) {
+            batch.vectors[i] = {shared ? batch.buffers[i].data() : rx_.data(), rx_size};
+            batch.messages[i] = {};
+            batch.messages[i].msg_hdr.msg_iov = &batch.vectors[i];
+            batch.messages[i].msg_hdr.msg_iovlen = 1;
+        }
+        const int n =
+            ::recvmmsg(socket_.native_handle(), batch.messages.data(), size, MSG_DONTWAIT, nullptr);
+        if (n < 0) {
+            if (errno == EAGAIN || errno == EWOULDBLOCK) return true;
+            if (!on_receive(last_error(), {})) return false;
+            continue;
+        }
+        for (int i = 0; i < n; ++i) {
+            const auto& m = batch.messages[static_cast<std::size_t>(i)];
+            const auto* data = static_cast<const std::uint8_t*>(m.msg_hdr.msg_iov->iov_base);
+            if (!on_receive({}, Bytes{data, m.msg_len})) return false;
+        }
+        if (static_cast<unsigned>(n) < size) return true;
+    }
+    return true;
+}
+
+void UdpTransport::flush() {
+    constexpr std::size_t most = 32;
+    std::array<mmsghdr, most> messages;
+    std::array<iovec, most> vectors;
+    std::size_t next = 0, offset = 0;
+    while (next < held_sizes_.size()) {
+        const auto count = std::min(most, held_sizes_.size() - next);
+        std::size_t at = offset;
+        for (std::size_t i = 0; i < count; ++i) {
+            vectors[i] = {held_.data() + at, held_sizes_[next + i]};
+            messages[i] = {};
+            messages[i].msg_hdr.msg_iov = &vectors[i];
+            messages[i].msg_hdr.msg_iovlen = 1;
+            at += held_sizes_[next + i];
+        }
+        const int sent = ::sendmmsg(socket_.native_handle(), messages.data(),
+                                    static_cast<unsigned>(count), MSG_DONTWAIT | MSG_NOSIGNAL);
+        if (sent < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) {
+            // That datagram is lost: the retry logic's business, as for send().
+            offset += held_sizes_[next++];
+            continue;
+        }
+        if (sent <= 0) {
+            // The socket's buffer is full: the rest waits in the queue, in order.
+            for (; next < held_sizes_.size(); offset += held_sizes_[next++])
+                queue_.push(Bytes{held_.data() + offset, held_sizes_[next]});
+            write_next();
+            break;
+        }
+        for (int i = 0; i < sent; ++i)
+            offset += held_sizes_[next++];
+    }
+    held_.clear();
+    held_sizes_.clear();
+}
+#else
 void UdpTransport::receive() {
     auto gen = generation_;
     std::weak_ptr<int> life = life_;
     socket_.async_receive(asio::buffer(rx_),
                           [this, life, gen](boost::system::error_code ec, std::size_t n) {
                               if (life.expired() || gen != generation_) return;
-                              if (!on_receive(ec, n)) return;
-                              // Take what else is queued now, without another trip through the
-                              // reactor.
-                              for (int i = 0; i < 64; ++i) {
-                                  boost::system::error_code e;
-                                  const auto m = socket_.receive(asio::buffer(rx_), 0, e);
-                                  if (e == asio::error::would_block || e == asio::error::try_again)
-                                      break;
-                                  if (!on_receive(e, m)) return;
-                              }
+                              if (!on_receive(ec, ec ? Bytes{} : Bytes{rx_.data(), n})) return;
+                              if (!drain()) return;
                               receive();
                           });
 }
 
-bool UdpTransport::on_receive(boost::system::error_code ec, std::size_t n) {
+bool UdpTransport::drain() {
+    // Takes what else is queued now, without another trip through the reactor.
+    for (int i = 0; i < 64; ++i) {
+        boost::system::error_code e;
+        const auto m = socket_.receive(asio::buffer(rx_), 0, e);
+        if (e == asio::error::would_block || e == asio::error::try_again) break;
+        if (!on_receive(e, e ? Bytes{} : Bytes{rx_.data(), m})) return false;
+    }
+    return true;
+}
+
+void UdpTransport::flush() {}  // nothing is held: send() writes at once
+#endif
+
+bool UdpTransport::on_receive(boost::system::error_code ec, Bytes datagram) {
     auto gen = generation_;
     std::weak_ptr<int> life = life_;
     if (ec) {
@@ -129,9 +253,9 @@ bool UdpTransport::on_receive(boost::system::error_code ec, std::size_t n) {
                 fail(make_error_code(ClientError::connection_closed));
                 return false;
         }
-    } else if (n < rx_.size() && on_frame_) {
+    } else if (datagram.size() < rx_size && on_frame_) {
         // A datagram that fills the whole buffer is longer than 2,012 bytes: not FINS.
-        on_frame_(Bytes{rx_.data(), n});
+        on_frame_(datagram);
     }
     return !life.expired() && gen == generation_;
 }
@@ -146,6 +270,11 @@ bool UdpTransport::peer_gone() {
 
 void UdpTransport::send(Bytes frame) {
     if (state_ != State::open) return;
+    if (holding_ && !writing_ && queue_.empty()) {
+        held_.insert(held_.end(), frame.begin(), frame.end());
+        held_sizes_.push_back(frame.size());
+        return;
+    }
     if (!writing_ && queue_.empty()) {
         boost::system::error_code ec;
         socket_.send(asio::buffer(frame.data(), frame.size()), 0, ec);
@@ -173,6 +302,9 @@ void UdpTransport::write_next() {
 
 void UdpTransport::close() {
     close_connection();
+    holding_ = false;
+    held_.clear();
+    held_sizes_.clear();
 }
 
 }  // namespace fins::transport

@@ -14,11 +14,19 @@
 // holds 256 answers of up to about 400 bytes).
 // Datagrams longer than 2,012 bytes are dropped. LinkInfo nodes come from
 // node_from_address() of the local and the peer address.
+//
+// System calls (Linux): a readable socket is drained with recvmmsg, up to 16 datagrams a
+// call, into buffers the thread's transports share (a drain hands every frame over before
+// it returns; a drain that starts inside another one, from a handler that runs an
+// io_context, uses the transport's own buffer). Frames sent by the frame handlers during
+// a drain are held and leave together in one sendmmsg when the drain ends, in order,
+// before the socket is watched again. Elsewhere one datagram per call.
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/udp.hpp>
@@ -45,11 +53,21 @@ class UdpTransport final : public SocketTransport<asio::ip::udp> {
     void connect_first(const asio::ip::udp::resolver::results_type& results);
     void finish_open(Result<LinkInfo> result) override;
     void receive();
-    // Handles one receive result; false once the transport was closed or replaced.
-    bool on_receive(boost::system::error_code ec, std::size_t n);
+    // Reads every datagram queued now and hands the frames over; false once the transport
+    // was closed or replaced by a handler.
+    bool drain();
+    // Handles one receive result: a datagram, or an error (then `datagram` is empty);
+    // false once the transport was closed or replaced.
+    bool on_receive(boost::system::error_code ec, Bytes datagram);
+    // Sends the frames held during a drain.
+    void flush();
     void write_next();
 
-    std::array<std::uint8_t, max_frame_size + 1> rx_{};
+    static constexpr std::size_t rx_size = max_frame_size + 1;  // a full one is too long
+    std::array<std::uint8_t, rx_size> rx_{};
+    bool holding_ = false;                 // inside a drain: send() holds frames
+    std::vector<std::uint8_t> held_;       // frames held, back to back
+    std::vector<std::size_t> held_sizes_;  // their sizes
 };
 
 // What a receive error on a connected UDP socket means.

@@ -136,6 +136,40 @@ TEST(UdpTransport, ReceiveBufferHolds256AnswersInFlight) {
     EXPECT_EQ(ok, 256u);
 }
 
+// 64 answers arrive together (the responder holds 64 requests, then answers them all);
+// each completion sends the next request from inside the transport's drain. Those 64 are
+// held until the drain ends and leave together (Linux: one sendmmsg): every one must
+// reach the responder, which answers only once it has all 64.
+TEST(UdpTransport, RequestsSentByCompletionsDuringADrainAllGoOut) {
+    UdpResponder server;
+    server.hold_until(64);
+    auto client = Client::connect([&] {
+        ClientOptions o;
+        o.port = server.port();
+        o.timeout = 5s;
+        o.retries = 0;  // a request that never went out is a failed request
+        return o;
+    }());
+    ASSERT_TRUE(client);
+    std::size_t first = 0, second = 0;
+    for (std::uint16_t i = 0; i < 64; ++i)
+        (*client)->async_send(
+            MemoryAreaRead{{0x82, static_cast<std::uint16_t>(i * 10), 0}, 5},
+            [&, i](Result<MemoryAreaReadResponse> r) {
+                if (!r || r->data.size() != 10) return;
+                ++first;
+                (*client)->async_send(
+                    MemoryAreaRead{{0x82, static_cast<std::uint16_t>(1000 + i), 0}, 3},
+                    [&second](Result<MemoryAreaReadResponse> a) {
+                        if (a && a->data.size() == 6) ++second;
+                    });
+            });
+    (*client)->run();
+    EXPECT_EQ(first, 64u);
+    EXPECT_EQ(second, 64u);
+    EXPECT_EQ((*client)->stats().timed_out, 0u);
+}
+
 // Reads one packet whose bytes arrive in two parts, split at every position, and counts
 // the reads the transport made: it must see both parts (two writes on loopback are
 // often read together, so the test writes the second part only after the transport has

@@ -71,6 +71,10 @@ PlcPoller::PlcPoller(asio::io_context& io, const Plc& plc, double phase, PollerE
             gs->item_offsets.push_back(std::move(offsets));
             gs->answer_sizes.push_back(answer);
         }
+        for (const auto& t : g.tags)
+            gs->plain_words.push_back(t.flag || t.type == TagType::bits || t.type == TagType::string
+                                          ? std::uint8_t{0}
+                                          : static_cast<std::uint8_t>(t.words));
         gs->samples.resize(g.tags.size());
         gs->published.resize(g.tags.size());
         gs->have_published.assign(g.tags.size(), false);
@@ -289,7 +293,13 @@ void PlcPoller::complete(Request& r, const ResponseView* response, std::error_co
             continue;
         }
         const auto& slot = gs.plan.slots[i];
-        if (f.kind == PlannedFrame::Kind::read)
+        if (const auto n = gs.plain_words[i]; n > 0 && f.kind == PlannedFrame::Kind::read) {
+            // decode_words() without reading the tag's configuration.
+            s.error = {};
+            const auto* word = response->data.data() + 2 * std::size_t{slot.offset};
+            for (std::size_t k = 0; k < n; ++k, word += 2)
+                s.value.words[k] = static_cast<std::uint16_t>((word[0] << 8) | word[1]);
+        } else if (f.kind == PlannedFrame::Kind::read)
             decode_words(gs.cfg.tags[i], response->data, slot.offset, s);
         else
             decode_items(gs.cfg.tags[i], response->data, gs.item_offsets[r.frame].data(),
@@ -310,13 +320,16 @@ void PlcPoller::finish_group(std::size_t g) {
         gs.need_full = false;
         gs.last_full = now;
     }
-    for (std::size_t i = 0; i < gs.samples.size(); ++i) {
-        TagSample& s = gs.samples[i];
-        s.changed =
-            !gs.have_published[i] || changed(gs.cfg.tags[i], gs.cfg.deadband, s, gs.published[i]);
-        if (s.changed || full) {
-            gs.published[i] = s;
-            gs.have_published[i] = true;
+    // `always` publishes every tag of every cycle: nothing is compared, nothing kept.
+    if (gs.cfg.publish != Publish::always) {
+        for (std::size_t i = 0; i < gs.samples.size(); ++i) {
+            TagSample& s = gs.samples[i];
+            s.changed = !gs.have_published[i] ||
+                        changed(gs.cfg.tags[i], gs.cfg.deadband, s, gs.published[i]);
+            if (s.changed || full) {
+                gs.published[i] = s;
+                gs.have_published[i] = true;
+            }
         }
     }
     GroupSample sample{&plc_, &gs.cfg, gs.samples, now_ms(), full};

@@ -20,6 +20,9 @@ struct PlcPoller::GroupState {
     std::vector<CommandCode> commands;                     // 01 01 or 01 04, per frame
     std::vector<std::vector<std::uint16_t>> item_offsets;  // 01 04: byte offset of each value
     std::vector<std::size_t> answer_sizes;                 // expected response data bytes
+    // Per tag: its words when its value is the words as read (not bits, flag or string),
+    // else 0 (decode_words() then).
+    std::vector<std::uint8_t> plain_words;
     std::vector<TagSample> samples;
     std::vector<TagSample> published;
     std::vector<bool> have_published;
