@@ -3,6 +3,7 @@
 // loader is not on any hot path and this keeps every check one line.
 #include "bridge/config.hpp"
 #include "bridge/config_loader.hpp"
+#include "config/text_file.hpp"
 
 #include <unistd.h>
 
@@ -281,11 +282,9 @@ tl::expected<BridgeConfig, std::string> parse_config(const std::string& text,
 
 tl::expected<BridgeConfig, std::string> load_config(const std::string& path,
                                                     const std::string& instance) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return tl::unexpected(fmt::format("{}: cannot read the file", path));
-    std::ostringstream text;
-    text << in.rdbuf();
-    return parse_config(text.str(), path, instance);
+    const auto text = config::read_text_file(path);
+    if (!text) return tl::unexpected(text.error());
+    return parse_config(*text, path, instance);
 }
 
 }  // namespace fins::bridge

@@ -15,6 +15,7 @@
 #include <toml++/toml.h>
 
 #include "config/schema.hpp"
+#include "config/text_file.hpp"
 #include "fins/values.hpp"
 #include "finsd/config_plant.hpp"
 #include "finsd/config_values.hpp"
@@ -317,11 +318,9 @@ Expected<void> load_config_text(std::string_view text, std::string_view source,
 }
 
 Expected<void> load_config_file(const std::filesystem::path& file, Settings& settings) {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) return tl::unexpected<Error>(fmt::format("{}: cannot read the file", file.string()));
-    std::ostringstream text;
-    text << in.rdbuf();
-    return load_config_text(text.str(), file.string(), settings);
+    const auto text = config::read_text_file(file);
+    if (!text) return tl::unexpected<Error>(text.error());
+    return load_config_text(*text, file.string(), settings);
 }
 
 }  // namespace fins::finsd

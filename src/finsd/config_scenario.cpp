@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "config/text_file.hpp"
 #include "finsd/config_scenario_loader.hpp"
 #include "finsd/config_values.hpp"
 #include "plc/plc.hpp"
@@ -125,11 +126,8 @@ std::size_t offset_of(std::string_view text, std::size_t line, std::size_t colum
 }  // namespace
 
 std::string ScenarioLoader::read_text(std::string_view file) {
-    std::ifstream in{std::filesystem::path(file), std::ios::binary};
-    if (!in) return {};
-    std::ostringstream text;
-    text << in.rdbuf();
-    return std::move(text).str();
+    auto text = config::read_text_file(std::filesystem::path(file));
+    return text ? std::move(*text) : std::string();
 }
 
 std::string ScenarioLoader::raw(const toml::source_region& r) const {
@@ -154,12 +152,10 @@ std::string ScenarioLoader::raw(const toml::source_region& r) const {
 
 tl::expected<toml::table, std::string> ScenarioLoader::parse_file(
     const std::filesystem::path& file) {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) return Unexpected(fmt::format("{}: cannot read the file", file.string()));
-    std::ostringstream text;
-    text << in.rdbuf();
+    const auto text = config::read_text_file(file);
+    if (!text) return Unexpected(text.error());
     try {
-        return toml::parse(text.str(), file.string());
+        return toml::parse(*text, file.string());
     } catch (const toml::parse_error& e) {
         return Unexpected(fmt::format("{}:{}:{}: {}", file.string(), e.source().begin.line,
                                       e.source().begin.column, e.description()));

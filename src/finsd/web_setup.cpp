@@ -12,6 +12,7 @@
 #include <fmt/core.h>
 #include <spdlog/spdlog.h>
 
+#include "config/text_file.hpp"
 #include "server/metrics/metrics.hpp"
 #include "server/routing/plant.hpp"
 #include "server/routing/router.hpp"
@@ -25,13 +26,15 @@ using Json = nlohmann::json;
 
 // The token: the file's first line, without surrounding white space.
 std::optional<std::string> read_token(const std::filesystem::path& file, std::string& why) {
-    std::ifstream in(file);
-    if (!in) {
-        why = fmt::format("--http-token-file {}: cannot read it", file.string());
+    // A token is a line; 64 KiB bounds what a wrong path (/dev/zero) can make finsd read.
+    const auto text = config::read_text_file(file, 64 * 1024);
+    if (!text) {
+        why = fmt::format(
+            "--http-token-file {}: cannot read it{}", file.string(),
+            text.error().find("larger than") != std::string::npos ? ": larger than 64 KiB" : "");
         return std::nullopt;
     }
-    std::string line;
-    std::getline(in, line);
+    const std::string line = text->substr(0, text->find('\n'));
     const auto first = line.find_first_not_of(" \t\r\n");
     const auto last = line.find_last_not_of(" \t\r\n");
     if (first == std::string::npos) {

@@ -205,6 +205,28 @@ TEST(FinsdConfig, ConfigErrorsExit2NamingKeyAndLine) {
     EXPECT_NE(flag.result().err.find("--mode"), std::string::npos);
 }
 
+// A wrong path must end in a message, not in a finsd reading until memory runs out:
+// /dev/zero never ends, so without the bound this test would not end either.
+TEST(FinsdConfig, AConfigurationThatNeverEndsIsRefusedAtItsBound) {
+    Finsd zero({"--config", "/dev/zero"});
+    ASSERT_FALSE(zero.started());
+    EXPECT_EQ(zero.result().exit_code, 2);
+    EXPECT_NE(zero.result().err.find("/dev/zero: larger than 16 MiB: not a configuration file"),
+              std::string::npos)
+        << zero.result().err;
+    Finsd scenario({"--scenario", "/dev/zero"});
+    ASSERT_FALSE(scenario.started());
+    EXPECT_EQ(scenario.result().exit_code, 2);
+    EXPECT_NE(scenario.result().err.find("/dev/zero: larger than 16 MiB"), std::string::npos)
+        << scenario.result().err;
+    Finsd token({"--http", "127.0.0.1:0", "--http-token-file", "/dev/zero"});
+    ASSERT_FALSE(token.started());
+    EXPECT_NE(token.result().err.find("--http-token-file /dev/zero: cannot read it: larger "
+                                      "than 64 KiB"),
+              std::string::npos)
+        << token.result().err;
+}
+
 TEST(FinsdConfig, StateFileErrorsExit3) {
     ScratchDir dir("cfg");
     const std::string data = (dir.path() / "data").string();
