@@ -20,6 +20,7 @@
 #include "finsd/config.hpp"
 #include "finsd/config_scenario.hpp"
 #include "plc/plc.hpp"
+#include "scenario/scenario.hpp"  // compile_scenario returns a unique_ptr to it
 #include "server/control/control_channel_file.hpp"
 
 namespace {
