@@ -40,9 +40,10 @@ Bridge::Bridge(asio::io_context& io, const BridgeConfig& config,
     std::random_device seed;
     std::size_t index = 0;
     for (const auto& p : config_.plcs) {
-        pollers_.emplace(p.name,
-                         std::make_unique<PlcPoller>(io_, p, spread_phase(index++), *this,
-                                                     (std::uint64_t{seed()} << 32) | seed()));
+        auto poller = std::make_unique<PlcPoller>(io_, p, spread_phase(index++), *this,
+                                                  (std::uint64_t{seed()} << 32) | seed());
+        by_plc_.emplace(&p, PlcEntry{poller.get(), nullptr});
+        pollers_.emplace(p.name, std::move(poller));
     }
     ownership_->on_change([this] { reconcile(); });
 }
@@ -132,6 +133,7 @@ void Bridge::reconcile() {
         } else if (!mine && p->running()) {
             p->stop();
             statuses_.erase(name);
+            by_plc_[&p->plc()].status = nullptr;
             format_->released(p->plc(), sink_);
         }
     }
@@ -148,16 +150,18 @@ void Bridge::publish(Message&& m) {
 
 void Bridge::group_done(const GroupSample& sample) {
     format_->values(sample, sink_);
-    const auto st = statuses_.find(sample.plc->name);
-    const auto p = pollers_.find(sample.plc->name);
-    if (st != statuses_.end() && p != pollers_.end())
-        if (auto next = tag_failures_.cycle(sample, st->second, p->second->destination()))
-            status_changed(*next);
+    // By the PLC's address, not its name: this runs for every cycle of every PLC.
+    const auto e = by_plc_.find(sample.plc);
+    if (e == by_plc_.end() || e->second.status == nullptr) return;
+    if (auto next = tag_failures_.cycle(sample, *e->second.status, e->second.poller->destination()))
+        status_changed(*next);
 }
 
 void Bridge::status_changed(const PlcStatus& status) {
-    statuses_[status.plc->name] = status;
-    if (!status.failing) tag_failures_.reset(status.plc->name);
+    auto& kept = statuses_[status.plc->name];
+    kept = status;
+    if (const auto e = by_plc_.find(status.plc); e != by_plc_.end()) e->second.status = &kept;
+    if (!status.failing) tag_failures_.reset(status.plc);
     if (status.online && !status.failing)
         spdlog::info("PLC {} online", status.plc->name);
     else

@@ -147,6 +147,13 @@ class Bridge final : public PollerEvents {
     std::map<std::string, std::unique_ptr<PlcPoller>, std::less<>> pollers_;
     TagFailures tag_failures_;  // PLCs online whose every tag fails
     std::map<std::string, PlcStatus, std::less<>> statuses_;
+    // A cycle's look-up (group_done), by the configured PLC's address: its poller and its
+    // entry in statuses_ (null until its first status, and after it is released).
+    struct PlcEntry {
+        PlcPoller* poller = nullptr;
+        const PlcStatus* status = nullptr;
+    };
+    std::unordered_map<const Plc*, PlcEntry> by_plc_;
     std::map<std::string, IdMemory, std::less<>> ids_;
     std::deque<Held> held_;  // at most max_pending_commands
     std::uint64_t dropped_commands_ = 0;

@@ -13,7 +13,10 @@
 // the bridge's id memory; the response echoes the same JSON value.
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <unordered_map>
+#include <vector>
 
 #include "bridge/payload.hpp"
 
@@ -34,9 +37,20 @@ class JsonPayload final : public PayloadFormat {
                                        bool retained) override;
 
   private:
+    // A group's data topic and its tags' keys, `"name":` after `"name":`, rendered once.
+    struct GroupText {
+        std::string topic;
+        std::string keys;
+        std::vector<std::uint32_t> key_ends;  // tag i's key: [key_ends[i], key_ends[i + 1])
+        std::vector<TagType> types;           // tag i's type
+    };
+    const GroupText& text_of(const GroupSample& s);
+
     std::string prefix_;
     std::string instance_;
     std::string buffer_;  // reused for every data message
+    // By the group's address in the configuration, which outlives the format.
+    std::unordered_map<const Group*, GroupText> groups_;
 };
 
 // The JSON text of an error: {"error":"...","end_code":"1103"}.

@@ -83,8 +83,13 @@ struct Client::Impl final : FrameSink {
     // Before a request is sent on a link with nothing in flight (its end-of-stream or
     // error may have been waiting unread since the last request, e.g. finsd restarted):
     // notices a dead link now, so the request goes out on a fresh connection.
+    // An embedded client's loop keeps running between requests: once the transport has
+    // read its socket to the end since the last send, an error would already have been
+    // read, and the system call is saved (UDP: once per request on an idle link, which is
+    // every poll cycle of the bridge). An own loop stops between calls: always looked at.
     void check_idle_link() {
         if (tracker.in_flight() != 0 || !tracker.is_link_up()) return;
+        if (embedded && transport->read_to_end_since_send()) return;
         if (!transport->peer_gone()) return;
         transport->close();
         tracker.link_down(make_error_code(ClientError::connection_closed));  // nothing to fail

@@ -89,6 +89,11 @@ class Transport {
     // the peer has closed or reset an open connection (an end of stream waits unread).
     // UDP: clears an ICMP error left over from earlier traffic and returns false.
     [[nodiscard]] virtual bool peer_gone() = 0;
+    // True when, since the last frame was sent, the receive side has read the socket to
+    // its end (no datagram, no error left), so nothing an earlier answer left behind can
+    // be waiting: a client whose io_context keeps running (an embedded one) then needs no
+    // peer_gone() before its next request, since its loop reads an error as it comes.
+    [[nodiscard]] virtual bool read_to_end_since_send() const noexcept { return false; }
 
   protected:
     FrameHandler on_frame_;

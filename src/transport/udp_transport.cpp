@@ -161,7 +161,10 @@ bool UdpTransport::drain() {
         const int n =
             ::recvmmsg(socket_.native_handle(), batch.messages.data(), size, MSG_DONTWAIT, nullptr);
         if (n < 0) {
-            if (errno == EAGAIN || errno == EWOULDBLOCK) return true;
+            if (errno == EAGAIN || errno == EWOULDBLOCK) {
+                read_to_end_ = true;
+                return true;
+            }
             if (!on_receive(last_error(), {})) return false;
             continue;
         }
@@ -170,12 +173,18 @@ bool UdpTransport::drain() {
             const auto* data = static_cast<const std::uint8_t*>(m.msg_hdr.msg_iov->iov_base);
             if (!on_receive({}, Bytes{data, m.msg_len})) return false;
         }
-        if (static_cast<unsigned>(n) < size) return true;
+        if (static_cast<unsigned>(n) < size) {
+            // Fewer than asked for: the queue was empty (an error after the datagrams
+            // would stay pending and wake the reactor again).
+            read_to_end_ = true;
+            return true;
+        }
     }
     return true;
 }
 
 void UdpTransport::flush() {
+    if (!held_sizes_.empty()) read_to_end_ = false;
     constexpr std::size_t most = 32;
     std::array<mmsghdr, most> messages;
     std::array<iovec, most> vectors;
@@ -270,6 +279,7 @@ bool UdpTransport::peer_gone() {
 
 void UdpTransport::send(Bytes frame) {
     if (state_ != State::open) return;
+    read_to_end_ = false;
     if (holding_ && !writing_ && queue_.empty()) {
         held_.insert(held_.end(), frame.begin(), frame.end());
         held_sizes_.push_back(frame.size());
@@ -302,6 +312,7 @@ void UdpTransport::write_next() {
 
 void UdpTransport::close() {
     close_connection();
+    read_to_end_ = false;
     holding_ = false;
     held_.clear();
     held_sizes_.clear();

@@ -48,6 +48,7 @@ class UdpTransport final : public SocketTransport<asio::ip::udp> {
     void close() override;
 
     [[nodiscard]] bool peer_gone() override;
+    [[nodiscard]] bool read_to_end_since_send() const noexcept override { return read_to_end_; }
 
   private:
     void connect_first(const asio::ip::udp::resolver::results_type& results);
@@ -68,6 +69,7 @@ class UdpTransport final : public SocketTransport<asio::ip::udp> {
     bool holding_ = false;                 // inside a drain: send() holds frames
     std::vector<std::uint8_t> held_;       // frames held, back to back
     std::vector<std::size_t> held_sizes_;  // their sizes
+    bool read_to_end_ = false;             // read_to_end_since_send(): Linux's drain only
 };
 
 // What a receive error on a connected UDP socket means.

@@ -170,6 +170,53 @@ TEST(UdpTransport, RequestsSentByCompletionsDuringADrainAllGoOut) {
     EXPECT_EQ((*client)->stats().timed_out, 0u);
 }
 
+#ifdef __linux__  // the drain (recvmmsg) is Linux's; elsewhere the flag stays false
+// read_to_end_since_send() lets an embedded client skip its SO_ERROR read before a request
+// (client_impl.hpp, check_idle_link): it may be true only once the socket was read to its
+// end after the last send, answers and ICMP errors included.
+TEST(UdpTransport, ReadToEndOnlyAfterTheLastSendWasAnsweredAndRead) {
+    asio::io_context io;
+    asio::ip::udp::socket peer(io, {asio::ip::make_address("127.0.0.1"), 0});
+    transport::TransportOptions options;
+    options.port = peer.local_endpoint().port();
+    transport::UdpTransport link(io, options);
+    std::size_t frames = 0, refused = 0;
+    link.set_frame_handler([&frames](Bytes) { ++frames; });
+    link.set_error_handler([&refused](std::error_code ec) {
+        if (ec == make_error_code(asio::error::connection_refused)) ++refused;
+    });
+    std::optional<Result<transport::LinkInfo>> opened;
+    link.async_open([&opened](Result<transport::LinkInfo> r) { opened = r; });
+    for (int i = 0; i < 500 && !opened; ++i)
+        io.run_one_for(10ms);
+    ASSERT_TRUE(opened && *opened);
+    EXPECT_FALSE(link.read_to_end_since_send()) << "nothing read yet";
+
+    const std::array<std::uint8_t, 12> frame{0x80, 0, 2, 0, 1, 0, 0, 1, 0, 7, 1, 1};
+    link.send(Bytes{frame.data(), frame.size()});
+    EXPECT_FALSE(link.read_to_end_since_send()) << "sent, its answer not read";
+    std::array<std::uint8_t, 64> in{};
+    asio::ip::udp::endpoint from;
+    ASSERT_EQ(peer.receive_from(asio::buffer(in), from), frame.size());
+    peer.send_to(asio::buffer(frame), from);
+    for (int i = 0; i < 500 && frames == 0; ++i)
+        io.run_one_for(10ms);
+    ASSERT_EQ(frames, 1u);
+    EXPECT_TRUE(link.read_to_end_since_send()) << "answered and read to the end";
+
+    // Nothing listens any more: the next send's ICMP error must be read before it is true.
+    peer.close();
+    link.send(Bytes{frame.data(), frame.size()});
+    EXPECT_FALSE(link.read_to_end_since_send());
+    for (int i = 0; i < 500 && refused == 0; ++i)
+        io.run_one_for(10ms);
+    ASSERT_EQ(refused, 1u);
+    EXPECT_TRUE(link.read_to_end_since_send()) << "the error was read, nothing is left";
+    link.close();
+    EXPECT_FALSE(link.read_to_end_since_send());
+}
+#endif
+
 // Reads one packet whose bytes arrive in two parts, split at every position, and counts
 // the reads the transport made: it must see both parts (two writes on loopback are
 // often read together, so the test writes the second part only after the transport has

@@ -15,21 +15,29 @@ std::optional<PlcStatus> TagFailures::cycle(const GroupSample& sample, const Plc
     while (g < groups.size() && &groups[g] != sample.group)
         ++g;
     if (g == groups.size()) return std::nullopt;
-    auto& cycles = plcs_[sample.plc->name];
-    cycles.groups.resize(groups.size(), Outcome::unknown);
     const auto end_code = [](const TagSample& t) {
         return t.error && t.error.category() == end_code_category();
     };
     const bool all_failed =
         !sample.tags.empty() && std::all_of(sample.tags.begin(), sample.tags.end(), end_code);
-    if (all_failed)
-        cycles.first = sample.tags.front().error;
-    else if (std::any_of(sample.tags.begin(), sample.tags.end(),
+    auto found = plcs_.find(sample.plc);
+    if (!all_failed) {
+        if (std::none_of(sample.tags.begin(), sample.tags.end(),
                          [](const TagSample& t) { return !t.error; }))
-        cycles.groups[g] = Outcome::some_value;
-    else
-        return std::nullopt;  // timeouts, or no tag: going offline says why
-    if (all_failed) cycles.groups[g] = Outcome::all_end_codes;
+            return std::nullopt;  // timeouts, or no tag: going offline says why
+        // A value: not failing. Nothing to remember unless an earlier cycle failed.
+        if (found == plcs_.end())
+            return current.failing ? std::optional<PlcStatus>(
+                                         PlcStatus{sample.plc, true, "", sample.ts_ms, false})
+                                   : std::nullopt;
+        found->second.groups[g] = Outcome::some_value;
+    } else {
+        if (found == plcs_.end()) found = plcs_.emplace(sample.plc, PlcCycles{}).first;
+        found->second.groups.resize(groups.size(), Outcome::unknown);
+        found->second.first = sample.tags.front().error;
+        found->second.groups[g] = Outcome::all_end_codes;
+    }
+    const auto& cycles = found->second;
     const bool failing = std::all_of(cycles.groups.begin(), cycles.groups.end(),
                                      [](Outcome o) { return o == Outcome::all_end_codes; });
     if (failing == current.failing) return std::nullopt;

@@ -9,10 +9,10 @@
 #pragma once
 
 #include <cstdint>
-#include <map>
 #include <optional>
 #include <string>
 #include <system_error>
+#include <unordered_map>
 #include <vector>
 
 #include "bridge/payload.hpp"
@@ -28,7 +28,7 @@ class TagFailures {
     std::optional<PlcStatus> cycle(const GroupSample& sample, const PlcStatus& current,
                                    NodeAddress destination);
     // Forgets the PLC's cycles (a status of the poller: online, offline).
-    void reset(const std::string& plc) { plcs_.erase(plc); }
+    void reset(const Plc* plc) { plcs_.erase(plc); }
 
   private:
     enum class Outcome : std::uint8_t { unknown, some_value, all_end_codes };
@@ -36,7 +36,9 @@ class TagFailures {
         std::vector<Outcome> groups;
         std::error_code first;  // an end code of the last failed cycle
     };
-    std::map<std::string, PlcCycles, std::less<>> plcs_;
+    // Only PLCs with a group whose last cycle failed with end codes have an entry: a PLC
+    // whose cycles bring values costs one look-up by address a cycle, nothing else.
+    std::unordered_map<const Plc*, PlcCycles> plcs_;
 };
 
 // The text of a failing status: the end code, the node the frames go to and why, and

@@ -44,6 +44,24 @@ TEST(PollerTickGrid, SkipsAndCountsTheGridPointsItWasTooLateFor) {
     EXPECT_EQ(grid.next(), t0 + 600ms);
 }
 
+// Aligned to 1 ms: the first tick is the next whole millisecond of the clock at or after
+// start + phase x interval, every tick stays on whole milliseconds, and two grids started
+// a few microseconds apart with the same phase tick at the same time point (one wake-up).
+TEST(PollerTickGrid, AlignedGridsStartedApartShareTheirTicks) {
+    const auto start = t0 + 123456ns;
+    TickGrid a(start, 100ms, 0.25, 1ms);
+    EXPECT_EQ(a.next(), t0 + 26ms) << "25.123456 ms rounded up";
+    EXPECT_EQ(a.next().time_since_epoch() % 1ms, Clock::duration::zero());
+    TickGrid b(start + 37us, 100ms, 0.25, 1ms);
+    EXPECT_EQ(b.next(), a.next());
+    TickGrid exact(t0, 100ms, 0.25, 1ms);
+    EXPECT_EQ(exact.next(), t0 + 25ms) << "already whole: not moved";
+    for (int k = 0; k < 10; ++k) {
+        EXPECT_EQ(a.advance(a.next() + 3ms), 0u);
+        EXPECT_EQ(a.next(), t0 + 26ms + (k + 1) * 100ms);
+    }
+}
+
 TEST(PollerPhases, SpreadEvenlyOverTheIntervalForAnyCount) {
     for (std::size_t n : {2u, 3u, 10u, 100u, 1000u}) {
         std::vector<double> phases;
