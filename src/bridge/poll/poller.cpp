@@ -100,8 +100,8 @@ void PlcPoller::start() {
     const auto now = PollClock::now();
     for (std::size_t g = 0; g < groups_.size(); ++g) {
         auto& gs = *groups_[g];
-        gs.grid = TickGrid(now, std::chrono::duration_cast<PollClock::duration>(gs.cfg.interval),
-                           phase_, tick_alignment);
+        const auto interval = std::chrono::duration_cast<PollClock::duration>(gs.cfg.interval);
+        gs.grid = TickGrid(now, interval, phase_, tick_alignment(interval));
         gs.need_full = true;
         gs.in_cycle = false;
         schedule(g);

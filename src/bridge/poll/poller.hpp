@@ -48,9 +48,6 @@
 namespace fins::bridge {
 
 inline constexpr std::size_t max_pending_writes = 16;  // per PLC; more are refused at once
-// Every group's ticks fall on whole milliseconds of the clock (TickGrid's alignment): the
-// groups whose phases fall in the same millisecond share one wake-up of the loop.
-inline constexpr std::chrono::milliseconds tick_alignment{1};
 
 struct PendingWrite;  // poller_parts.hpp: a write command and its read back
 

@@ -62,6 +62,15 @@ TEST(PollerTickGrid, AlignedGridsStartedApartShareTheirTicks) {
     }
 }
 
+// 5 ms, or a twentieth of a shorter interval: every interval keeps 20 time points.
+TEST(PollerTickGrid, AlignmentIsFiveMillisecondsOrATwentiethOfTheInterval) {
+    EXPECT_EQ(tick_alignment(100ms), 5ms);
+    EXPECT_EQ(tick_alignment(60s), 5ms);
+    EXPECT_EQ(tick_alignment(100ms) * 20, 100ms);
+    EXPECT_EQ(tick_alignment(10ms), 500us);
+    EXPECT_EQ(tick_alignment(1ms), 50us);
+}
+
 TEST(PollerPhases, SpreadEvenlyOverTheIntervalForAnyCount) {
     for (std::size_t n : {2u, 3u, 10u, 100u, 1000u}) {
         std::vector<double> phases;
