@@ -20,72 +20,19 @@
 
 namespace fins::finsd {
 
-namespace {
-
-// The profile a foreign state file was written for, to name it in the refusal: the
-// header holds the profile name NUL-terminated (plc/storage/storage.cpp), so look for
-// each known name there rather than depend on the header's offsets.
-std::string state_file_profile(const std::filesystem::path& dir) {
-    std::ifstream f(dir / "finsd.state", std::ios::binary);
-    std::string head(4096, '\0');
-    f.read(head.data(), static_cast<std::streamsize>(head.size()));
-    head.resize(static_cast<std::size_t>(f.gcount()));
-    for (const auto& p : plc::profiles())
-        if (head.find(std::string(1, '\0') + p.name + std::string(1, '\0')) != std::string::npos)
-            return p.name;
-    return "unknown";
-}
-
-// The PLC on its state file (or the heap) into `plc` (plc::open_plc); -1, or the exit
-// code. A state file refused for its content stops finsd unless --reset-state.
-int open_plc(const Settings& s, const plc::Profile& profile, std::unique_ptr<plc::Plc>& plc) {
-    using plc::Storage;
-    auto opened = plc::open_plc(profile, s.data_dir, {s.durability}, s.reset_state);
-    const std::string file =
-        s.data_dir ? (*s.data_dir / "finsd.state").string() : std::string("(heap)");
-    if (!opened) {
-        const std::error_code error = opened.error().error;
-        if (opened.error().setting_aside)
-            return report_failure(3, file + ": cannot move it aside: " + error.message());
-        const bool refused = Storage::is_refusal(error);
-        std::string why = error.message();
-        if (error == plc::state_file::make_error(plc::state_file::Error::other_profile))
-            why += fmt::format(": the file is for profile '{}', this finsd runs '{}'",
-                               state_file_profile(*s.data_dir), profile.name);
-        return report_failure(3, file + ": " + why +
-                                     (refused ? "; finsd never replaces it by itself: start "
-                                                "with --reset-state to move it aside and "
-                                                "begin with empty retained memory"
-                                              : ""));
-    }
-    // Warnings about the operator's data go to stderr with the refusals, whatever the log
-    // level (stdout's first line stays "listening <port>" at warn).
-    if (opened->moved_aside)
-        std::fprintf(stderr,
-                     "finsd: warning: %s: %s; --reset-state moved it to %s: retained memory "
-                     "starts empty\n",
-                     file.c_str(), opened->refusal.message().c_str(),
-                     opened->moved_aside->string().c_str());
-    plc = std::move(opened->plc);
-    return -1;
-}
-
-}  // namespace
+namespace {}  // namespace
 
 int open_single(asio::io_context& io, const Settings& s, Served& served) {
     plc::Profile profile = *plc::find_profile(s.profile);
     if (s.dip_write_protection) profile.dip_switch |= plc::dip_pin1;
     if (auto r = mount_serial_units(s.serial, profile); !r) return report_failure(2, r.error());
 
-    if (const int rc = open_plc(s, profile, served.single_plc); rc >= 0) return rc;
+    // A state file refused, moved aside or not stopped cleanly: said as for a plant's CPU Unit.
+    auto opened = server::open_cpu_state(profile, s.data_dir, {s.durability}, s.reset_state, "");
+    if (!opened) return report_failure(3, opened.error().message);
+    served.single_plc = std::move(*opened);
     plc::Plc& plc = *served.single_plc;
     const bool restored = plc.storage().restored();
-    if (s.data_dir && restored && !plc.storage().checksums_verified())
-        std::fprintf(stderr,
-                     "finsd: warning: %s was not stopped cleanly (SIGKILL, crash or power "
-                     "loss; or it was just converted from an earlier format): its header and "
-                     "section table are intact; its data has no valid checksums to check\n",
-                     plc.storage().path().string().c_str());
     if (s.data_dir)
         spdlog::info("finsd: {} state file {}", restored ? "restored" : "new",
                      plc.storage().path().string());

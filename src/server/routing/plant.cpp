@@ -5,6 +5,7 @@
 #include <sys/resource.h>
 #endif
 
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <set>
@@ -172,45 +173,7 @@ struct Plant::Impl {
     std::vector<Server*> by_port;  // the router's port index -> its server
 };
 
-namespace {
-
-// A CPU Unit on its state file (plc::open_plc), each outcome in a line naming the CPU
-// Unit and the file, as finsd --reset-state words them for a single node.
-Result<std::unique_ptr<plc::Plc>> open_cpu(const PlantCpuConfig& c, const plc::Profile& profile,
-                                           bool reset_state) {
-    auto opened = plc::open_plc(profile, c.data_dir, {c.durability}, reset_state);
-    const std::string file =
-        c.data_dir ? (*c.data_dir / "finsd.state").string() : std::string("(heap)");
-    if (!opened) {
-        const boost::system::error_code error = opened.error().error;
-        if (opened.error().setting_aside)
-            spdlog::error("finsd: plc \"{}\": {}: cannot move it aside: {}", c.name, file,
-                          error.message());
-        else
-            spdlog::error("finsd: plc \"{}\": {}: {}{}", c.name, file, error.message(),
-                          plc::Storage::is_refusal(error)
-                              ? "; finsd never replaces it by itself: start with "
-                                "--reset-state to move it aside and begin with empty "
-                                "retained memory"
-                              : "");
-        return Unexpected(error);
-    }
-    if (opened->moved_aside)
-        spdlog::warn(
-            "finsd: plc \"{}\": {}: {}; --reset-state moved it to {}: retained memory "
-            "starts empty",
-            c.name, file, opened->refusal.message(), opened->moved_aside->string());
-    auto& storage = opened->plc->storage();
-    if (storage.restored() && !storage.checksums_verified())
-        spdlog::warn(
-            "finsd: plc \"{}\": {} was not stopped cleanly (SIGKILL, crash or power "
-            "loss): its header and section table are intact; its data has no valid "
-            "checksums to check",
-            c.name, storage.path().string());
-    return std::move(opened->plc);
-}
-
-}  // namespace
+namespace {}  // namespace
 
 std::size_t plant_descriptors(const PlantConfig& config) noexcept {
     std::size_t n = 0;
@@ -265,8 +228,13 @@ Result<std::unique_ptr<Plant>> Plant::start(asio::io_context& io, const PlantCon
     for (const auto& c : config.cpus) {
         plc::Profile profile = *plc::find_profile(c.profile);
         if (c.units) profile.units = *c.units;
-        auto plc = open_cpu(c, profile, config.reset_state);
-        if (!plc) return Unexpected(plc.error());
+        auto plc = open_cpu_state(profile, c.data_dir, {c.durability}, config.reset_state,
+                                  fmt::format("plc \"{}\": ", c.name));
+        if (!plc) {
+            // On stderr whatever the log level, as a single node's refusal.
+            std::fprintf(stderr, "finsd: %s\n", plc.error().message.c_str());
+            return Unexpected(plc.error().error);
+        }
         (*plc)->change_mode(c.mode, std::chrono::system_clock::now());
         if (const auto refused = set_up_file_memory(**plc, c.files, c.data_dir,
                                                     fmt::format("plc \"{}\": ", c.name))) {

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include <boost/asio/io_context.hpp>
+#include <tl/expected.hpp>
 
 #include "fins/error.hpp"
 #include "plc/plc.hpp"
@@ -78,6 +79,23 @@ struct FileMemoryRefusal {
 std::optional<FileMemoryRefusal> set_up_file_memory(
     plc::Plc& plc, const FileMemoryOptions& options,
     const std::optional<std::filesystem::path>& data_dir, std::string_view who);
+
+// A CPU Unit's PLC on its state file (plc::open_plc) or the heap: the one opening of
+// finsd's single node and of each plant CPU Unit, so both say the same. Every line about
+// the operator's data goes to stderr whatever the log level (stdout's first line stays
+// "listening <port>"), each starting with `who` ("" or "plc \"A\": "): a file moved aside
+// by --reset-state, a file not stopped cleanly. A refusal is returned (finsd exits 3 with
+// it): the file, why, the profile a file of another one was written for, and the way out.
+struct CpuStateRefusal {
+    std::error_code error;
+    std::string message;
+};
+tl::expected<std::unique_ptr<plc::Plc>, CpuStateRefusal> open_cpu_state(
+    const plc::Profile& profile, const std::optional<std::filesystem::path>& data_dir,
+    plc::StorageOptions options, bool reset_state, std::string_view who);
+
+// The profile whose name a state file's header holds ("unknown": none known).
+std::string state_file_profile(const std::filesystem::path& file);
 
 struct PlantCpuConfig {
     std::string name;

@@ -94,5 +94,50 @@ data_dir = ")" + data.string() + R"("
     EXPECT_GT(fs::file_size(file), 4096u);
 }
 
+// What a plant says about a CPU Unit's state file reaches the operator at every log level,
+// as a single node's does (they went through the log and vanished at --log-level error or
+// off), and a file of another profile names it (W342's CPU Units differ in areas and sizes).
+TEST(PlantStateFile, SaidAtEveryLogLevelAndAnotherProfilesFileIsNamed) {
+    ScratchDir dir("plant-state-quiet");
+    const fs::path data = dir.path() / "unit";
+    const fs::path file = data / "finsd.state";
+    const auto plant = [&](const std::string& profile) {
+        return dir.write(profile + ".toml", R"(
+[[plc]]
+name = "unit"
+profile = ")" + profile + R"("
+data_dir = ")" + data.string() + R"("
+  [[plc.ethernet]]
+  network = 1
+  bind = "127.0.63.2"  # its own: the test above binds .1
+  port = 9611
+)");
+    };
+    const auto cs1h = plant("cs1h");
+    FinsdOptions quiet;
+    quiet.log_level = "error";
+    {
+        Finsd killed({"--config", cs1h}, quiet);
+        ASSERT_TRUE(killed.started()) << killed.result().err;
+        EXPECT_EQ(killed.stop(SIGKILL).exit_code, 128 + SIGKILL);
+        Finsd d({"--config", cs1h}, quiet);
+        ASSERT_TRUE(d.started()) << d.result().err;
+        const auto stopped = d.stop();
+        EXPECT_EQ(stopped.exit_code, 0);
+        EXPECT_TRUE(has(stopped.err, "finsd: warning: plc \"unit\": " + file.string() +
+                                         " was not stopped cleanly"))
+            << stopped.err;
+    }
+    FinsdOptions off;
+    off.log_level = "off";
+    Finsd other({"--config", plant("cj2h")}, off);
+    ASSERT_FALSE(other.started());
+    EXPECT_EQ(other.result().exit_code, 3);
+    const std::string& err = other.result().err;
+    EXPECT_TRUE(has(err, "plc \"unit\": " + file.string() + ": ")) << err;
+    EXPECT_TRUE(has(err, "the file is for profile 'cs1h', this CPU Unit runs 'cj2h'")) << err;
+    EXPECT_TRUE(has(err, "--reset-state")) << err;
+}
+
 }  // namespace
 }  // namespace fins::test
