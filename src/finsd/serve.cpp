@@ -27,7 +27,7 @@ namespace {
 
 // The control channel's and the web front's view of each CPU Unit (`finsd ctl --plc
 // NAME|NET.NODE`; the first without --plc). Network instructions leave through its first
-// unit; its [[schedule]]'s counters are listed when they run on one unit.
+// unit; its [[schedule]]'s counters are listed whichever units run them.
 std::vector<server::ControlTarget> control_targets(const Served& served,
                                                    const CpuUnitExtras& extras) {
     std::vector<server::ControlTarget> targets(served.cpus.size());
@@ -37,8 +37,7 @@ std::vector<server::ControlTarget> control_targets(const Served& served,
         t.plc = cpu.plc;
         t.name = cpu.name;
         t.instructions = &cpu.units.front()->instructions();
-        if (i < extras.schedules.size() && extras.schedules[i].size() == 1)
-            t.schedule = extras.schedules[i].front().get();
+        if (i < extras.schedule_entries.size()) t.schedule = extras.schedule_entries[i];
         if (i < extras.scenarios.size()) t.scenario = extras.scenarios[i].get();
         for (const auto* unit : cpu.units)
             t.addresses.emplace_back(unit->address().network, unit->address().node);
@@ -125,11 +124,11 @@ int serve(const Settings& s) {
             return rc;
         }
     auto targets = control_targets(served, extras);
-    // --http (docs/web.md): every CPU Unit, each with its first unit's server.
-    std::vector<const server::Server*> first_units;
+    // --http (docs/web.md): every CPU Unit, each with all its Ethernet units' servers.
+    std::vector<UnitServers> units;
     for (const auto& cpu : served.cpus)
-        first_units.push_back(cpu.units.front());
-    auto web = start_web(io, s.http, targets, first_units, served.plant.get());
+        units.emplace_back(cpu.units.begin(), cpu.units.end());
+    auto web = start_web(io, s.http, targets, std::move(units), served.plant.get());
     if (web.exit_code >= 0) {
         extras.stop();
         return report_failure(web.exit_code, web.error);

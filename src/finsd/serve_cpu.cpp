@@ -114,17 +114,27 @@ int set_up_cpu(asio::io_context& io, const Served& served, std::size_t i, CpuUni
 
     // [[schedule]]: each scheduled instruction leaves through the unit its destination
     // network is reached by (the CPU Unit's routing tables; a single node's one unit).
+    // Each entry's unit and place there, so that `finsd ctl instructions` lists every
+    // entry's counters in the configuration's order, whichever unit runs it.
     std::vector<std::vector<server::ScheduledInstruction>> by_unit(cpu.units.size());
-    for (const auto& e : *setup.schedule)
-        by_unit[server::unit_toward(*cpu.config, e.scheduled.request.destination.network)]
-            .push_back(e.scheduled);
+    std::vector<std::pair<std::size_t, std::size_t>> placed;
+    for (const auto& e : *setup.schedule) {
+        const auto k = server::unit_toward(*cpu.config, e.scheduled.request.destination.network);
+        placed.emplace_back(k, by_unit[k].size());
+        by_unit[k].push_back(e.scheduled);
+    }
     extras.schedules.emplace_back();
+    std::vector<const server::InstructionSchedule*> of_unit(cpu.units.size(), nullptr);
     for (std::size_t k = 0; k < by_unit.size(); ++k) {
         if (by_unit[k].empty()) continue;
         extras.schedules.back().push_back(std::make_unique<server::InstructionSchedule>(
             io.get_executor(), cpu.units[k]->instructions(), std::move(by_unit[k])));
         extras.schedules.back().back()->start();
+        of_unit[k] = extras.schedules.back().back().get();
     }
+    auto& entries = extras.schedule_entries.emplace_back();
+    for (const auto& [k, index] : placed)
+        entries.push_back({of_unit[k], index});
     return -1;
 }
 

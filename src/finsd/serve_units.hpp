@@ -17,6 +17,7 @@
 #include "finsd/config.hpp"
 #include "finsd/serial_ports.hpp"
 #include "plc/plc.hpp"
+#include "server/control/control.hpp"
 #include "server/instructions/instruction_schedule.hpp"
 #include "server/routing/plant.hpp"
 #include "server/scenario/scenario_runner.hpp"
@@ -75,6 +76,8 @@ struct CpuUnitExtras {
     // Per CPU Unit, in the order of Served::cpus: its [[schedule]] runs on each unit that
     // sends some of it (a single node: its one unit); its scenario, or null.
     std::vector<std::vector<std::unique_ptr<server::InstructionSchedule>>> schedules;
+    // Per CPU Unit: its [[schedule]] entries in the configuration's order (ControlTarget).
+    std::vector<std::vector<server::ScheduleEntry>> schedule_entries;
     std::vector<std::unique_ptr<server::ScenarioRunner>> scenarios;
 
     void stop();

@@ -1,6 +1,7 @@
 // finsd's HTTP front at start-up (contract in web_setup.hpp).
 #include "finsd/web_setup.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <ctime>
 #include <fstream>
@@ -56,8 +57,8 @@ std::string utc_text(std::chrono::system_clock::time_point t) {
 }  // namespace
 
 WebStart start_web(boost::asio::io_context& io, const HttpSettings& http,
-                   std::vector<server::ControlTarget> targets,
-                   std::vector<const server::Server*> servers, server::Plant* plant) {
+                   std::vector<server::ControlTarget> targets, std::vector<UnitServers> units,
+                   server::Plant* plant) {
     WebStart out;
     if (!http.listen) return out;
     const auto listen = parse_http_listen(*http.listen);
@@ -85,16 +86,14 @@ WebStart start_web(boost::asio::io_context& io, const HttpSettings& http,
         context.options.token = *token;
     }
     context.targets = std::move(targets);
-    // Each CPU Unit's server, found by its Plc in constant time: a plant's listing asks
-    // this once per unit (a linear search made 10,000 units 10^8 comparisons).
-    auto server_by_plc =
-        std::make_shared<std::unordered_map<const plc::Plc*, const server::Server*>>();
-    for (std::size_t i = 0; i < context.targets.size() && i < servers.size(); ++i)
-        server_by_plc->emplace(context.targets[i].plc, servers[i]);
-    const auto server_of =
-        [server_by_plc](const server::ControlTarget& t) -> const server::Server* {
-        const auto found = server_by_plc->find(t.plc);
-        return found == server_by_plc->end() ? nullptr : found->second;
+    // Each CPU Unit's Ethernet units, found by its Plc in constant time: a plant's listing
+    // asks this once per CPU Unit (a linear search made 10,000 units 10^8 comparisons).
+    auto units_by_plc = std::make_shared<std::unordered_map<const plc::Plc*, UnitServers>>();
+    for (std::size_t i = 0; i < context.targets.size() && i < units.size(); ++i)
+        units_by_plc->emplace(context.targets[i].plc, units[i]);
+    const auto units_of = [units_by_plc](const server::ControlTarget& t) -> const UnitServers* {
+        const auto found = units_by_plc->find(t.plc);
+        return found == units_by_plc->end() || found->second.empty() ? nullptr : &found->second;
     };
     // A plant's relay counts of a CPU Unit by end code: {"0000": passed, "0501": refused}.
     const auto relays_of = [plant](const server::ControlTarget& t) {
@@ -104,45 +103,73 @@ WebStart start_web(boost::asio::io_context& io, const HttpSettings& http,
                 relays[fmt::format("{:04X}", code)] = n;
         return relays;
     };
-    context.network_status = [server_of, relays_of](const server::ControlTarget& t, Json& status) {
+    // Every Ethernet unit's FINS/TCP connections and FINS/UDP peers, each with the network
+    // of the unit it came to; the peers newest first across the units.
+    context.network_status = [units_of, relays_of](const server::ControlTarget& t, Json& status) {
         status["relays"] = relays_of(t);
-        const auto* s = server_of(t);
-        if (s == nullptr) return;
+        const auto* servers = units_of(t);
+        if (servers == nullptr) return;
         Json list = Json::array();
-        for (const auto& c : s->tcp_connection_list()) {
-            Json entry{{"address", c.address},
-                       {"port", c.port},
-                       {"state", c.established ? "established" : "handshake"}};
-            entry["node"] = c.established ? Json(c.node) : Json(nullptr);
-            list.push_back(std::move(entry));
+        std::vector<std::pair<server::UdpPeerInfo, std::uint8_t>> peers;
+        for (const auto* s : *servers) {
+            const auto network = s->address().network;
+            for (const auto& c : s->tcp_connection_list()) {
+                Json entry{{"address", c.address},
+                           {"port", c.port},
+                           {"state", c.established ? "established" : "handshake"},
+                           {"network", network}};
+                entry["node"] = c.established ? Json(c.node) : Json(nullptr);
+                list.push_back(std::move(entry));
+            }
+            for (auto& p : s->udp_peer_list())
+                peers.emplace_back(std::move(p), network);
         }
         status["connections"] = std::move(list);
-        Json peers = Json::array();
-        for (const auto& p : s->udp_peer_list())
-            peers.push_back({{"address", p.address},
-                             {"port", p.port},
-                             {"node", p.node},
-                             {"last_seen", utc_text(p.last_seen)}});
-        status["udp_peers"] = std::move(peers);
+        std::stable_sort(peers.begin(), peers.end(), [](const auto& a, const auto& b) {
+            return a.first.last_seen > b.first.last_seen;
+        });
+        Json peer_list = Json::array();
+        for (const auto& [p, network] : peers)
+            peer_list.push_back({{"address", p.address},
+                                 {"port", p.port},
+                                 {"node", p.node},
+                                 {"network", network},
+                                 {"last_seen", utc_text(p.last_seen)}});
+        status["udp_peers"] = std::move(peer_list);
     };
-    context.describe = [server_of, relays_of](const server::ControlTarget& t, Json& entry) {
+    // The listing: the first unit's ports (what a client of the CPU Unit addresses first),
+    // every unit's ports and address, and the TCP connections of them all.
+    context.describe = [units_of, relays_of](const server::ControlTarget& t, Json& entry) {
         entry["relays"] = relays_of(t);
-        const auto* s = server_of(t);
-        if (s == nullptr) return;
-        entry["udp_port"] = s->udp_port();
-        entry["tcp_port"] = s->tcp_port();
-        entry["tcp_connections"] = s->tcp_connections();
+        const auto* servers = units_of(t);
+        if (servers == nullptr) return;
+        entry["udp_port"] = servers->front()->udp_port();
+        entry["tcp_port"] = servers->front()->tcp_port();
+        std::size_t connections = 0;
+        Json list = Json::array();
+        for (const auto* s : *servers) {
+            const auto a = s->address();
+            list.push_back({{"network", a.network},
+                            {"node", a.node},
+                            {"udp_port", s->udp_port()},
+                            {"tcp_port", s->tcp_port()},
+                            {"tcp_connections", s->tcp_connections()}});
+            connections += s->tcp_connections();
+        }
+        entry["tcp_connections"] = connections;
+        entry["ethernet_units"] = std::move(list);
     };
     // The server the metrics below describe, known once it started (it owns this hook).
     auto web_server = std::make_shared<const web::HttpServer*>(nullptr);
-    context.metrics = [servers, web_server]() {
+    context.metrics = [units, web_server]() {
         using server::metrics::Family;
         Family tcp{"fins_tcp_connections", "FINS/TCP client connections by state", "gauge", {}};
         std::size_t established = 0;
         std::size_t handshake = 0;
-        for (const auto* s : servers)
-            for (const auto& c : s->tcp_connection_list())
-                ++(c.established ? established : handshake);
+        for (const auto& of_cpu : units)
+            for (const auto* s : of_cpu)
+                for (const auto& c : s->tcp_connection_list())
+                    ++(c.established ? established : handshake);
         tcp.samples = {{"state=\"established\"", static_cast<double>(established)},
                        {"state=\"handshake\"", static_cast<double>(handshake)}};
         Family web{"fins_web_connections", "Open HTTP and WebSocket connections", "gauge", {}};

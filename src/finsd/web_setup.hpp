@@ -27,10 +27,12 @@ struct WebStart {
     std::string error;
 };
 
-// `servers[i]` serves `targets[i]` (its first Ethernet unit in a plant); `plant` when
-// there is one (routes and relays).
+// `units[i]` are the Ethernet units of `targets[i]`, in the configuration's order (the
+// listing's udp_port and tcp_port are the first one's; connections, peers and
+// fins_tcp_connections count them all); `plant` when there is one (routes and relays).
+using UnitServers = std::vector<const server::Server*>;
 WebStart start_web(boost::asio::io_context& io, const HttpSettings& http,
-                   std::vector<server::ControlTarget> targets,
-                   std::vector<const server::Server*> servers, server::Plant* plant = nullptr);
+                   std::vector<server::ControlTarget> targets, std::vector<UnitServers> units,
+                   server::Plant* plant = nullptr);
 
 }  // namespace fins::finsd

@@ -10,6 +10,7 @@
 // both transports (a generic stream socket); on the loopback one it first reads the token
 // line (control_channel_file.hpp): a wrong or overlong one closes the connection unanswered.
 #include "server/control/control.hpp"
+#include "server/instructions/instruction_schedule.hpp"
 
 #ifndef _WIN32
 #include <sys/stat.h>
@@ -260,7 +261,8 @@ Result<std::unique_ptr<ControlServer>> ControlServer::start(asio::io_context& io
     ControlTarget target;
     target.plc = &plc;
     target.instructions = instructions;
-    target.schedule = schedule;
+    for (std::size_t i = 0; schedule != nullptr && i < schedule->size(); ++i)
+        target.schedule.push_back({schedule, i});
     return start(io, std::vector<ControlTarget>{std::move(target)}, path);
 }
 

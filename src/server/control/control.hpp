@@ -40,6 +40,13 @@ class NetworkInstructions;
 class InstructionSchedule;
 class ScenarioControl;
 
+// One [[schedule]] entry of a CPU Unit: the schedule that runs it (that of the unit its
+// destination is reached through) and its place there.
+struct ScheduleEntry {
+    const InstructionSchedule* schedule = nullptr;
+    std::size_t index = 0;
+};
+
 // One CPU Unit the channel drives.
 struct ControlTarget {
     plc::Plc* plc = nullptr;
@@ -47,7 +54,8 @@ struct ControlTarget {
     std::vector<std::pair<std::uint8_t, std::uint8_t>> addresses;  // its (network, node)s
     // With an engine, the send / recv / sendcmd verbs run on it.
     NetworkInstructions* instructions = nullptr;
-    const InstructionSchedule* schedule = nullptr;
+    // Its [[schedule]] entries in the configuration's order, whichever unit runs each.
+    std::vector<ScheduleEntry> schedule;
     ScenarioControl* scenario = nullptr;  // its running scenario, if any (control_scenario.hpp)
 };
 

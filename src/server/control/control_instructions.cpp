@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "codec/hex.hpp"
+#include "server/control/control.hpp"
 #include "server/instructions/instruction_schedule.hpp"
 #include "server/instructions/network_instructions.hpp"
 
@@ -95,8 +96,9 @@ Json result_json(InstructionKind kind, const InstructionResult& r) {
 
 }  // namespace
 
-bool handle_instruction_request(NetworkInstructions* engine, const InstructionSchedule* schedule,
-                                const Json& j, const ControlReply& reply) {
+bool handle_instruction_request(NetworkInstructions* engine,
+                                const std::vector<ScheduleEntry>& schedule, const Json& j,
+                                const ControlReply& reply) {
     const std::string cmd = j.at("cmd").get<std::string>();
     const bool status = cmd == "instructions";
     const auto kind = parse_instruction_kind(cmd);
@@ -108,8 +110,8 @@ bool handle_instruction_request(NetworkInstructions* engine, const InstructionSc
     if (status) {
         const auto& c = engine->counters();
         Json entries = Json::array();
-        for (std::size_t i = 0; schedule != nullptr && i < schedule->size(); ++i) {
-            const auto& e = schedule->counters(i);
+        for (const auto& entry : schedule) {
+            const auto& e = entry.schedule->counters(entry.index);
             entries.push_back({{"runs", e.runs},
                                {"done", e.done},
                                {"errors", e.errors},

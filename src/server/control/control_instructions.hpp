@@ -16,6 +16,7 @@
 #pragma once
 
 #include <functional>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -23,12 +24,14 @@ namespace fins::server {
 
 class NetworkInstructions;
 class InstructionSchedule;
+struct ScheduleEntry;
 
 using ControlReply = std::function<void(nlohmann::json)>;
 
 // True when `request` is one of the verbs above; `reply` is then called exactly once
 // (maybe later, on the io_context). False leaves the request to the caller.
-bool handle_instruction_request(NetworkInstructions* engine, const InstructionSchedule* schedule,
+bool handle_instruction_request(NetworkInstructions* engine,
+                                const std::vector<ScheduleEntry>& schedule,
                                 const nlohmann::json& request, const ControlReply& reply);
 
 }  // namespace fins::server

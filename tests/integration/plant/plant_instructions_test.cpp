@@ -98,6 +98,74 @@ TEST(PlantInstructions, W596_3_EachCpuUnitRunsItsOwnSchedule) {
     EXPECT_EQ(b["schedule"].size(), 0u) << b.dump();
 }
 
+// A router's [[plc.schedule]] entries leave through the units their destinations are
+// reached by (one schedule per unit): `finsd ctl --plc NAME instructions` lists every
+// entry, in the configuration's order, whichever unit runs it (it listed none once the
+// entries were spread over two units).
+TEST(PlantInstructions, W596_3_ScheduleSpreadOverTwoUnitsListsEveryEntry) {
+    const FixedPorts fixed_ports;
+    ScratchDir dir("plant-schedule-units");
+    const auto config = dir.write("plant.toml", R"(
+[[plc]]
+name = "router"
+memory = { "D100" = [7, 8] }
+  [[plc.schedule]]
+  every = "50ms"
+  instruction = "send"
+  dest = "2.3.0"
+  local = "D100"
+  remote = "D300"
+  count = 2
+  [[plc.schedule]]
+  every = "50ms"
+  instruction = "send"
+  dest = "1.2.0"
+  local = "D100"
+  remote = "D200"
+  count = 2
+  [[plc.ethernet]]
+  unit = 0
+  network = 1
+  bind = "127.0.71.1"
+  port = 9611
+  [[plc.ethernet]]
+  unit = 1
+  network = 2
+  bind = "127.0.72.1"
+  port = 9611
+[[plc]]
+name = "on-1"
+  [[plc.ethernet]]
+  network = 1
+  bind = "127.0.71.2"
+  port = 9611
+[[plc]]
+name = "on-2"
+  [[plc.ethernet]]
+  network = 2
+  bind = "127.0.72.3"
+  port = 9611
+)");
+    const std::string socket = (dir.path() / "ctl.sock").string();
+    Finsd d({"--config", config, "--control", socket});
+    ASSERT_TRUE(d.started()) << d.result().err;
+    nlohmann::json listed;
+    const auto both_done = [&] {
+        listed = nlohmann::json::parse(ctl(socket, {"--plc", "router", "instructions"}).out,
+                                       nullptr, false);
+        const auto& e = listed["schedule"];
+        return e.is_array() && e.size() == 2 && e[0]["done"].get<int>() >= 1 &&
+               e[1]["done"].get<int>() >= 1;
+    };
+    for (int i = 0; i < 100 && !both_done(); ++i)
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));  // the next period
+    ASSERT_EQ(listed["schedule"].size(), 2u) << listed.dump();
+    EXPECT_GE(listed["schedule"][0]["done"].get<int>(), 1) << listed.dump();
+    EXPECT_GE(listed["schedule"][1]["done"].get<int>(), 1) << listed.dump();
+    EXPECT_EQ(listed["schedule"][0]["errors"], 0) << listed.dump();
+    EXPECT_EQ(listed["schedule"][1]["errors"], 0) << listed.dump();
+}
+
 // Issue 27, W596 1-4: a unit's FINS/TCP connections count its [[plc.remote]] clients, as
 // a single node's count its [[remote]]s: more than max_connections is a start error.
 TEST(PlantInstructions, W596_1_4_TcpRemotesCountAgainstTheUnitsConnections) {

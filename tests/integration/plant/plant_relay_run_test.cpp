@@ -11,6 +11,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -283,6 +284,53 @@ TEST_F(PlantRelayRun, StatusAndMetricsCountWhatEachRouterTookAndRefused) {
     // The process's counters: five frames taken, one of them refused with 0501.
     EXPECT_EQ(metric("fins_relays_total") - relays_before, 5);
     EXPECT_EQ(metric("fins_relay_errors_total{end_code=\"0501\"}"), 1);
+}
+
+// A router has an Ethernet unit on each network: /api/plcs lists both (their ports and
+// connections), and /api/status and /metrics count the FINS/TCP clients of both, not only
+// of the first unit (they did: a client of router-a's network 2 unit was not seen).
+TEST_F(PlantRelayRun, EveryEthernetUnitsClientsAreListedAndCounted) {
+    Json router_a;
+    const auto before = get("/api/plcs");
+    for (const auto& p : before["plcs"])
+        if (p.value("name", "") == "router-a") router_a = p;
+    ASSERT_TRUE(router_a.is_object());
+    const auto& units = router_a["ethernet_units"];
+    ASSERT_EQ(units.size(), 2u) << router_a.dump();
+    EXPECT_EQ(units[0]["network"], 1);
+    EXPECT_EQ(units[0]["node"], 1);
+    EXPECT_EQ(units[0]["udp_port"], router_a["udp_port"]);
+    EXPECT_EQ(units[0]["tcp_port"], router_a["tcp_port"]);
+    EXPECT_EQ(units[1]["network"], 2);
+    EXPECT_EQ(units[1]["node"], 1);
+    const auto second_port = units[1]["tcp_port"].get<std::uint16_t>();
+    ASSERT_NE(second_port, 0);
+    EXPECT_EQ(metric("fins_tcp_connections{state=\"established\"}"), 0);
+
+    asio::io_context io;
+    RawTcp first(io, "127.0.1.1", fins_port());
+    ASSERT_EQ(first.handshake(0).size(), 24u);
+    RawTcp second(io, "127.0.2.1", second_port);
+    const auto hello = second.handshake(0);
+    ASSERT_EQ(hello.size(), 24u);
+    EXPECT_EQ(hello[23], 1) << "router-a's node on network 2";
+
+    EXPECT_EQ(metric("fins_tcp_connections{state=\"established\"}"), 2);
+    const auto connections = get("/api/status?plc=router-a")["connections"];
+    ASSERT_EQ(connections.size(), 2u) << connections.dump();
+    std::vector<int> networks;
+    for (const auto& c : connections) {
+        EXPECT_EQ(c["state"], "established");
+        networks.push_back(c["network"].get<int>());
+    }
+    std::sort(networks.begin(), networks.end());
+    EXPECT_EQ(networks, (std::vector<int>{1, 2}));
+    const auto after = get("/api/plcs");
+    for (const auto& p : after["plcs"])
+        if (p.value("name", "") == "router-a") {
+            EXPECT_EQ(p["tcp_connections"], 2);
+            EXPECT_EQ(p["ethernet_units"][1]["tcp_connections"], 1);
+        }
 }
 
 }  // namespace
