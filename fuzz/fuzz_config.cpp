@@ -74,10 +74,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (size == 0) return 0;
     const std::string_view text(reinterpret_cast<const char*>(data + 1), size - 1);
     switch (data[0] % 4) {
-        case 0: finsd_config(text); break;
-        case 1: bridge_config(text); break;
-        case 2: scenario(text); break;
-        default: channel_file(text); break;
+        case 0:
+            finsd_config(text);
+            break;
+        case 1:
+            bridge_config(text);
+            break;
+        case 2:
+            scenario(text);
+            break;
+        default:
+            channel_file(text);
+            break;
     }
     return 0;
 }
