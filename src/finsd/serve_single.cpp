@@ -2,9 +2,6 @@
 // CPU Unit with one Ethernet unit, in the order a plant opens each of its CPU Units
 // (server/routing/plant.hpp): state file -> Plc -> mode -> file memory -> Server.
 #include <chrono>
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <string>
 #include <utility>
 
@@ -16,7 +13,6 @@
 #include "finsd/serve_units.hpp"
 #include "plc/profile.hpp"
 #include "plc/storage/storage.hpp"
-#include "plc/storage/storage_format.hpp"
 
 namespace fins::finsd {
 
