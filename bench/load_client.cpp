@@ -35,6 +35,7 @@ struct ClientStatsLine {
     double p99_us = 0;
     std::size_t errors = 0;
     std::size_t count = 0;
+    std::uint64_t waited_for_id = 0;  // requests that found no SID usable (ClientStats)
 };
 
 // Keeps `depth` 1-word reads of D0 in flight for `seconds`; each completion issues the
@@ -86,6 +87,7 @@ ClientStatsLine drive_client(bool tcp, std::uint16_t port, unsigned depth, doubl
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
     ClientStatsLine s;
     s.errors = p.errors;
+    s.waited_for_id = (*client)->stats().waited_for_id;
     s.count = p.latencies.size();
     if (p.latencies.empty()) return s;
     std::sort(p.latencies.begin(), p.latencies.end());
@@ -121,16 +123,17 @@ int run_client_mode(std::uint16_t port, double seconds, bool json,
                 "{{\"mode\":\"client\",\"transport\":\"{}\",\"in_flight\":{},\"client_rps\":{:.0f},"
                 "\"client_p50_us\":{:.1f},\"client_p99_us\":{:.1f},\"client_errors\":{},"
                 "\"raw_rps\":{:.0f},\"ratio\":{:.2f},\"client_cpu_us\":{:.2f},\"raw_cpu_us\":{:.2f}"
-                "}}\n",
+                ","
+                "\"waited_for_id\":{}}}\n",
                 proto, depth, client.rate, client.p50_us, client.p99_us, client.errors, raw, ratio,
-                client_cpu, raw_cpu);
+                client_cpu, raw_cpu, client.waited_for_id);
         } else {
             fmt::print(
                 "{} in-flight {:>2}: fins::Client {:>8.0f} req/s p50 {:>6.1f} us p99 {:>6.1f} us "
                 "errors {} | raw generator {:>8.0f} req/s | ratio {:.2f} | CPU per request: client "
-                "{:.2f} us, raw {:.2f} us\n",
+                "{:.2f} us, raw {:.2f} us | waited for a SID {}\n",
                 proto, depth, client.rate, client.p50_us, client.p99_us, client.errors, raw, ratio,
-                client_cpu, raw_cpu);
+                client_cpu, raw_cpu, client.waited_for_id);
         }
         std::fflush(stdout);
         if (client.rate <= 0 || raw <= 0) return 1;
