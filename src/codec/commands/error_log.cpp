@@ -1,24 +1,20 @@
 // 21 01 .. 21 41: ERROR CLEAR, ERROR LOG READ/CLEAR, FINS WRITE ACCESS LOG READ/CLEAR
 // (W342 5-3-27 .. 5-3-31, frames 6/2101 .. 6/2141; record layout seed 003 p.208).
-#include "codec/command_codec.hpp"
 #include "fins/commands/error_log.hpp"
+#include "codec/command_codec.hpp"
 
 #include <array>
 
 namespace fins {
 
 using codec::check_fixed;
+using codec::empty_response;
 using codec::end_code;
 using codec::malformed;
 
 namespace {
 
 constexpr std::size_t read_size = 4;  // beginning record, number of records
-
-Result<EmptyResponse> expect_empty(Bytes data) {
-    if (!data.empty()) return malformed();
-    return EmptyResponse{};
-}
 
 // False for a nibble above 9.
 bool bcd_field(std::uint8_t b, std::uint8_t& out) noexcept {
@@ -179,7 +175,7 @@ Result<ErrorClear> ErrorClear::decode(Bytes parameters) noexcept {
 }
 
 Result<ErrorClear::Response> ErrorClear::decode_response(Bytes data) const {
-    return expect_empty(data);
+    return empty_response(data);
 }
 
 void ErrorLogRecord::encode(ByteWriter& w) const noexcept {
@@ -217,7 +213,7 @@ Result<ErrorLogClear> ErrorLogClear::decode(Bytes parameters) noexcept {
 }
 
 Result<ErrorLogClear::Response> ErrorLogClear::decode_response(Bytes data) const {
-    return expect_empty(data);
+    return empty_response(data);
 }
 
 void WriteAccessLogRead::encode(ByteWriter& w) const noexcept {
@@ -239,7 +235,7 @@ Result<WriteAccessLogClear> WriteAccessLogClear::decode(Bytes parameters) noexce
 }
 
 Result<WriteAccessLogClear::Response> WriteAccessLogClear::decode_response(Bytes data) const {
-    return expect_empty(data);
+    return empty_response(data);
 }
 
 }  // namespace fins

@@ -53,9 +53,4 @@ Result<C> checked(C command, const ByteReader& r) {
     return command;
 }
 
-inline Result<EmptyResponse> empty_response(Bytes data) {
-    if (!data.empty()) return malformed();
-    return EmptyResponse{};
-}
-
 }  // namespace fins::codec::file_fields

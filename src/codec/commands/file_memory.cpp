@@ -11,6 +11,7 @@
 
 namespace fins {
 
+using codec::empty_response;
 using codec::end_code;
 using codec::malformed;
 using namespace codec::file_fields;

@@ -3,12 +3,13 @@
 // Server side (decode): errors are the end codes the CPU Unit answers, 1002 for a
 // command shorter than its fixed part and 1001 for one longer than it.
 // Client side (decode_response): any length or echo mismatch is malformed_response.
-#include "codec/command_codec.hpp"
 #include "fins/commands/memory_area.hpp"
+#include "codec/command_codec.hpp"
 
 namespace fins {
 
 using codec::check_fixed;
+using codec::empty_response;
 using codec::end_code;
 using codec::malformed;
 
@@ -32,13 +33,6 @@ MemoryAddress read_address(ByteReader& r) noexcept {
     a.word = r.u16();
     a.bit = r.u8();
     return a;
-}
-
-// Checks a parameter block against a fixed size before anything is read from it.
-
-Result<EmptyResponse> expect_empty(Bytes data) {
-    if (!data.empty()) return malformed();
-    return EmptyResponse{};
 }
 
 }  // namespace
@@ -85,7 +79,7 @@ Result<MemoryAreaWrite> MemoryAreaWrite::decode(Bytes parameters) noexcept {
 }
 
 Result<MemoryAreaWrite::Response> MemoryAreaWrite::decode_response(Bytes response) const {
-    return expect_empty(response);
+    return empty_response(response);
 }
 
 void MemoryAreaFill::encode(ByteWriter& w) const noexcept {
@@ -105,7 +99,7 @@ Result<MemoryAreaFill> MemoryAreaFill::decode(Bytes parameters) noexcept {
 }
 
 Result<MemoryAreaFill::Response> MemoryAreaFill::decode_response(Bytes data) const {
-    return expect_empty(data);
+    return empty_response(data);
 }
 
 void MultipleMemoryAreaReadResponse::encode(ByteWriter& w) const noexcept {
@@ -189,7 +183,7 @@ Result<MemoryAreaTransfer> MemoryAreaTransfer::decode(Bytes parameters) noexcept
 }
 
 Result<MemoryAreaTransfer::Response> MemoryAreaTransfer::decode_response(Bytes data) const {
-    return expect_empty(data);
+    return empty_response(data);
 }
 
 }  // namespace fins

@@ -1,20 +1,16 @@
 // RUN 04 01 and STOP 04 02 (W342 5-3-13, 5-3-14; frames 6/0401, 6/0402).
-#include "codec/command_codec.hpp"
 #include "fins/commands/operating_mode.hpp"
+#include "codec/command_codec.hpp"
 
 namespace fins {
 
+using codec::empty_response;
 using codec::end_code;
 
 namespace {
 
 constexpr std::size_t program_number_size = 2;
 constexpr std::size_t run_max_size = program_number_size + 1;  // + mode byte
-
-Result<EmptyResponse> expect_empty(Bytes data) {
-    if (!data.empty()) return Unexpected(make_error_code(ClientError::malformed_response));
-    return EmptyResponse{};
-}
 
 constexpr bool valid_mode(std::uint8_t mode) noexcept {
     return mode == static_cast<std::uint8_t>(RunMode::monitor) ||
@@ -51,7 +47,7 @@ Result<Run> Run::decode(Bytes parameters) noexcept {
 }
 
 Result<Run::Response> Run::decode_response(Bytes data) const {
-    return expect_empty(data);
+    return empty_response(data);
 }
 
 void Stop::encode(ByteWriter& w) const noexcept {
@@ -71,7 +67,7 @@ Result<Stop> Stop::decode(Bytes parameters) noexcept {
 }
 
 Result<Stop::Response> Stop::decode_response(Bytes data) const {
-    return expect_empty(data);
+    return empty_response(data);
 }
 
 }  // namespace fins

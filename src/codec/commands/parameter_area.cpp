@@ -11,6 +11,7 @@
 namespace fins {
 
 using codec::check_fixed;
+using codec::empty_response;
 using codec::end_code;
 using codec::malformed;
 
@@ -33,11 +34,6 @@ constexpr ParameterAreaInfo areas[] = {
 
 std::uint16_t with_flag(std::uint16_t count, bool last) noexcept {
     return static_cast<std::uint16_t>((count & word_count_mask) | (last ? last_word_bit : 0));
-}
-
-Result<EmptyResponse> expect_empty(Bytes data) {
-    if (!data.empty()) return malformed();
-    return EmptyResponse{};
 }
 
 }  // namespace
@@ -130,7 +126,7 @@ Result<ParameterAreaWrite> ParameterAreaWrite::decode(Bytes parameters) noexcept
 }
 
 Result<ParameterAreaWrite::Response> ParameterAreaWrite::decode_response(Bytes response) const {
-    return expect_empty(response);
+    return empty_response(response);
 }
 
 void ParameterAreaClear::encode(ByteWriter& w) const noexcept {
@@ -154,7 +150,7 @@ Result<ParameterAreaClear> ParameterAreaClear::decode(Bytes parameters) noexcept
 }
 
 Result<ParameterAreaClear::Response> ParameterAreaClear::decode_response(Bytes data) const {
-    return expect_empty(data);
+    return empty_response(data);
 }
 
 }  // namespace fins
