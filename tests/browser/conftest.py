@@ -221,6 +221,16 @@ def wait_for(predicate, timeout, what, interval=0.02):
         time.sleep(interval)
 
 
+def click_css(driver, css, what, timeout=5):
+    """Clicks the element `css` selects, found and clicked in one script: a part of the page
+    that re-renders between a find_element and a click (the switches do, on every status
+    message) would leave a stale reference in the test's hand. Waits up to `timeout` s for
+    the element to be there."""
+    return wait_for(lambda: driver.execute_script(
+        "const e = document.querySelector(arguments[0]); if (!e) return false; e.click(); return true;",
+        css), timeout, what)
+
+
 def open_page(driver, url):
     driver.get(url)
     wait_for(lambda: driver.execute_script("return document.body.dataset.ready === 'true'"), 15,

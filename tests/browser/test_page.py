@@ -12,8 +12,8 @@ from pathlib import Path
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
 
-from conftest import (cell_text, go_to, open_page, screenshot, severe_console_errors, wait_for,
-                      _chrome)
+from conftest import (cell_text, click_css, go_to, open_page, screenshot, severe_console_errors,
+                      wait_for, _chrome)
 
 
 def click_cell(driver, word):
@@ -203,23 +203,19 @@ def test_fault_switches_change_what_fins_answers(finsd_factory, page):
     open_page(page, finsd.url)
     assert finsd.fins("write", "D5", 1, check=False)[0] == 0
     # Network write protection: FINS writes are refused (end code 2102).
-    switch = wait_for(lambda: page.find_element(By.CSS_SELECTOR, "[data-test='switch-network_write_protection']"),
-                      5, "the protection switch")
-    page.execute_script("arguments[0].click()", switch)
+    click_css(page, "[data-test='switch-network_write_protection']", "the protection switch")
     wait_for(lambda: finsd.fins("write", "D5", 2, check=False)[0] == 4, 5, "FINS writes refused")
     code, out = finsd.fins("write", "D5", 2, check=False)
     assert "2102" in str(out)
     assert finsd.read("D5") == [1]
     # Battery error: 06 01 reports error 00F7 and a non-fatal error.
-    switch = page.find_element(By.CSS_SELECTOR, "[data-test='switch-battery_low']")
-    page.execute_script("arguments[0].click()", switch)
+    click_css(page, "[data-test='switch-battery_low']", "the battery switch")
     wait_for(lambda: finsd.fins("status")[1]["error_code"] == "00F7", 5, "06 01 error code 00F7")
     assert "battery error" in finsd.fins("status")[1]["non_fatal"]
     wait_for(lambda: "00F7" in page.find_element(By.ID, "cpu-errors").text, 5, "the error on the page")
     screenshot(page, "page-faults")
     # And off again.
-    page.execute_script("arguments[0].click()",
-                        page.find_element(By.CSS_SELECTOR, "[data-test='switch-network_write_protection']"))
+    click_css(page, "[data-test='switch-network_write_protection']", "the protection switch")
     wait_for(lambda: finsd.fins("write", "D5", 3, check=False)[0] == 0, 5, "FINS writes accepted")
     assert finsd.read("D5") == [3]
 

@@ -86,14 +86,17 @@ def test_read_only_page_shows_its_controls_disabled(finsd_factory, page):
     wait_for(lambda: page.find_element(By.ID, "control-badge").text == "read only", 5, "the badge")
     wait_for(lambda: page.find_elements(By.CSS_SELECTOR, "[data-test='switch-battery_low']"), 5,
              "the switches")
-    controls = (page.find_elements(By.CSS_SELECTOR, "#mode-buttons button") +
-                page.find_elements(By.CSS_SELECTOR, "#fal-form input, #fal-form select, #fal-form button") +
-                page.find_elements(By.CSS_SELECTOR, "#switches input"))
+    # Read in one script: the switches re-render on every status message, and an element
+    # found first and read after would be stale by then.
+    controls = page.execute_script(
+        "return Array.from(document.querySelectorAll('#mode-buttons button, #fal-form input, "
+        "#fal-form select, #fal-form button, #switches input')).map(e => ({disabled: "
+        "e.hasAttribute('disabled'), title: e.title || '', test: e.dataset.test || '', "
+        "html: e.outerHTML}));")
     assert len(controls) >= 3 + 5 + 4
     for c in controls:
-        assert c.get_attribute("disabled") is not None, c.get_attribute("outerHTML")
-        assert "--http-control" in (c.get_attribute("title") or "") or \
-            c.get_attribute("data-test") == "switch-dip_write", c.get_attribute("outerHTML")
+        assert c["disabled"], c["html"]
+        assert "--http-control" in c["title"] or c["test"] == "switch-dip_write", c["html"]
     # A click on a disabled button sends nothing.
     page.execute_script("document.querySelector(\"[data-test='mode-program']\").click()")
     assert finsd.fins("status")[1]["mode"] == "run"
