@@ -86,7 +86,7 @@ int main(int argc, char** argv) {
                 i, port, interval_ms, i);
         const auto conf_path = rdir / "bridge.toml";
         std::ofstream(conf_path) << conf;
-        tb::Recorder rec(broker.port(), {"fo/+/g"});
+        tb::Recorder rec(broker.port(), std::vector<std::string>{"fo/+/g"});
         std::vector<std::string> names;
         std::vector<std::unique_ptr<tb::Child>> bridges;
         for (int i = 0; i < instances; ++i) {

@@ -133,7 +133,10 @@ int main(int argc, char** argv) {
         };
         const auto shapes = tcp ? std::vector<Shape>{{1, false}, {32, false}, {1, true}}
                                 : std::vector<Shape>{{1, false}, {32, false}};
-        for (const auto [depth, split] : shapes) {
+        for (const auto& shape : shapes) {
+            // Named copies, not a structured binding: clang 14 cannot capture one in a lambda.
+            const unsigned depth = shape.depth;
+            const bool split = shape.split;
             const std::string name =
                 fmt::format("{}{}-{}", tcp ? "tcp" : "udp", split ? "-split" : "", depth);
             if (!cases.empty() && std::find(cases.begin(), cases.end(), name) == cases.end())

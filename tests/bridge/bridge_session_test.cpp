@@ -134,7 +134,7 @@ TEST(BridgeSession, WritesAroundARestartOfABrokerWithPersistenceAreEachAnsweredO
     fins::test::Finsd finsd{{}};
     Recorder::Options o;
     o.persistent_id = "session-test-" + std::to_string(::getpid());
-    Recorder sub{broker.port(), {"t/#"}, o};
+    Recorder sub{broker.port(), std::vector<std::string>{"t/#"}, o};
     ASSERT_TRUE(broker.started() && finsd.started() && sub.connected());
     const auto config = mqtt_section(broker.port()) + plc("press1", finsd.port()) + tags;
     auto bridge = std::make_unique<BridgeProcess>(dir, config);

@@ -87,7 +87,7 @@ TEST(SparkplugMqtt, BirthSequenceSeqWrapRebirthDcmdOnceAndNdeathOnKill) {
             "]\n";
     }
     const auto conf_path = dir.write("bridge.toml", conf);
-    tb::Recorder rec(broker.port(), {"spBv1.0/#"});
+    tb::Recorder rec(broker.port(), std::vector<std::string>{"spBv1.0/#"});
     tb::Child bridge({tb::bridge_path, "--config", conf_path}, dir.path() / "bridge.log");
 
     // 1. NBIRTH (seq 0), then DBIRTH of both devices, then DDATA; seq +1 mod 256 throughout.

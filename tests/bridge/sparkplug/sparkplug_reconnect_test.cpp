@@ -75,7 +75,7 @@ TEST(SparkplugReconnect, NothingBeforeEachConnectionsNbirthAndSeqCountsOnFromIt)
         "\n[[plc.group]]\nname = \"fast\"\ninterval_ms = 20\npublish = \"always\"\n"
         "tags = [ { name = \"speed\", address = \"D100\", type = \"int16\" } ]\n";
     const auto conf_path = dir.write("bridge.toml", conf);
-    tb::Recorder rec(broker.port(), {"spBv1.0/#"});
+    tb::Recorder rec(broker.port(), std::vector<std::string>{"spBv1.0/#"});
     ASSERT_TRUE(rec.connected());
     tb::Child bridge({tb::bridge_path, "--config", conf_path}, dir.path() / "bridge.log");
     ASSERT_TRUE(rec.wait([](const auto& ms) { return births(ms) >= 1; }, 30s)) << bridge.log();
