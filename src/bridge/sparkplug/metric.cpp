@@ -1,6 +1,7 @@
 #include "bridge/sparkplug/metric.hpp"
 
 #include <array>
+#include <cmath>
 #include <limits>
 #include <utility>
 
@@ -31,7 +32,14 @@ std::uint64_t as_bits(const MetricValue& v) {
     if (const auto* i = std::get_if<std::int64_t>(&v)) return static_cast<std::uint64_t>(*i);
     if (const auto* u = std::get_if<std::uint64_t>(&v)) return *u;
     if (const auto* d = std::get_if<double>(&v)) {
-        if (*d < 0) return static_cast<std::uint64_t>(static_cast<std::int64_t>(*d));
+        // Saturated: converting a double that no 64-bit integer holds is undefined
+        // behaviour (a Double metric's 1e300 came here too, for nothing).
+        if (std::isnan(*d)) return 0;
+        if (*d < 0) {
+            if (*d < -0x1p63) return std::uint64_t{1} << 63;  // INT64_MIN's pattern
+            return static_cast<std::uint64_t>(static_cast<std::int64_t>(*d));
+        }
+        if (*d >= 0x1p64) return std::numeric_limits<std::uint64_t>::max();
         return static_cast<std::uint64_t>(*d);
     }
     return 0;

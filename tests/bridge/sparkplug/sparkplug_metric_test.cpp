@@ -2,6 +2,7 @@
 // specification names for it, signed values as two's complement, and bad input is refused.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 
 #include "bridge/sparkplug/metric.hpp"
@@ -65,6 +66,17 @@ TEST(SparkplugMetric, EveryBasicTypeRoundTrips) {
     EXPECT_EQ(std::get<std::string>(round_trip(pb::String, std::string("ABC"))), "ABC");
     // A uint16 word read as an int (the bridge's integer holder) still encodes as its pattern.
     EXPECT_EQ(std::get<std::uint64_t>(round_trip(pb::UInt16, std::int64_t{1234})), 1234U);
+}
+
+// A double that no 64-bit integer holds saturates (converting it would be undefined
+// behaviour, which clang's UBSan reports): the largest pattern, INT64_MIN's, 0 for NaN.
+TEST(SparkplugMetric, ADoubleBeyondSixtyFourBitsSaturates) {
+    EXPECT_EQ(std::get<std::uint64_t>(round_trip(pb::UInt64, 1e300)),
+              std::numeric_limits<std::uint64_t>::max());
+    EXPECT_EQ(std::get<std::int64_t>(round_trip(pb::Int64, -1e300)),
+              std::numeric_limits<std::int64_t>::min());
+    EXPECT_EQ(std::get<std::uint64_t>(round_trip(pb::UInt64, std::nan(""))), 0U);
+    EXPECT_EQ(std::get<std::int64_t>(round_trip(pb::Int64, -2.5)), -2);
 }
 
 TEST(SparkplugMetric, AFailedReadIsNullWithQualityBad) {
