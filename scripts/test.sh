@@ -8,7 +8,7 @@
 #   3. a short soak of the ASan+UBSan finsd (scripts/soak.sh: verifying UDP and TCP
 #      clients, garbage datagrams, connection churn; counts as one test);
 #   4. the libFuzzer targets over every decoder, the dispatcher and a whole session,
-#      briefly each, from the committed corpus (fuzz/corpus/);
+#      briefly each, from the committed corpus (fuzz/corpus/), built by the ASan tree;
 #   5. the Linux arm64 cross build: its unit tests and a round trip under qemu-user, and
 #      its .debs (docs/platforms.md);
 #   6. the Windows cross build: its unit tests and fins.exe under wine, and its .zip
@@ -90,8 +90,6 @@ soak_ok=1
 summary+=("soak: $(grep -E '^soak: [0-9]+ s,' "$soak_log" | tail -n 1 | sed 's/^soak: //')")
 rm -f "$soak_log"
 
-stage "fuzz: build"
-"$root/scripts/build.sh" fuzz
 stage "fuzz: ${fuzz_seconds}s per target"
 # A libFuzzer run uses one core: as many run at once as there are cores (each still for
 # $fuzz_seconds), so the stage takes 17 x 20 s / 2 rather than 17 x 20 s on CI's 2 cores.
@@ -101,11 +99,11 @@ run_fuzzer() {  # TARGET: its log and status go to $fuzz_dir/TARGET.{log,rc}
   corpus="$fuzz_dir/$target.corpus"; mkdir -p "$corpus"
   [[ -d "$seeds" ]] && cp -r "$seeds/." "$corpus/"
   local rc=0
-  "$root/build-fuzz/bin/$target" -max_total_time="$fuzz_seconds" -print_final_stats=0 \
+  "$root/build-asan/bin/$target" -max_total_time="$fuzz_seconds" -print_final_stats=0 \
     "$corpus" >"$fuzz_dir/$target.log" 2>&1 || rc=$?
   echo "$rc" >"$fuzz_dir/$target.rc"
 }
-mapfile -t fuzzers <"$root/build-fuzz/fuzzers.txt"  # written by fuzz/CMakeLists.txt
+mapfile -t fuzzers <"$root/build-asan/fuzzers.txt"  # written by fuzz/CMakeLists.txt
 fuzz_jobs=${FINS_JOBS:-$(nproc)}
 for target in "${fuzzers[@]}"; do
   while (($(jobs -rp | wc -l) >= fuzz_jobs)); do wait -n || true; done
