@@ -92,7 +92,7 @@ rm -f "$soak_log"
 
 stage "fuzz: ${fuzz_seconds}s per target"
 # A libFuzzer run uses one core: as many run at once as there are cores (each still for
-# $fuzz_seconds), so the stage takes 17 x 20 s / 2 rather than 17 x 20 s on CI's 2 cores.
+# $fuzz_seconds), so the stage takes 18 x 20 s / 2 rather than 18 x 20 s on CI's 2 cores.
 fuzz_dir=$(mktemp -d)
 run_fuzzer() {  # TARGET: its log and status go to $fuzz_dir/TARGET.{log,rc}
   local target=$1 corpus seeds="$root/fuzz/corpus/$1"
