@@ -18,10 +18,10 @@ using namespace std::chrono_literals;
 
 TEST(TcpAccept, OutOfDescriptorsBacksOffLogsOncePerIntervalAndRecovers) {
     // Log level info: the start-up lines format before descriptors run out. Under UBSan
-    // the first check of a dynamic type needs a pipe (to probe the vtable's memory), so
-    // a type first checked once no descriptor is left is reported as an "invalid vptr"
-    // (clang's runtime: the error_code of the failed accept): a sanitizer artifact, not a
-    // finsd fault, suppressed for this finsd by tests/ubsan_no_descriptors.supp.
+    // a dynamic type's check that misses its cache needs a pipe (to probe the vtable's
+    // memory), so once no descriptor is left any object is reported as an "invalid vptr"
+    // (CI: the error_code of the failed accept): a sanitizer artifact, not a finsd fault.
+    // tests/ubsan_no_descriptors.supp turns that check off for this finsd alone.
     const std::string supp = FINS_SOURCE_DIR "/tests/ubsan_no_descriptors.supp";
     Finsd finsd({"--max-connections", "64", "--tcp-max-pending", "64"},
                 {.log_level = "info",
