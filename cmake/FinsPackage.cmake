@@ -15,6 +15,14 @@ foreach(part ${fins_parts})
   set_target_properties(${part} PROPERTIES POSITION_INDEPENDENT_CODE ON)
   list(APPEND fins_objects $<TARGET_OBJECTS:${part}>)
 endforeach()
+# Windows: fmt is compiled in this tree (cmake/FinsWindowsDeps.cmake), and libfins carries
+# it; on Linux libfins links Debian's libfmt.
+if(WIN32)
+  list(APPEND fins_objects $<TARGET_OBJECTS:fins_win_fmt>)
+  set(fins_fmt $<BUILD_INTERFACE:fmt::fmt>)
+else()
+  set(fins_fmt fmt::fmt)
+endif()
 
 # 0.x releases break the ABI at every minor version, so the SONAME carries it.
 if(PROJECT_VERSION_MAJOR EQUAL 0)
@@ -35,7 +43,7 @@ foreach(lib fins_shared fins_static)
     $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
   target_compile_features(${lib} PUBLIC cxx_std_20)
   # The public headers use tl::expected (fins::Result); fmt and threads are used inside.
-  target_link_libraries(${lib} PUBLIC tl::expected PRIVATE fmt::fmt Threads::Threads)
+  target_link_libraries(${lib} PUBLIC tl::expected PRIVATE ${fins_fmt} Threads::Threads)
   if(WIN32)
     # Winsock 2 and its extensions, under Asio's sockets.
     target_link_libraries(${lib} PRIVATE ws2_32 mswsock)
