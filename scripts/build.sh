@@ -16,12 +16,10 @@ jobs=${FINS_JOBS:-$(nproc)}
 # 11.9 s with GNU ld, and the ASan tree links 55 programs (docs/testing.md).
 lld=(-DCMAKE_EXE_LINKER_FLAGS=-fuse-ld=lld -DCMAKE_SHARED_LINKER_FLAGS=-fuse-ld=lld
   -DCMAKE_MODULE_LINKER_FLAGS=-fuse-ld=lld)
-# The optimised trees' level (release, arm64, windows; package.sh's too): Release's -O3
-# unless FINS_OPT says otherwise (scripts/test.sh: -O1, to fit CI's time; docs/testing.md).
-opt=${FINS_OPT:--O3}
+source "$root/scripts/release_opt.sh"
 case "$kind" in
   # What users run: optimised, and not failing on a newer compiler's new warning.
-  release) dir=build; args=(-DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_FLAGS_RELEASE=$opt -DNDEBUG") ;;
+  release) dir=build; args=(-DCMAKE_BUILD_TYPE=Release "${fins_release_opt[@]}") ;;
   # What CI tests: ASan+UBSan, warnings as errors, everything (benchmarks compile too),
   # and the libFuzzer targets on the same libraries (their coverage instrumentation too):
   # one tree instead of two. clang-14 compiles it in about half the time g++ takes with
@@ -46,7 +44,7 @@ case "$kind" in
   arm64) dir=build-arm64
     "$root/scripts/deps.sh" arm64
     args=(-DCMAKE_TOOLCHAIN_FILE="$root/cmake/toolchains/aarch64-linux-gnu.cmake"
-      -DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_FLAGS_RELEASE=$opt -DNDEBUG" -DFINS_WERROR=ON
+      -DCMAKE_BUILD_TYPE=Release "${fins_release_opt[@]}" -DFINS_WERROR=ON
       "-DCMAKE_CXX_FLAGS=-Wno-error=restrict -Wno-error=array-bounds -Wno-error=stringop-overflow"
       -DFINS_BENCH=OFF -DFINS_EXAMPLES=OFF
       -DCMAKE_INSTALL_PREFIX=/usr -DFINS_MAN=ON
@@ -57,7 +55,7 @@ case "$kind" in
   windows) dir=build-windows
     "$root/scripts/deps.sh" windows
     args=(-DCMAKE_TOOLCHAIN_FILE="$root/cmake/toolchains/x86_64-w64-mingw32.cmake"
-      -DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_FLAGS_RELEASE=$opt -DNDEBUG" -DFINS_WERROR=ON
+      -DCMAKE_BUILD_TYPE=Release "${fins_release_opt[@]}" -DFINS_WERROR=ON
       "-DCMAKE_CXX_FLAGS=-Wno-error=restrict -Wno-error=array-bounds -Wno-error=stringop-overflow"
       -DFINS_BENCH=OFF -DFINS_EXAMPLES=OFF -DFINS_DOCS=OFF) ;;
   *) echo "usage: $0 [release|asan|tsan|fuzz|arm64|windows]" >&2; exit 2 ;;

@@ -36,8 +36,8 @@ if [[ "${1:-}" == arm64 ]]; then
 fi
 # No tests, benchmarks or in-tree examples: the ASan tree builds those, consumers.sh the
 # examples against the install.
-# Release's -O3 unless FINS_OPT says otherwise (scripts/test.sh: -O1; docs/testing.md).
-args=(-DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_FLAGS_RELEASE=${FINS_OPT:--O3} -DNDEBUG" -DCMAKE_INSTALL_PREFIX=/usr -DFINS_TESTS=OFF -DFINS_BENCH=OFF
+source "$root/scripts/release_opt.sh"
+args=(-DCMAKE_BUILD_TYPE=Release "${fins_release_opt[@]}" -DCMAKE_INSTALL_PREFIX=/usr -DFINS_TESTS=OFF -DFINS_BENCH=OFF
   -DFINS_EXAMPLES=OFF -DFINS_MAN=ON)
 # The .deb's Python module is for Debian's own interpreter, whatever else is on PATH.
 if [[ -x /usr/bin/python3 ]]; then args+=(-DPython3_EXECUTABLE=/usr/bin/python3); fi
