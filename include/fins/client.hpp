@@ -34,7 +34,10 @@
 // that it duplicates answers (an answer to a SID that had all its answers), every SID
 // released within `sid_quarantine` of that is quarantined too. When no SID is usable a
 // request waits in a queue (its timeout runs) instead of reusing one early. This holds
-// as long as no datagram outlives `sid_quarantine` in the network (engine/sid_pool.hpp).
+// as long as no datagram outlives the quarantine in the network. The quarantine follows
+// the network: an awaited late answer that comes in the second half of `sid_quarantine`
+// after its SID's release raises it to twice that delay (at most 64 times
+// `sid_quarantine`) until such answers stop (engine/sid_pool.hpp).
 //
 // Errors (all std::error_code): EndCode for a non-zero end code in send<C>() and the
 // helpers (end-code flag bits 0x0040/0x0080 alone still count as success; send_raw()
@@ -145,6 +148,9 @@ struct ClientStats {
     std::uint64_t reconnects = 0;     // successful opens after the first
     std::uint64_t quarantined = 0;    // SIDs put into quarantine (see above)
     std::uint64_t waited_for_id = 0;  // requests that waited for a usable SID
+    // Late answers that showed the network holding datagrams nearly `sid_quarantine`,
+    // and made the quarantine longer (see above).
+    std::uint64_t quarantine_raised = 0;
 };
 
 class Client {

@@ -205,6 +205,7 @@ ClientStats Client::stats() const noexcept {
     out.reconnects = impl_->opens > 0 ? impl_->opens - 1 : 0;
     out.quarantined = s.quarantined;
     out.waited_for_id = s.waited_for_id;
+    out.quarantine_raised = s.quarantine_raised;
     return out;
 }
 

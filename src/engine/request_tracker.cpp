@@ -224,8 +224,10 @@ RequestTracker::Disposition RequestTracker::on_frame(Bytes frame, SteadyTime now
     if (index == none || response->command != requests_[index].command) {
         ++stats_.stale_discarded;
         const auto before = sids_.quarantined_count();
+        const auto raised_before = sids_.raised_count();
         sids_.unexpected_answer(sid, index != none, now);
         stats_.quarantined += sids_.quarantined_count() - before;
+        stats_.quarantine_raised += sids_.raised_count() - raised_before;
         return Disposition::stale;
     }
     if (check) {

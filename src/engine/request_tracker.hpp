@@ -96,6 +96,7 @@ struct TrackerStats {
     std::uint64_t quarantined = 0;         // SIDs put into quarantine
     std::uint64_t waited_for_id = 0;       // requests that had to wait for a usable SID
     std::uint64_t refused = 0;             // requests failed because the sink refused a frame
+    std::uint64_t quarantine_raised = 0;   // late answers that made the quarantine longer
 };
 
 // Per-request options of submit() and submit_no_response() (see the contract above).

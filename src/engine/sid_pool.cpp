@@ -1,5 +1,7 @@
 #include "engine/sid_pool.hpp"
 
+#include <algorithm>
+
 namespace fins {
 
 SidPool::SidPool(std::chrono::nanoseconds quarantine) : quarantine_(quarantine) {
@@ -10,6 +12,8 @@ void SidPool::reset() {
     clean_ = {};
     suspect_ = {};
     trouble_until_ = {};
+    stretched_ = {};
+    stretched_until_ = {};
     for (std::uint16_t id = 0; id < size; ++id) {
         sids_[id] = Sid{};
         push_back(clean_, id);
@@ -84,7 +88,7 @@ void SidPool::release(std::uint8_t sid, unsigned unanswered, SteadyTime now) {
     s.released = now;
     s.unanswered = static_cast<std::uint8_t>(unanswered > 0xFF ? 0xFF : unanswered);
     if (unanswered > 0 || troubled(now)) {
-        quarantine(sid, now + quarantine_);
+        quarantine(sid, now + effective_quarantine(now));
         return;
     }
     s.where = Where::clean;
@@ -92,12 +96,41 @@ void SidPool::release(std::uint8_t sid, unsigned unanswered, SteadyTime now) {
 }
 
 void SidPool::trouble(SteadyTime now) noexcept {
-    trouble_until_ = now + quarantine_ * trouble_quarantines;
-    // Clean SIDs released within `quarantine` before the evidence may get a duplicate too.
-    // The clean list is in release order, so they are a tail of it.
-    while (clean_.tail != none && sids_[clean_.tail].released + quarantine_ > now) {
+    const auto q = effective_quarantine(now);
+    trouble_until_ = now + q * trouble_quarantines;
+    // Clean SIDs released within the quarantine before the evidence may get a duplicate
+    // too. The clean list is in release order, so they are a tail of it.
+    while (clean_.tail != none && sids_[clean_.tail].released + q > now) {
         const auto id = clean_.tail;
-        quarantine(id, sids_[id].released + quarantine_);
+        quarantine(id, sids_[id].released + q);
+    }
+}
+
+void SidPool::late_answer(std::chrono::nanoseconds late, SteadyTime now) noexcept {
+    if (late * 2 <= quarantine_) return;  // in the first half: as the quarantine expects
+    const auto grown = std::min(late * 2, quarantine_ * max_stretch);
+    const auto current = effective_quarantine(now);
+    stretched_ = std::max(grown, current);
+    stretched_until_ = now + stretched_ * trouble_quarantines;
+    if (grown <= current) return;
+    ++raised_count_;
+    // Every SID in quarantine now rests the grown quarantine from its release too; the
+    // list is sorted again by the new ends (at most 256 entries, a rare event).
+    std::array<std::uint16_t, size> ids{};
+    std::size_t n = 0;
+    for (auto id = suspect_.head; id != none; id = sids_[id].next) {
+        auto& s = sids_[id];
+        s.usable_at = std::max(s.usable_at, s.released + grown);
+        ids[n++] = id;
+    }
+    std::stable_sort(ids.begin(), ids.begin() + static_cast<std::ptrdiff_t>(n),
+                     [this](std::uint16_t a, std::uint16_t b) {
+                         return sids_[a].usable_at < sids_[b].usable_at;
+                     });
+    suspect_ = {};
+    for (std::size_t i = 0; i < n; ++i) {
+        sids_[ids[i]].prev = sids_[ids[i]].next = none;
+        push_back(suspect_, ids[i]);
     }
 }
 
@@ -105,6 +138,7 @@ void SidPool::unexpected_answer(std::uint8_t sid, bool busy, SteadyTime now) {
     auto& s = sids_[sid];
     if (!busy && s.where != Where::busy && s.unanswered > 0) {
         --s.unanswered;  // the late answer its quarantine waits for
+        late_answer(now - s.released, now);
         return;
     }
     trouble(now);

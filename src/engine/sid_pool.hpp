@@ -19,12 +19,22 @@
 //   released within `quarantine` before such evidence or while troubled, clean ones
 //   included, is quarantined too, because a duplicate of its answer may still be on the
 //   way.
+// - The quarantine follows the network: an awaited late answer (to a SID in quarantine
+//   for it) that comes in the second half of the configured quarantine, L after its SID's
+//   release, shows that datagrams live almost that long, so the quarantine grows to 2L
+//   (at most `max_stretch` times the configured one) for every SID released from then
+//   on and every SID in quarantine now. Queueing delay grows gradually, so the answers
+//   that come before the end show how late the next ones may be; and a longer quarantine
+//   leaves fewer SIDs usable, which lowers the load that made the answers late. After
+//   `trouble_quarantines` of the grown quarantine without such an answer, the configured
+//   one applies again.
 // - acquire() prefers clean SIDs (least recently used first), then the suspect SID whose
 //   quarantine ended first. A SID in quarantine is never handed out early: when none is
 //   usable, acquire() returns nothing and next_usable() says when to try again.
 // - reset() (a fresh connection or socket: no old answer can reach it) makes all 256
 //   clean, in order 00, 01, ... FF.
-// The assumption behind it: no datagram outlives `quarantine` in the network.
+// The assumption behind it: no datagram outlives the quarantine in the network, and one
+// that would gives notice by the answers before it.
 #pragma once
 
 #include <array>
@@ -41,6 +51,8 @@ class SidPool {
     static constexpr std::size_t size = 256;
     // A network seen duplicating is assumed to go on doing so for this many quarantines.
     static constexpr int trouble_quarantines = 4;
+    // The quarantine grows to at most this many times the configured one.
+    static constexpr int max_stretch = 64;
 
     explicit SidPool(std::chrono::nanoseconds quarantine);
 
@@ -49,6 +61,11 @@ class SidPool {
     void set_min_rest(std::chrono::nanoseconds rest) noexcept { min_rest_ = rest; }
     [[nodiscard]] std::chrono::nanoseconds min_rest() const noexcept { return min_rest_; }
     [[nodiscard]] std::chrono::nanoseconds quarantine() const noexcept { return quarantine_; }
+    // The quarantine a SID released at `now` gets: the configured one, or more while late
+    // answers show that the network holds datagrams nearly that long (see above).
+    [[nodiscard]] std::chrono::nanoseconds effective_quarantine(SteadyTime now) const noexcept {
+        return now < stretched_until_ && stretched_ > quarantine_ ? stretched_ : quarantine_;
+    }
 
     std::optional<std::uint8_t> acquire(SteadyTime now);
     // `unanswered`: transmissions of the request that got no answer.
@@ -65,6 +82,8 @@ class SidPool {
     [[nodiscard]] bool troubled(SteadyTime now) const noexcept { return now < trouble_until_; }
     // How many times a SID was put into quarantine.
     [[nodiscard]] std::uint64_t quarantined_count() const noexcept { return quarantined_count_; }
+    // How many times late answers made the quarantine longer.
+    [[nodiscard]] std::uint64_t raised_count() const noexcept { return raised_count_; }
 
   private:
     static constexpr std::uint16_t none = 0xFFFF;
@@ -89,6 +108,8 @@ class SidPool {
     // Into the suspect list, kept sorted by usable_at.
     void quarantine(std::uint16_t sid, SteadyTime usable_at) noexcept;
     void trouble(SteadyTime now) noexcept;
+    // An awaited answer came `late` after its SID's release.
+    void late_answer(std::chrono::nanoseconds late, SteadyTime now) noexcept;
 
     std::chrono::nanoseconds quarantine_;
     std::chrono::nanoseconds min_rest_{0};
@@ -97,6 +118,9 @@ class SidPool {
     List suspect_;  // earliest end of quarantine first
     SteadyTime trouble_until_{};
     std::uint64_t quarantined_count_ = 0;
+    std::chrono::nanoseconds stretched_{0};  // the grown quarantine, until stretched_until_
+    SteadyTime stretched_until_{};
+    std::uint64_t raised_count_ = 0;
 };
 
 }  // namespace fins
