@@ -19,7 +19,6 @@ using namespace std::chrono_literals;
 
 namespace {
 
-#ifndef _WIN32  // under wine a 2 KB chunk through the proxy misses all 16 attempts of 50 ms
 std::vector<std::uint8_t> pattern_bytes(std::size_t n, std::uint32_t seed) {
     std::vector<std::uint8_t> out(n);
     for (std::size_t i = 0; i < n; ++i)
@@ -36,7 +35,13 @@ void put_through_faults(std::uint32_t seed, bool replace) {
     LossyUdpProxy proxy(server.port(), faults);
     ClientOptions options;
     options.port = proxy.port();
+    // Under wine on a loaded host, an answer through the proxy came up to a second late
+    // (docs/windows.md): all 16 attempts of 50 ms missed there, so wine's are longer.
+#ifdef _WIN32
+    options.timeout = 150ms;
+#else
     options.timeout = 50ms;
+#endif
     options.retries = 15;             // the most W596 allows: a chunk lost 16 times fails
     options.sid_quarantine = 1000ms;  // margin for starved threads on a loaded machine
     auto client = Client::connect(options);
@@ -84,6 +89,5 @@ TEST(FileTransferThroughLoss, W342_5_3_34_PutReplacingCompletesIdenticalThroughL
         put_through_faults(seed, true);
     }
 }
-#endif
 
 }  // namespace

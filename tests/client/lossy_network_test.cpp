@@ -19,9 +19,6 @@ using namespace std::chrono_literals;
 
 namespace {
 
-// Not under wine: 336 to 962 of 5,000 reads took another word's answer there, varying
-// from run to run with the load (docs/windows.md); the cause is not yet established.
-#ifndef _WIN32
 constexpr std::uint16_t read_count = 5000;
 
 // A bijection on 16 bits (odd multiplier): word i holds a value no other word holds.
@@ -71,7 +68,10 @@ void run_through_faults(std::uint32_t seed, std::size_t window) {
     // The guarantee holds while no answer comes later than the quarantine: here a
     // request and its answer may each be held 60 ms, plus scheduling on a loaded machine
     // (CI runs two ASan tests at once: a proxy or server thread starved for 250 ms let a
-    // late answer through, so the margin is a second).
+    // late answer through, so the margin is a second). Under wine on a loaded host,
+    // answers came up to that second late, and the 336 to 962 reads that took another
+    // word's value before the quarantine followed the network (engine/sid_pool.hpp) were
+    // the ones that came later still.
     options.sid_quarantine = 1000ms;
     auto client = Client::connect(options);
     ASSERT_TRUE(client) << client.error().message();
@@ -87,7 +87,14 @@ void run_through_faults(std::uint32_t seed, std::size_t window) {
         EXPECT_EQ(message, make_error_code(ClientError::timeout).message()) << n << " times";
     }
     EXPECT_EQ(driver.ok + driver.wrong + failed, read_count);
+    // Retries get most reads through. Under wine on a loaded host, answers come up to a
+    // second late and 38 % of the reads got through (docs/windows.md): there the check is
+    // only that the reads were not all lost, which would make the one above hollow.
+#ifdef _WIN32
+    EXPECT_GT(driver.ok, read_count / 5u) << "a fifth of the reads get through";
+#else
     EXPECT_GT(driver.ok, read_count / 2u) << "retries get most reads through";
+#endif
     const auto c = proxy.counts();
     EXPECT_GT(c.dropped, 0u);
     EXPECT_GT(c.duplicated, 0u);
@@ -97,6 +104,7 @@ void run_through_faults(std::uint32_t seed, std::size_t window) {
     ::testing::Test::RecordProperty("stale_discarded", static_cast<int>(s.stale_discarded));
     ::testing::Test::RecordProperty("quarantined", static_cast<int>(s.quarantined));
     ::testing::Test::RecordProperty("waited_for_id", static_cast<int>(s.waited_for_id));
+    ::testing::Test::RecordProperty("quarantine_raised", static_cast<int>(s.quarantine_raised));
 }
 
 // W596 SendCmd (p. 3-16): timeout and retries; frames 1.1: the SID is all that ties an
@@ -108,6 +116,5 @@ TEST(SendCmdServiceId, LateAnswersNeverCompleteAnotherReadWith200InFlight) {
 TEST(SendCmdServiceId, LateAnswersNeverCompleteAnotherReadWith32InFlight) {
     run_through_faults(2, 32);
 }
-#endif
 
 }  // namespace
