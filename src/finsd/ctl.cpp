@@ -184,6 +184,8 @@ std::optional<std::string> send_request(const std::string& path, const std::stri
 int run_ctl(int argc, char** argv) {
     using Json = nlohmann::json;
     CLI::App app{"finsd ctl: change a running finsd through its control socket"};
+    // Options are --name on Windows too, and an argument such as /path is a value there.
+    app.allow_windows_style_options(false);
     app.name("finsd ctl");
     app.require_subcommand(1);
     // Options may follow the verb, as with `fins`: `finsd ctl status --socket PATH`.

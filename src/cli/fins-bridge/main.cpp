@@ -18,6 +18,8 @@
 
 int main(int argc, char** argv) {
     CLI::App app{"fins-bridge: Omron PLC tags over FINS to MQTT and back (docs/bridge.md)"};
+    // As fins and finsd: options are --name on every system.
+    app.allow_windows_style_options(false);
     std::string config;
     std::string instance;
     bool plan = false;

@@ -26,6 +26,10 @@ void add_discover_verbs(CLI::App& app, const GlobalOptions& g, int& exit_code);
 int main(int argc, char** argv) {
     using namespace fins::cli;
     CLI::App app{"fins: talk FINS to an Omron CS/CJ/CP/NX PLC or to finsd"};
+    // Options are --name on Windows too. CLI11 also takes /name there by default, and then
+    // a PLC path (`fins files put a.bin /DIR/A.BIN`) was taken for an option; the
+    // verbs made after this inherit it.
+    app.allow_windows_style_options(false);
     app.require_subcommand(1);
     // Global options may also follow the verb: `fins read D100 --json`.
     app.fallthrough(true);

@@ -55,6 +55,8 @@ void list_profiles() {
 // to go on.
 int configure(int argc, char** argv, Settings& settings) {
     CLI::App app{"finsd: a virtual Omron CPU Unit speaking FINS/UDP and FINS/TCP"};
+    // Options are --name on Windows too, and an argument such as /path is a value there.
+    app.allow_windows_style_options(false);
     app.set_version_flag("--version", std::string("finsd ") + FINSKIT_VERSION);
     app.footer(
         "finsd ctl [--socket PATH] VERB ...: change a running finsd through its control channel\n"
