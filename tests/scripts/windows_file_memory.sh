@@ -9,17 +9,9 @@
 # from ctest's environment). Every wait is for a condition, bounded in time; every
 # process started is ended on exit (only those: wineserver is left to wine).
 set -euo pipefail
-bin=$1
-host_bin=$2
-wine=/usr/lib/wine/wine64
-[[ -x "$host_bin/fins" ]] || { echo "windows file memory: no host fins in $host_bin" >&2; exit 1; }
-[[ -f "$bin/finsd.exe" ]] || { echo "windows file memory: no finsd.exe in $bin" >&2; exit 1; }
-source "$(dirname "$0")/round_trip_lib.sh"  # free_port, wait_for, round_trip_workdir
-round_trip_workdir
-fail() { echo "windows file memory: $*" >&2; tail -n 20 "$work/finsd.log" >&2 || true; exit 1; }
+source "$(dirname "$0")/round_trip_lib.sh"  # windows_test, free_port, wait_for
+windows_test "windows file memory" "$1" "$2" "$2/fins" "$1/finsd.exe"
 fins() { "$host_bin/fins" --host 127.0.0.1 --port "$port" --timeout 5 "$@"; }
-passed=0
-check() { if "$@"; then passed=$((passed + 1)); else fail "failed: $*"; fi; }
 refused() { ! fins "$@" >/dev/null 2>&1; }  # a non-zero exit: the PLC or the CLI said no
 listed() { fins files ls "${2:-}" | tr -d '\r' | grep -q "$1"; }
 

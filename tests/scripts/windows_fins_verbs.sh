@@ -11,14 +11,8 @@
 # ctest's environment). Every wait is for a condition, bounded in time; every process
 # started is ended on exit.
 set -euo pipefail
-bin=$1
-host_bin=$2
-wine=/usr/lib/wine/wine64
-[[ -x "$host_bin/finsd" ]] || { echo "windows fins verbs: no host finsd in $host_bin" >&2; exit 1; }
-[[ -f "$bin/fins.exe" ]] || { echo "windows fins verbs: no fins.exe in $bin" >&2; exit 1; }
-source "$(dirname "$0")/round_trip_lib.sh"  # free_port, wait_for, round_trip_workdir
-round_trip_workdir
-fail() { echo "windows fins verbs: $*" >&2; tail -n 20 "$work/finsd.log" >&2 || true; exit 1; }
+source "$(dirname "$0")/round_trip_lib.sh"  # windows_test, free_port, wait_for
+windows_test "windows fins verbs" "$1" "$2" "$2/finsd" "$2/fins" "$1/fins.exe"
 
 port=$(free_port)
 "$host_bin/finsd" --bind 127.0.0.1 --port "$port" --control "$work/ctl.sock" \
@@ -43,7 +37,6 @@ run() {
   out=$(tr -d '\r' <"$work/out")
   err=$(tr -d '\r' <"$work/err")
 }
-passed=0
 # same ARGS...: the Linux fins and fins.exe print the same and end the same.
 same() {
   local linux_out linux_err linux_rc

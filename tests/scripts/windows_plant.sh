@@ -15,17 +15,9 @@
 # WINEDEBUG from ctest's environment). Every wait is for a condition, bounded in time;
 # the one finsd.exe started is ended on exit.
 set -euo pipefail
-bin=$1
-host_bin=$2
 source_dir=$3
-wine=/usr/lib/wine/wine64
-[[ -x "$host_bin/fins" ]] || { echo "windows plant: no host fins in $host_bin" >&2; exit 1; }
-[[ -f "$bin/finsd.exe" ]] || { echo "windows plant: no finsd.exe in $bin" >&2; exit 1; }
-source "$(dirname "$0")/round_trip_lib.sh"  # free_port, wait_for, round_trip_workdir
-round_trip_workdir
-fail() { echo "windows plant: $*" >&2; tail -n 20 "$work/finsd.log" >&2 || true; exit 1; }
-passed=0
-check() { if "$@"; then passed=$((passed + 1)); else fail "failed: $*"; fi; }
+source "$(dirname "$0")/round_trip_lib.sh"  # windows_test, free_port, wait_for
+windows_test "windows plant" "$1" "$2" "$2/fins" "$1/finsd.exe" "$3/examples/three-networks.toml"
 
 # The five units' ports, in the file's order: router-a 1.1 and 2.1, router-b 2.2 and
 # 3.2, line-3 3.5.

@@ -5,13 +5,8 @@
 # (WINEPREFIX and WINEDEBUG from ctest's environment). Every wait is for a condition,
 # bounded in time; every process started is ended on exit.
 set -euo pipefail
-bin=$1
-host_bin=$2
-wine=/usr/lib/wine/wine64
-[[ -x "$host_bin/finsd" ]] || { echo "windows round trip: no host finsd in $host_bin" >&2; exit 1; }
-source "$(dirname "$0")/round_trip_lib.sh"  # free_port, wait_for, round_trip_workdir
-round_trip_workdir
-fail() { echo "windows round trip: $*" >&2; tail -n 20 "$work/finsd.log" >&2 || true; exit 1; }
+source "$(dirname "$0")/round_trip_lib.sh"  # windows_test, free_port, wait_for
+windows_test "windows round trip" "$1" "$2" "$2/finsd" "$1/fins.exe"
 # wine's console output ends lines with CR LF: compare without the CR.
 fins() { "$wine" "$bin/fins.exe" --host 127.0.0.1 --port "$port" "$@" | tr -d '\r'; }
 
@@ -19,8 +14,6 @@ port=$(free_port)
 "$host_bin/finsd" --bind 127.0.0.1 --port "$port" --control "$work/ctl.sock" >"$work/finsd.log" 2>&1 &
 pids+=($!)
 wait_for 60 grep -q "listening $port" "$work/finsd.log" || fail "finsd did not listen"
-passed=0
-check() { if "$@"; then passed=$((passed + 1)); else fail "failed: $*"; fi; }
 values() { fins "$@" --json | grep -o '"values":\[[^]]*\]'; }
 
 check fins write D100 4242 >/dev/null

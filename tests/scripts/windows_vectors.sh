@@ -11,15 +11,9 @@
 # ctest's environment). Every wait is for a condition, bounded in time; every process
 # started is ended on exit (only those: wineserver is left to wine).
 set -euo pipefail
-bin=$1
-host_bin=$2
-wine=/usr/lib/wine/wine64
 vectors="$(cd "$(dirname "$0")/../vectors" && pwd)"
-[[ -x "$host_bin/fins" ]] || { echo "windows vectors: no host fins in $host_bin" >&2; exit 1; }
-[[ -f "$bin/finsd.exe" ]] || { echo "windows vectors: no finsd.exe in $bin" >&2; exit 1; }
-source "$(dirname "$0")/round_trip_lib.sh"  # free_port, wait_for, round_trip_workdir
-round_trip_workdir
-fail() { echo "windows vectors: $*" >&2; tail -n 20 "$work/finsd.log" >&2 || true; exit 1; }
+source "$(dirname "$0")/round_trip_lib.sh"  # windows_test, free_port, wait_for
+windows_test "windows vectors" "$1" "$2" "$2/fins" "$1/finsd.exe"
 
 port=$(free_port)
 "$wine" "$bin/finsd.exe" --bind 127.0.0.1 --port "$port" >"$work/finsd.log" 2>&1 &
